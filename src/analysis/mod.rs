@@ -1,0 +1,1 @@
+//! Linearised stability analysis (thesis section 2.3 and 6.1).

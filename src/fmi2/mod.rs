@@ -1,0 +1,1 @@
+//! The generic FMI 2.0 Co-Simulation layer.

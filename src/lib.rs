@@ -1,0 +1,15 @@
+//! boomsim: the hydraulically actuated boom of the thesis "Stabilization of hydraulically actuated
+//! boom using pressure feedback" as FMI 2.0 Co-Simulation FMUs.
+//!
+//! Physics lives in [`hydraulics`], [`mechanics`] and [`control`] and knows nothing about FMI;
+//! [`models`] composes it into FMU models; [`fmi2`] exposes any model through the C ABI.
+
+pub mod analysis;
+pub mod control;
+pub mod fmi2;
+pub mod hydraulics;
+pub mod mechanics;
+pub mod models;
+pub mod params;
+pub mod solver;
+pub mod units;

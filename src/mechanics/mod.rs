@@ -1,0 +1,1 @@
+//! Boom kinematics, kinetics and deflection (thesis section 2.1).

@@ -1,0 +1,1 @@
+//! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].

@@ -1,0 +1,1 @@
+//! The stiff integrator used inside fmi2DoStep.
