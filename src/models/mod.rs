@@ -1,1 +1,14 @@
 //! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].
+
+pub mod pressure_feedback_controller;
+
+pub use pressure_feedback_controller::PressureFeedbackController;
+
+use crate::fmi2::Fmu;
+
+/// Every FMU boomsim ships, with the cdylib package that exports it.
+pub fn all() -> Vec<Fmu> {
+    vec![Fmu::of::<PressureFeedbackController>(
+        "fmu-pressure-feedback-controller",
+    )]
+}

@@ -1,0 +1,631 @@
+//! The 34 FMI 2.0 Co-Simulation functions, generic over the model. The export macro
+//! ([`crate::export_fmu`]) forwards each `#[no_mangle] extern "C"` symbol here.
+//!
+//! Every function checks its pointers and the state machine, catches panics, and reports
+//! failures through the logger with the instance name (ARCHITECTURE.md, principle 4).
+#![allow(clippy::missing_safety_doc)]
+
+use super::fmu_state::{self, FmuState};
+use super::guid::guid;
+use super::instance::{Core, Instance};
+use super::log::{Logger, LOG_FMI_CALLS};
+use super::model::Model;
+use super::state::{allowed, describe, Mask, State};
+use super::types::*;
+use super::variables::Value;
+use std::ffi::{CStr, CString};
+use std::os::raw::{c_char, c_int};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// The instance behind a component pointer, if it is one of ours for this model.
+unsafe fn instance<'a, M: Model>(c: fmi2Component) -> Option<&'a mut Instance<M>> {
+    let inst = (c as *mut Instance<M>).as_mut()?;
+    (inst.magic == Instance::<M>::MAGIC).then_some(inst)
+}
+
+fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
+    p.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_default()
+}
+
+/// Runs `body` for a valid instance in an allowed state; errors are logged, panics caught.
+fn call<M: Model>(
+    c: fmi2Component,
+    function: &str,
+    mask: Mask,
+    body: impl FnOnce(&mut Instance<M>) -> Result<fmi2Status, String>,
+) -> fmi2Status {
+    // SAFETY: FMI requires `c` to be a pointer returned by fmi2Instantiate; a null or foreign
+    // pointer is detected by the magic tag where the memory is readable.
+    let Some(inst) = (unsafe { instance::<M>(c) }) else {
+        return fmi2Status::Error;
+    };
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        if inst.log.is_enabled(LOG_FMI_CALLS) {
+            inst.log.info("logFmiCalls", function);
+        }
+        let state = inst.core.state;
+        if mask & state.bit() == 0 {
+            return Err(format!(
+                "illegal call in state {state:?}; it is allowed in: {}",
+                describe(mask)
+            ));
+        }
+        body(inst)
+    }));
+    match result {
+        Ok(Ok(status)) => status,
+        Ok(Err(message)) => {
+            inst.log
+                .status(fmi2Status::Error, &format!("{function}: {message}"));
+            fmi2Status::Error
+        }
+        Err(p) => {
+            inst.core.state = State::Error;
+            let m = format!(
+                "{function}: internal error: {}; the instance is now in the Error state (fmi2Reset or fmi2FreeInstance)",
+                panic_text(p.as_ref())
+            );
+            inst.log.status(fmi2Status::Error, &m);
+            fmi2Status::Error
+        }
+    }
+}
+
+/// A slice from a C array; NULL is an error unless `n` is 0.
+unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
+    if n == 0 {
+        Ok(&[])
+    } else if p.is_null() {
+        Err(format!("{what} is NULL but {n} elements were announced"))
+    } else {
+        Ok(std::slice::from_raw_parts(p, n))
+    }
+}
+
+unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mut [T], String> {
+    if n == 0 {
+        Ok(&mut [])
+    } else if p.is_null() {
+        Err(format!("{what} is NULL but {n} elements were announced"))
+    } else {
+        Ok(std::slice::from_raw_parts_mut(p, n))
+    }
+}
+
+unsafe fn text<'a>(p: fmi2String) -> Option<&'a str> {
+    (!p.is_null())
+        .then(|| CStr::from_ptr(p).to_str().ok())
+        .flatten()
+}
+
+pub fn get_types_platform() -> *const c_char {
+    c"default".as_ptr()
+}
+
+pub fn get_version() -> *const c_char {
+    c"2.0".as_ptr()
+}
+
+pub unsafe fn instantiate<M: Model>(
+    name: fmi2String,
+    fmu_type: c_int,
+    fmu_guid: fmi2String,
+    _resource_location: fmi2String,
+    functions: *const fmi2CallbackFunctions,
+    _visible: fmi2Boolean,
+    logging_on: fmi2Boolean,
+) -> fmi2Component {
+    catch_unwind(|| {
+        let f = functions.as_ref().copied()?;
+        let instance_name = text(name).unwrap_or("");
+        let logger = Logger::new(f.logger, f.componentEnvironment, instance_name, M::INFO.log_categories, logging_on != 0);
+        let fail = |message: String| {
+            logger.status(fmi2Status::Error, &format!("fmi2Instantiate: {message}"));
+            None
+        };
+        let expected = guid::<M>();
+        if f.logger.is_none() || f.allocateMemory.is_none() || f.freeMemory.is_none() {
+            return fail("the callback functions logger, allocateMemory and freeMemory must not be NULL".into());
+        }
+        if instance_name.is_empty() {
+            return fail("instanceName must be a non-empty UTF-8 string".into());
+        }
+        if fmu_type != FMI2_COSIMULATION {
+            return fail(format!(
+                "fmuType = {fmu_type} is not supported: {} is a Co-Simulation FMU (fmi2CoSimulation = 1)",
+                M::INFO.identifier
+            ));
+        }
+        match text(fmu_guid) {
+            Some(g) if g == expected => {}
+            g => {
+                return fail(format!(
+                    "fmuGUID = {g:?} does not match this binary's GUID {expected}: modelDescription.xml and binary come from different builds"
+                ))
+            }
+        }
+        Some(Box::into_raw(Box::new(Instance::<M>::new(logger))) as fmi2Component)
+    })
+    .ok()
+    .flatten()
+    .unwrap_or(std::ptr::null_mut())
+}
+
+pub unsafe fn free_instance<M: Model>(c: fmi2Component) {
+    let status = call::<M>(c, "fmi2FreeInstance", allowed::FREE_INSTANCE, |_| {
+        Ok(fmi2Status::OK)
+    });
+    if status == fmi2Status::OK {
+        let mut inst = Box::from_raw(c as *mut Instance<M>);
+        inst.magic = 0;
+    }
+}
+
+pub unsafe fn set_debug_logging<M: Model>(
+    c: fmi2Component,
+    on: fmi2Boolean,
+    n: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    call::<M>(
+        c,
+        "fmi2SetDebugLogging",
+        allowed::SET_DEBUG_LOGGING,
+        |inst| {
+            let names = slice(categories, n, "categories")?
+                .iter()
+                .map(|&p| text(p).ok_or_else(|| "a category name is NULL or not UTF-8".to_string()))
+                .collect::<Result<Vec<_>, _>>()?;
+            inst.log.set_debug_logging(on != 0, &names)?;
+            Ok(fmi2Status::OK)
+        },
+    )
+}
+
+pub unsafe fn setup_experiment<M: Model>(
+    c: fmi2Component,
+    tolerance_defined: fmi2Boolean,
+    tolerance: f64,
+    start: f64,
+    stop_defined: fmi2Boolean,
+    stop: f64,
+) -> fmi2Status {
+    call::<M>(
+        c,
+        "fmi2SetupExperiment",
+        allowed::SETUP_EXPERIMENT,
+        |inst| {
+            inst.setup_experiment(
+                (tolerance_defined != 0).then_some(tolerance),
+                start,
+                (stop_defined != 0).then_some(stop),
+            )?;
+            Ok(fmi2Status::OK)
+        },
+    )
+}
+
+pub unsafe fn enter_initialization_mode<M: Model>(c: fmi2Component) -> fmi2Status {
+    call::<M>(
+        c,
+        "fmi2EnterInitializationMode",
+        allowed::ENTER_INITIALIZATION_MODE,
+        |inst| {
+            inst.enter_initialization_mode();
+            Ok(fmi2Status::OK)
+        },
+    )
+}
+
+pub unsafe fn exit_initialization_mode<M: Model>(c: fmi2Component) -> fmi2Status {
+    call::<M>(
+        c,
+        "fmi2ExitInitializationMode",
+        allowed::EXIT_INITIALIZATION_MODE,
+        |inst| {
+            inst.exit_initialization_mode()?;
+            Ok(fmi2Status::OK)
+        },
+    )
+}
+
+pub unsafe fn terminate<M: Model>(c: fmi2Component) -> fmi2Status {
+    call::<M>(c, "fmi2Terminate", allowed::TERMINATE, |inst| {
+        inst.core.state = State::Terminated;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn reset<M: Model>(c: fmi2Component) -> fmi2Status {
+    call::<M>(c, "fmi2Reset", allowed::RESET, |inst| {
+        inst.core = Core::new();
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// Shared body of the four getters.
+unsafe fn get<M: Model, T>(
+    c: fmi2Component,
+    function: &str,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    out: *mut T,
+    wanted: &str,
+    read: impl Fn(&Value) -> T,
+) -> fmi2Status {
+    call::<M>(c, function, allowed::GET, |inst| {
+        let vrs = slice(vr, n, "vr")?;
+        let out = slice_mut(out, n, "value")?;
+        inst.get(vrs, out, wanted, read)?;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn get_real<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *mut f64,
+) -> fmi2Status {
+    get::<M, f64>(c, "fmi2GetReal", vr, n, value, "Real", |v| {
+        if let Value::Real(x) = v {
+            *x
+        } else {
+            f64::NAN
+        }
+    })
+}
+
+pub unsafe fn get_integer<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *mut c_int,
+) -> fmi2Status {
+    get::<M, c_int>(c, "fmi2GetInteger", vr, n, value, "Integer", |v| {
+        if let Value::Integer(x) = v {
+            *x
+        } else {
+            0
+        }
+    })
+}
+
+pub unsafe fn get_boolean<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *mut c_int,
+) -> fmi2Status {
+    get::<M, c_int>(c, "fmi2GetBoolean", vr, n, value, "Boolean", |v| {
+        matches!(v, Value::Boolean(true)) as c_int
+    })
+}
+
+pub unsafe fn get_string<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    call::<M>(c, "fmi2GetString", allowed::GET, |inst| {
+        let vrs = slice(vr, n, "vr")?;
+        let out = slice_mut(value, n, "value")?;
+        let mut texts = vec![CString::default(); n];
+        inst.get(vrs, &mut texts, "String", |v| match v {
+            Value::String(s) => CString::new(s.replace('\0', " ")).unwrap_or_default(),
+            _ => CString::default(),
+        })?;
+        // The pointers stay valid until the next fmi2GetString on this instance (FMI 2.0, 2.1.7).
+        inst.strings = texts;
+        out.iter_mut()
+            .zip(&inst.strings)
+            .for_each(|(o, s)| *o = s.as_ptr());
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// Shared body of the four setters.
+unsafe fn set<M: Model, T: Copy>(
+    c: fmi2Component,
+    function: &str,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const T,
+    wanted: &str,
+    convert: impl Fn(T) -> Result<Value, String>,
+) -> fmi2Status {
+    call::<M>(c, function, allowed::SET, |inst| {
+        let vrs = slice(vr, n, "vr")?;
+        let values = slice(value, n, "value")?
+            .iter()
+            .map(|&x| convert(x))
+            .collect::<Result<Vec<_>, _>>()?;
+        inst.set(vrs, values, wanted)?;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn set_real<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *const f64,
+) -> fmi2Status {
+    set::<M, f64>(c, "fmi2SetReal", vr, n, value, "Real", |x| {
+        Ok(Value::Real(x))
+    })
+}
+
+pub unsafe fn set_integer<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *const c_int,
+) -> fmi2Status {
+    set::<M, c_int>(c, "fmi2SetInteger", vr, n, value, "Integer", |x| {
+        Ok(Value::Integer(x))
+    })
+}
+
+pub unsafe fn set_boolean<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *const c_int,
+) -> fmi2Status {
+    set::<M, c_int>(c, "fmi2SetBoolean", vr, n, value, "Boolean", |x| match x {
+        FMI2_FALSE => Ok(Value::Boolean(false)),
+        FMI2_TRUE => Ok(Value::Boolean(true)),
+        _ => Err(format!(
+            "{x} is not an fmi2Boolean; valid values are fmi2False (0) and fmi2True (1)"
+        )),
+    })
+}
+
+pub unsafe fn set_string<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *const fmi2String,
+) -> fmi2Status {
+    set::<M, fmi2String>(c, "fmi2SetString", vr, n, value, "String", |p| {
+        text(p)
+            .map(|s| Value::String(s.to_owned()))
+            .ok_or_else(|| "a string value is NULL or not UTF-8".into())
+    })
+}
+
+pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    call::<M>(c, "fmi2GetFMUstate", allowed::FMU_STATE, |inst| {
+        let out = state.as_mut().ok_or("FMUstate is NULL")?;
+        if let Some(old) = (*out as *mut FmuState<M>)
+            .as_mut()
+            .filter(|s| s.magic == Instance::<M>::STATE_MAGIC)
+        {
+            old.core = inst.core.clone();
+        } else {
+            let s = FmuState {
+                magic: Instance::<M>::STATE_MAGIC,
+                core: inst.core.clone(),
+            };
+            *out = Box::into_raw(Box::new(s)) as fmi2FMUstate;
+        }
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// The FMU state behind a pointer, if it is one of ours for this model.
+unsafe fn fmu_state_ref<'a, M: Model>(s: fmi2FMUstate) -> Result<&'a mut FmuState<M>, String> {
+    (s as *mut FmuState<M>)
+        .as_mut()
+        .filter(|s| s.magic == Instance::<M>::STATE_MAGIC)
+        .ok_or_else(|| format!("FMUstate is NULL or not a state of {}", M::INFO.identifier))
+}
+
+pub unsafe fn set_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
+    call::<M>(c, "fmi2SetFMUstate", allowed::FMU_STATE, |inst| {
+        inst.core = fmu_state_ref::<M>(state)?.core.clone();
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    call::<M>(c, "fmi2FreeFMUstate", allowed::FMU_STATE, |_| {
+        let p = state.as_mut().ok_or("FMUstate is NULL")?;
+        if p.is_null() {
+            return Ok(fmi2Status::OK);
+        }
+        let s = fmu_state_ref::<M>(*p)?;
+        s.magic = 0;
+        drop(Box::from_raw(s as *mut FmuState<M>));
+        *p = std::ptr::null_mut();
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn serialized_fmu_state_size<M: Model>(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    call::<M>(c, "fmi2SerializedFMUstateSize", allowed::FMU_STATE, |_| {
+        let out = size.as_mut().ok_or("size is NULL")?;
+        *out = fmu_state::serialize(&fmu_state_ref::<M>(state)?.core, &guid::<M>()).len();
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn serialize_fmu_state<M: Model>(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    bytes: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    call::<M>(c, "fmi2SerializeFMUstate", allowed::FMU_STATE, |_| {
+        let data = fmu_state::serialize(&fmu_state_ref::<M>(state)?.core, &guid::<M>());
+        if data.len() != size {
+            return Err(format!(
+                "size = {size} bytes, but the state needs {} (fmi2SerializedFMUstateSize)",
+                data.len()
+            ));
+        }
+        slice_mut(bytes as *mut u8, size, "serializedState")?.copy_from_slice(&data);
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    c: fmi2Component,
+    bytes: *const fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
+    call::<M>(c, "fmi2DeSerializeFMUstate", allowed::FMU_STATE, |_| {
+        let data = slice(bytes as *const u8, size, "serializedState")?;
+        let out = state.as_mut().ok_or("FMUstate is NULL")?;
+        let core = fmu_state::deserialize::<M>(data, &guid::<M>())?;
+        let s = FmuState {
+            magic: Instance::<M>::STATE_MAGIC,
+            core,
+        };
+        *out = Box::into_raw(Box::new(s)) as fmi2FMUstate;
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// Shared body of the functions boomsim does not provide.
+fn unsupported<M: Model>(c: fmi2Component, function: &str, mask: Mask, why: &str) -> fmi2Status {
+    call::<M>(c, function, mask, |_| Err(format!("not supported: {why}")))
+}
+
+pub unsafe fn get_directional_derivative<M: Model>(c: fmi2Component) -> fmi2Status {
+    unsupported::<M>(
+        c,
+        "fmi2GetDirectionalDerivative",
+        allowed::DIRECTIONAL_DERIVATIVE,
+        "providesDirectionalDerivative=\"false\"",
+    )
+}
+
+pub unsafe fn set_real_input_derivatives<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    order: *const c_int,
+    value: *const f64,
+) -> fmi2Status {
+    call::<M>(
+        c,
+        "fmi2SetRealInputDerivatives",
+        allowed::SET_INPUT_DERIVATIVES,
+        |inst| {
+            inst.set_input_derivatives(
+                slice(vr, n, "vr")?,
+                slice(order, n, "order")?,
+                slice(value, n, "value")?,
+            )?;
+            Ok(fmi2Status::OK)
+        },
+    )
+}
+
+pub unsafe fn get_real_output_derivatives<M: Model>(c: fmi2Component) -> fmi2Status {
+    unsupported::<M>(
+        c,
+        "fmi2GetRealOutputDerivatives",
+        allowed::GET_OUTPUT_DERIVATIVES,
+        "maxOutputDerivativeOrder=\"0\"",
+    )
+}
+
+pub unsafe fn do_step<M: Model>(
+    c: fmi2Component,
+    t: f64,
+    h: f64,
+    _no_set_prior: fmi2Boolean,
+) -> fmi2Status {
+    call::<M>(c, "fmi2DoStep", allowed::DO_STEP, |inst| {
+        match inst.do_step(t, h)? {
+            None => Ok(fmi2Status::OK),
+            Some(why) => {
+                inst.log
+                    .status(fmi2Status::Discard, &format!("fmi2DoStep: {why}"));
+                Ok(fmi2Status::Discard)
+            }
+        }
+    })
+}
+
+pub unsafe fn cancel_step<M: Model>(c: fmi2Component) -> fmi2Status {
+    unsupported::<M>(
+        c,
+        "fmi2CancelStep",
+        allowed::CANCEL_STEP,
+        "doStep is synchronous (canRunAsynchronuously=\"false\")",
+    )
+}
+
+pub unsafe fn get_status<M: Model>(c: fmi2Component) -> fmi2Status {
+    unsupported::<M>(
+        c,
+        "fmi2GetStatus",
+        allowed::GET_STATUS,
+        "no fmi2Status kind is defined for a synchronous slave",
+    )
+}
+
+pub unsafe fn get_integer_status<M: Model>(c: fmi2Component) -> fmi2Status {
+    unsupported::<M>(
+        c,
+        "fmi2GetIntegerStatus",
+        allowed::GET_STATUS,
+        "FMI 2.0 defines no integer status",
+    )
+}
+
+pub unsafe fn get_string_status<M: Model>(c: fmi2Component) -> fmi2Status {
+    unsupported::<M>(
+        c,
+        "fmi2GetStringStatus",
+        allowed::GET_STATUS,
+        "no string status (fmi2PendingStatus needs an asynchronous doStep)",
+    )
+}
+
+pub unsafe fn get_real_status<M: Model>(
+    c: fmi2Component,
+    kind: c_int,
+    value: *mut f64,
+) -> fmi2Status {
+    call::<M>(c, "fmi2GetRealStatus", allowed::GET_STATUS, |inst| {
+        if kind != FMI2_LAST_SUCCESSFUL_TIME {
+            return Err(format!(
+                "status kind {kind} is not available; only fmi2LastSuccessfulTime (2) is"
+            ));
+        }
+        *value.as_mut().ok_or("value is NULL")? = inst.core.last_successful_time;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn get_boolean_status<M: Model>(
+    c: fmi2Component,
+    kind: c_int,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    call::<M>(c, "fmi2GetBooleanStatus", allowed::GET_STATUS, |inst| {
+        if kind != FMI2_TERMINATED {
+            return Err(format!(
+                "status kind {kind} is not available; only fmi2Terminated (3) is"
+            ));
+        }
+        // The slave asks to end the simulation only once a step has failed.
+        *value.as_mut().ok_or("value is NULL")? =
+            (inst.core.state == State::StepFailed) as fmi2Boolean;
+        Ok(fmi2Status::OK)
+    })
+}

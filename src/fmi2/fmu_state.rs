@@ -1,0 +1,234 @@
+//! FMU states: deep copies for fmi2GetFMUstate/SetFMUstate and their checked byte format for
+//! fmi2SerializeFMUstate/DeSerializeFMUstate.
+//!
+//! Byte format, little endian: magic `BOOMSIM\0`, format version (u32), GUID (u32 length +
+//! UTF-8), payload length (u64), payload, CRC-32 of everything before it (u32). The payload holds
+//! the state machine state, times, every variable value, the input derivatives and the model's
+//! own state. Any mismatch (size, GUID, version, checksum, value types) is refused with a reason.
+
+use super::instance::Core;
+use super::model::Model;
+use super::state::State;
+use super::variables::{Value, Values};
+
+/// `#[repr(C)]` so that the tag comes first: it tells our FMU states from foreign pointers.
+#[repr(C)]
+pub struct FmuState<M: Model> {
+    pub(crate) magic: u64,
+    pub core: Core<M>,
+}
+
+const MAGIC: &[u8; 8] = b"BOOMSIM\0";
+/// Version of the byte format; bump it when the layout changes.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Serialises a core into the checked byte format.
+pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
+    let mut p = Vec::new();
+    p.push(state_code(core.state));
+    for x in [core.time, core.start_time, core.last_successful_time] {
+        put_f64(&mut p, x);
+    }
+    for opt in [core.stop_time, core.tolerance] {
+        p.push(opt.is_some() as u8);
+        put_f64(&mut p, opt.unwrap_or(0.0));
+    }
+    p.push(core.outputs_current as u8);
+    put_u64(&mut p, core.values.all().len() as u64);
+    for v in core.values.all() {
+        match v {
+            Value::Real(x) => {
+                p.push(0);
+                put_f64(&mut p, *x)
+            }
+            Value::Integer(i) => {
+                p.push(1);
+                p.extend_from_slice(&i.to_le_bytes())
+            }
+            Value::Boolean(b) => {
+                p.push(2);
+                p.push(*b as u8)
+            }
+            Value::String(s) => {
+                p.push(3);
+                put_u64(&mut p, s.len() as u64);
+                p.extend_from_slice(s.as_bytes())
+            }
+        }
+    }
+    core.input_derivatives
+        .iter()
+        .for_each(|&d| put_f64(&mut p, d));
+    match &core.model {
+        None => p.push(0),
+        Some(m) => {
+            p.push(1);
+            let s = m.save();
+            put_u64(&mut p, s.len() as u64);
+            s.iter().for_each(|&x| put_f64(&mut p, x));
+        }
+    }
+    let mut out = Vec::with_capacity(p.len() + 64);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(guid.len() as u32).to_le_bytes());
+    out.extend_from_slice(guid.as_bytes());
+    put_u64(&mut out, p.len() as u64);
+    out.extend_from_slice(&p);
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out
+}
+
+/// Parses bytes written by [`serialize`] for this model and GUID.
+pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String> {
+    if bytes.len() < MAGIC.len() + 4 + 4 + 8 + 4 {
+        return Err(format!(
+            "{} bytes are too few for a serialised FMU state",
+            bytes.len()
+        ));
+    }
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    let crc = u32::from_le_bytes(crc.try_into().unwrap_or_default());
+    if !body.starts_with(MAGIC) {
+        return Err("the bytes are not a boomsim FMU state (wrong magic)".into());
+    }
+    if crc32fast::hash(body) != crc {
+        return Err("the serialised FMU state is corrupted (checksum mismatch)".into());
+    }
+    let mut r = Reader {
+        b: body,
+        at: MAGIC.len(),
+    };
+    let version = u32::from_le_bytes(r.take(4)?.try_into().unwrap_or_default());
+    if version != FORMAT_VERSION {
+        return Err(format!(
+            "serialised format version {version}; this FMU reads version {FORMAT_VERSION}"
+        ));
+    }
+    let n = u32::from_le_bytes(r.take(4)?.try_into().unwrap_or_default()) as usize;
+    let their_guid = String::from_utf8_lossy(r.take(n)?).into_owned();
+    if their_guid != guid {
+        return Err(format!(
+            "the state belongs to the FMU with GUID {their_guid}, not to {guid}"
+        ));
+    }
+    let len = r.u64()? as usize;
+    if len != body.len() - r.at {
+        return Err(format!(
+            "payload length {len} does not match the {} bytes present",
+            body.len() - r.at
+        ));
+    }
+    let state = decode_state(r.take(1)?[0])?;
+    let (time, start_time, last_successful_time) = (r.f64()?, r.f64()?, r.f64()?);
+    let mut opt = || -> Result<Option<f64>, String> {
+        let some = r.take(1)?[0] != 0;
+        let x = r.f64()?;
+        Ok(some.then_some(x))
+    };
+    let (stop_time, tolerance) = (opt()?, opt()?);
+    let outputs_current = r.take(1)?[0] != 0;
+    let mut values = Values::new(M::VARIABLES);
+    let count = r.u64()? as usize;
+    if count != M::VARIABLES.len() {
+        return Err(format!(
+            "the state has {count} variables; {} has {}",
+            M::INFO.identifier,
+            M::VARIABLES.len()
+        ));
+    }
+    for i in 0..count {
+        let v = match (r.take(1)?[0], values.at(i)) {
+            (0, Value::Real(_)) => Value::Real(r.f64()?),
+            (1, Value::Integer(_)) => Value::Integer(i32::from_le_bytes(
+                r.take(4)?.try_into().unwrap_or_default(),
+            )),
+            (2, Value::Boolean(_)) => Value::Boolean(r.take(1)?[0] != 0),
+            (3, Value::String(_)) => {
+                let n = r.u64()? as usize;
+                Value::String(String::from_utf8(r.take(n)?.to_vec()).map_err(|e| e.to_string())?)
+            }
+            (tag, _) => {
+                return Err(format!(
+                    "value {i} has type tag {tag}, which does not match variable \"{}\"",
+                    M::VARIABLES[i].name
+                ))
+            }
+        };
+        values.put(i, v);
+    }
+    let input_derivatives = (0..count).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
+    let model = match r.take(1)?[0] {
+        0 => None,
+        _ => {
+            let n = r.u64()? as usize;
+            let s = (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
+            Some(M::load(&values, &s)?)
+        }
+    };
+    if r.at != body.len() {
+        return Err(format!(
+            "{} unexpected bytes after the state",
+            body.len() - r.at
+        ));
+    }
+    Ok(Core {
+        state,
+        values,
+        input_derivatives,
+        model,
+        time,
+        start_time,
+        stop_time,
+        tolerance,
+        last_successful_time,
+        outputs_current,
+    })
+}
+
+fn put_f64(out: &mut Vec<u8>, x: f64) {
+    out.extend_from_slice(&x.to_le_bytes());
+}
+fn put_u64(out: &mut Vec<u8>, x: u64) {
+    out.extend_from_slice(&x.to_le_bytes());
+}
+
+fn state_code(s: State) -> u8 {
+    State::ALL.iter().position(|&x| x == s).unwrap_or(0) as u8
+}
+fn decode_state(c: u8) -> Result<State, String> {
+    State::ALL
+        .get(c as usize)
+        .copied()
+        .ok_or_else(|| format!("invalid state code {c}"))
+}
+
+/// A bounds-checked cursor.
+struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.b.len())
+            .ok_or("the serialised FMU state is truncated")?;
+        let s = &self.b[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or_default(),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or_default(),
+        ))
+    }
+}

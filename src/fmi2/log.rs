@@ -1,0 +1,144 @@
+//! Logging through the importer's callback, with FMI 2.0 log categories.
+
+use super::types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
+use std::ffi::CString;
+
+/// Categories every boomsim FMU declares, in this order, before the model's own.
+pub const GENERIC_CATEGORIES: &[(&str, &str)] = &[
+    ("logStatusWarning", "Messages with status fmi2Warning"),
+    ("logStatusDiscard", "Messages with status fmi2Discard"),
+    (
+        "logStatusError",
+        "Messages with status fmi2Error (always delivered)",
+    ),
+    (
+        "logStatusFatal",
+        "Messages with status fmi2Fatal (always delivered)",
+    ),
+    ("logAll", "Every message of every category"),
+    ("logFmiCalls", "Each FMI function call by name"),
+];
+const LOG_ALL: usize = 4;
+/// Index of the `logFmiCalls` category.
+pub const LOG_FMI_CALLS: usize = 5;
+
+/// The instance's connection to the importer's logger.
+pub struct Logger {
+    callback: fmi2CallbackLogger,
+    environment: fmi2ComponentEnvironment,
+    instance_name: CString,
+    categories: Vec<(&'static str, &'static str)>,
+    enabled: Vec<bool>,
+}
+
+// SAFETY: the environment pointer is only handed back to the importer's callback, which FMI
+// requires to be callable for this instance from whichever thread uses the instance.
+unsafe impl Send for Logger {}
+
+impl Logger {
+    /// A logger for one instance. With `logging_on`, every category is enabled; otherwise only
+    /// warnings, discards and errors are.
+    pub fn new(
+        callback: fmi2CallbackLogger,
+        environment: fmi2ComponentEnvironment,
+        instance_name: &str,
+        model_categories: &'static [(&'static str, &'static str)],
+        logging_on: bool,
+    ) -> Self {
+        let categories: Vec<_> = GENERIC_CATEGORIES
+            .iter()
+            .chain(model_categories)
+            .copied()
+            .collect();
+        let enabled = (0..categories.len())
+            .map(|i| logging_on || i < LOG_ALL)
+            .collect();
+        Logger {
+            callback,
+            environment,
+            instance_name: c_string(instance_name),
+            categories,
+            enabled,
+        }
+    }
+
+    /// The instance name given to fmi2Instantiate.
+    pub fn instance_name(&self) -> &str {
+        self.instance_name.to_str().unwrap_or("?")
+    }
+
+    /// fmi2SetDebugLogging: no categories = all of them; an unknown name is an error naming it.
+    pub fn set_debug_logging(&mut self, on: bool, names: &[&str]) -> Result<(), String> {
+        if names.is_empty() {
+            self.enabled.iter_mut().for_each(|e| *e = on);
+            return Ok(());
+        }
+        let mut idx = Vec::with_capacity(names.len());
+        for n in names {
+            match self.categories.iter().position(|(c, _)| c == n) {
+                Some(i) => idx.push(i),
+                None => {
+                    let known: Vec<&str> = self.categories.iter().map(|(c, _)| *c).collect();
+                    return Err(format!(
+                        "unknown log category \"{n}\"; the categories are {}",
+                        known.join(", ")
+                    ));
+                }
+            }
+        }
+        idx.into_iter().for_each(|i| self.enabled[i] = on);
+        Ok(())
+    }
+
+    /// Whether a category (by index) is currently delivered.
+    pub fn is_enabled(&self, category: usize) -> bool {
+        self.enabled.get(category).copied().unwrap_or(false) || self.enabled[LOG_ALL]
+    }
+
+    /// Logs `message` with `status`; the category follows from the status.
+    pub fn status(&self, status: fmi2Status, message: &str) {
+        let category = match status {
+            fmi2Status::Warning => 0,
+            fmi2Status::Discard => 1,
+            fmi2Status::Error => 2,
+            fmi2Status::Fatal => 3,
+            _ => LOG_FMI_CALLS,
+        };
+        let always = matches!(status, fmi2Status::Error | fmi2Status::Fatal);
+        if always || self.is_enabled(category) {
+            self.emit(status, self.categories[category].0, message);
+        }
+    }
+
+    /// Logs an fmi2OK message in a category given by name (the model's own or `logFmiCalls`).
+    pub fn info(&self, category: &str, message: &str) {
+        if let Some(i) = self.categories.iter().position(|(c, _)| *c == category) {
+            if self.is_enabled(i) {
+                self.emit(fmi2Status::OK, category, message);
+            }
+        }
+    }
+
+    fn emit(&self, status: fmi2Status, category: &str, message: &str) {
+        if let Some(log) = self.callback {
+            let category = c_string(category);
+            let message = c_string(message);
+            // SAFETY: a printf-style callback with a "%s" format and one NUL-terminated string.
+            unsafe {
+                log(
+                    self.environment,
+                    self.instance_name.as_ptr(),
+                    status as i32,
+                    category.as_ptr(),
+                    c"%s".as_ptr(),
+                    message.as_ptr(),
+                )
+            };
+        }
+    }
+}
+
+/// A C string from any text; interior NULs become spaces.
+fn c_string(s: &str) -> CString {
+    CString::new(s.replace('\0', " ")).unwrap_or_default()
+}

@@ -1,0 +1,80 @@
+//! The model trait: what a physics model provides so that [`crate::fmi2`] can export it.
+
+use super::variables::{Values, Variable};
+
+/// Static facts about a model, written to modelDescription.xml.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelInfo {
+    /// modelIdentifier: the .so name and the cdylib's `lib.name`.
+    pub identifier: &'static str,
+    pub description: &'static str,
+    /// Model version; part of the GUID.
+    pub version: &'static str,
+    /// DefaultExperiment: start, stop, step size.
+    pub start_time: f64,
+    pub stop_time: f64,
+    pub step_size: f64,
+    /// Relative tolerance used when fmi2SetupExperiment defines none.
+    pub default_tolerance: f64,
+    /// The model's own log categories (name, description), beside the generic ones.
+    pub log_categories: &'static [(&'static str, &'static str)],
+    /// Whether doStep uses input derivatives set by fmi2SetRealInputDerivatives (order 1).
+    pub can_interpolate_inputs: bool,
+    /// HTML fragment for documentation/index.html: equations, sources, notes.
+    pub documentation: &'static str,
+}
+
+/// A failed step: how far the model got and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepError {
+    /// Time of the last good state the model now holds.
+    pub time: f64,
+    pub message: String,
+}
+
+/// What a model says while it steps, routed to a log category by the FMI layer.
+pub trait Log {
+    /// Logs an info message in one of the model's own categories.
+    fn info(&mut self, category: &str, message: &str);
+    /// Logs a warning.
+    fn warning(&mut self, message: &str);
+}
+
+/// A model exported as an FMI 2.0 Co-Simulation slave.
+///
+/// The FMI layer owns the variable values (`Values`) and the state machine; the model holds its
+/// internal continuous state and reads parameters and inputs from `Values`.
+pub trait Model: Clone + Send + Sized + 'static {
+    const INFO: ModelInfo;
+    /// The variable table (unique value references across all types).
+    const VARIABLES: &'static [Variable];
+
+    /// Builds the model from final parameter and input values at the end of initialisation
+    /// (and, in initialisation mode, to compute initial outputs). Returns a message naming the
+    /// offending variables when their combination is inconsistent.
+    fn initialize(values: &Values) -> Result<Self, String>;
+
+    /// Re-reads tunable parameters changed between steps; keeps the continuous state.
+    fn retune(&mut self, values: &Values) -> Result<(), String>;
+
+    /// Writes outputs and locals from the current state and inputs.
+    fn outputs(&self, values: &mut Values);
+
+    /// Advances from `t` to `t + h`. Inputs are `values` at `t`, changing with the given first
+    /// derivatives (one per table row; zero unless set) when the model interpolates inputs.
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError>;
+
+    /// The internal state as numbers, for FMU state serialisation.
+    fn save(&self) -> Vec<f64>;
+
+    /// Restores a model saved by [`Model::save`] under the given variable values.
+    fn load(values: &Values, state: &[f64]) -> Result<Self, String>;
+}

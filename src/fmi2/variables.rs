@@ -1,0 +1,380 @@
+//! The variable table: the one source of truth for get/set, range checks, the GUID and
+//! modelDescription.xml (ARCHITECTURE.md, principle 2).
+
+use crate::params::ParamSpec;
+
+/// FMI 2.0 causality (section 2.2.7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    CalculatedParameter,
+    Input,
+    Output,
+    Local,
+}
+
+/// FMI 2.0 variability.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variability {
+    Constant,
+    Fixed,
+    Tunable,
+    Discrete,
+    Continuous,
+}
+
+/// FMI 2.0 `initial` attribute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Initial {
+    Exact,
+    Approx,
+    Calculated,
+}
+
+/// Type, start value and type-specific attributes of a variable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Kind {
+    Real {
+        start: f64,
+        unit: &'static str,
+        display_unit: &'static str,
+        min: f64,
+        max: f64,
+    },
+    Integer {
+        start: i32,
+        min: i32,
+        max: i32,
+    },
+    Boolean {
+        start: bool,
+    },
+    String {
+        start: &'static str,
+    },
+}
+
+/// The four FMI base types, for messages and type checks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BaseType {
+    Real,
+    Integer,
+    Boolean,
+    String,
+}
+
+/// One row of a model's variable table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Variable {
+    pub name: &'static str,
+    /// Value reference: stable across releases, never renumbered.
+    pub vr: u32,
+    pub description: &'static str,
+    pub causality: Causality,
+    pub variability: Variability,
+    pub initial: Initial,
+    pub kind: Kind,
+    /// For outputs: the value references of the inputs it depends on directly (ModelStructure).
+    pub depends_on: &'static [u32],
+}
+
+const NO_MIN: f64 = f64::NEG_INFINITY;
+const NO_MAX: f64 = f64::INFINITY;
+
+impl Variable {
+    const fn new(
+        name: &'static str,
+        vr: u32,
+        causality: Causality,
+        variability: Variability,
+        initial: Initial,
+        kind: Kind,
+        description: &'static str,
+    ) -> Self {
+        Variable {
+            name,
+            vr,
+            description,
+            causality,
+            variability,
+            initial,
+            kind,
+            depends_on: &[],
+        }
+    }
+
+    /// A tunable Real parameter from its physical description.
+    pub const fn param(vr: u32, p: ParamSpec) -> Self {
+        let kind = Kind::Real {
+            start: p.default,
+            unit: p.unit,
+            display_unit: p.display_unit,
+            min: p.min,
+            max: p.max,
+        };
+        Self::new(
+            p.name,
+            vr,
+            Causality::Parameter,
+            Variability::Tunable,
+            Initial::Exact,
+            kind,
+            p.description,
+        )
+    }
+
+    /// A continuous Real input with start value and admissible range.
+    pub const fn real_input(
+        name: &'static str,
+        vr: u32,
+        start: f64,
+        unit: &'static str,
+        display_unit: &'static str,
+        (min, max): (f64, f64),
+        description: &'static str,
+    ) -> Self {
+        let kind = Kind::Real {
+            start,
+            unit,
+            display_unit,
+            min,
+            max,
+        };
+        Self::new(
+            name,
+            vr,
+            Causality::Input,
+            Variability::Continuous,
+            Initial::Exact,
+            kind,
+            description,
+        )
+    }
+
+    /// A continuous Real output computed by the model (initial = calculated, no start value).
+    pub const fn real_output(
+        name: &'static str,
+        vr: u32,
+        unit: &'static str,
+        display_unit: &'static str,
+        description: &'static str,
+    ) -> Self {
+        let kind = Kind::Real {
+            start: 0.0,
+            unit,
+            display_unit,
+            min: NO_MIN,
+            max: NO_MAX,
+        };
+        Self::new(
+            name,
+            vr,
+            Causality::Output,
+            Variability::Continuous,
+            Initial::Calculated,
+            kind,
+            description,
+        )
+    }
+
+    /// A continuous Real local (internal state or diagnostic), initial = calculated.
+    pub const fn real_local(
+        name: &'static str,
+        vr: u32,
+        unit: &'static str,
+        display_unit: &'static str,
+        description: &'static str,
+    ) -> Self {
+        let kind = Kind::Real {
+            start: 0.0,
+            unit,
+            display_unit,
+            min: NO_MIN,
+            max: NO_MAX,
+        };
+        Self::new(
+            name,
+            vr,
+            Causality::Local,
+            Variability::Continuous,
+            Initial::Calculated,
+            kind,
+            description,
+        )
+    }
+
+    /// A tunable Boolean parameter.
+    pub const fn bool_param(
+        name: &'static str,
+        vr: u32,
+        start: bool,
+        description: &'static str,
+    ) -> Self {
+        let kind = Kind::Boolean { start };
+        Self::new(
+            name,
+            vr,
+            Causality::Parameter,
+            Variability::Tunable,
+            Initial::Exact,
+            kind,
+            description,
+        )
+    }
+
+    /// A fixed Integer parameter (FMI 2.0 has no structural parameters: fixed ones play that role).
+    pub const fn int_param(
+        name: &'static str,
+        vr: u32,
+        start: i32,
+        (min, max): (i32, i32),
+        description: &'static str,
+    ) -> Self {
+        let kind = Kind::Integer { start, min, max };
+        Self::new(
+            name,
+            vr,
+            Causality::Parameter,
+            Variability::Fixed,
+            Initial::Exact,
+            kind,
+            description,
+        )
+    }
+
+    /// The same variable, but fixed (settable only before initialisation ends).
+    pub const fn fixed(mut self) -> Self {
+        self.variability = Variability::Fixed;
+        self
+    }
+
+    /// The same output, declaring the inputs it depends on directly.
+    pub const fn depends(mut self, inputs: &'static [u32]) -> Self {
+        self.depends_on = inputs;
+        self
+    }
+
+    /// The variable's base type.
+    pub const fn base_type(&self) -> BaseType {
+        match self.kind {
+            Kind::Real { .. } => BaseType::Real,
+            Kind::Integer { .. } => BaseType::Integer,
+            Kind::Boolean { .. } => BaseType::Boolean,
+            Kind::String { .. } => BaseType::String,
+        }
+    }
+
+    /// Whether the XML carries a start value (FMI 2.0: initial exact/approx, or an input).
+    pub fn has_start(&self) -> bool {
+        self.initial != Initial::Calculated || self.causality == Causality::Input
+    }
+
+    /// The start value as a [`Value`].
+    pub fn start_value(&self) -> Value {
+        match self.kind {
+            Kind::Real { start, .. } => Value::Real(start),
+            Kind::Integer { start, .. } => Value::Integer(start),
+            Kind::Boolean { start } => Value::Boolean(start),
+            Kind::String { start } => Value::String(start.to_owned()),
+        }
+    }
+}
+
+/// A variable's current value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    Real(f64),
+    Integer(i32),
+    Boolean(bool),
+    String(String),
+}
+
+/// The current values of all variables of one instance, in table order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Values {
+    table: &'static [Variable],
+    values: Vec<Value>,
+    /// (vr, table index), sorted by vr.
+    index: Vec<(u32, usize)>,
+}
+
+impl Values {
+    /// All variables at their start values.
+    pub fn new(table: &'static [Variable]) -> Self {
+        let mut index: Vec<(u32, usize)> =
+            table.iter().enumerate().map(|(i, v)| (v.vr, i)).collect();
+        index.sort_unstable();
+        Values {
+            table,
+            values: table.iter().map(Variable::start_value).collect(),
+            index,
+        }
+    }
+
+    /// The variable table.
+    pub fn table(&self) -> &'static [Variable] {
+        self.table
+    }
+
+    /// Table index of a value reference.
+    pub fn position(&self, vr: u32) -> Option<usize> {
+        self.index
+            .binary_search_by_key(&vr, |&(r, _)| r)
+            .ok()
+            .map(|k| self.index[k].1)
+    }
+
+    /// The value at a table index.
+    pub fn at(&self, i: usize) -> &Value {
+        &self.values[i]
+    }
+
+    /// Replaces the value at a table index (the caller checked type and range).
+    pub fn put(&mut self, i: usize, v: Value) {
+        self.values[i] = v;
+    }
+
+    /// All values in table order.
+    pub fn all(&self) -> &[Value] {
+        &self.values
+    }
+
+    fn expect(&self, vr: u32) -> &Value {
+        let i = self
+            .position(vr)
+            .unwrap_or_else(|| panic!("no variable with value reference {vr}"));
+        &self.values[i]
+    }
+
+    /// The Real with value reference `vr` (panics on a wrong vr: a bug in the model, caught at the ABI).
+    pub fn real(&self, vr: u32) -> f64 {
+        match self.expect(vr) {
+            Value::Real(x) => *x,
+            v => panic!("variable {vr} is not a Real: {v:?}"),
+        }
+    }
+
+    /// The Integer with value reference `vr`.
+    pub fn integer(&self, vr: u32) -> i32 {
+        match self.expect(vr) {
+            Value::Integer(x) => *x,
+            v => panic!("variable {vr} is not an Integer: {v:?}"),
+        }
+    }
+
+    /// The Boolean with value reference `vr`.
+    pub fn boolean(&self, vr: u32) -> bool {
+        match self.expect(vr) {
+            Value::Boolean(x) => *x,
+            v => panic!("variable {vr} is not a Boolean: {v:?}"),
+        }
+    }
+
+    /// Sets a Real computed by the model (outputs, locals).
+    pub fn set_real(&mut self, vr: u32, x: f64) {
+        let i = self
+            .position(vr)
+            .unwrap_or_else(|| panic!("no variable with value reference {vr}"));
+        self.values[i] = Value::Real(x);
+    }
+}

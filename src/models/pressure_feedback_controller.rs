@@ -1,0 +1,226 @@
+//! The PressureFeedbackController FMU model: the high-pass filtered pressure feedback of thesis
+//! section 6.1 ([`crate::control::pressure_feedback`]) with operator reference and output limits.
+
+use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
+use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+
+/// Value references (stable across releases).
+pub mod vr {
+    pub const U_REF: u32 = 0;
+    pub const P: u32 = 1;
+    pub const U: u32 = 2;
+    pub const U_COMP: u32 = 3;
+    pub const K_F: u32 = 4;
+    pub const OMEGA_F: u32 = 5;
+    pub const Q_RATED: u32 = 6;
+    pub const ENABLE: u32 = 7;
+    pub const U_MIN: u32 = 8;
+    pub const U_MAX: u32 = 9;
+    pub const P_LP: u32 = 10;
+}
+
+/// Admissible fed-back pressure: absolute zero (gauge) up to 1000 bar, far above the PVG32's
+/// 350 bar rating, so any physical pressure passes and only nonsense is refused.
+const P_RANGE: (f64, f64) = (-1.01325e5, 1e8);
+
+const VARIABLES: &[Variable] = &[
+    Variable::real_input(
+        "u_ref",
+        vr::U_REF,
+        0.0,
+        "1",
+        "%",
+        (-1.0, 1.0),
+        "Operator's spool reference; < 0 lowers the load",
+    ),
+    Variable::real_input(
+        "p",
+        vr::P,
+        0.0,
+        "Pa",
+        "bar",
+        P_RANGE,
+        "Fed-back pressure (p4, rod side / CBV pilot)",
+    ),
+    Variable::real_output(
+        "u",
+        vr::U,
+        "1",
+        "%",
+        "Spool command u = clamp(u_ref + u_comp, u_min, u_max)",
+    )
+    .depends(&[vr::U_REF, vr::P]),
+    Variable::real_output(
+        "u_comp",
+        vr::U_COMP,
+        "1",
+        "%",
+        "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)",
+    )
+    .depends(&[vr::P]),
+    Variable::param(vr::K_F, FEEDBACK_SPECS[0]),
+    Variable::param(vr::OMEGA_F, FEEDBACK_SPECS[1]),
+    Variable::param(vr::Q_RATED, FEEDBACK_SPECS[2]),
+    Variable::bool_param(
+        "enable",
+        vr::ENABLE,
+        true,
+        "Feedback on; off gives u = u_ref (experiment U)",
+    ),
+    Variable::param(
+        vr::U_MIN,
+        crate::params::ParamSpec {
+            name: "u_min",
+            default: -1.0,
+            unit: "1",
+            display_unit: "%",
+            min: -1.0,
+            max: 1.0,
+            description: "Lower limit of the spool command",
+            source: "Full spool opening in the lowering direction (eq. 2.44)",
+        },
+    ),
+    Variable::param(
+        vr::U_MAX,
+        crate::params::ParamSpec {
+            name: "u_max",
+            default: 1.0,
+            unit: "1",
+            display_unit: "%",
+            min: -1.0,
+            max: 1.0,
+            description: "Upper limit of the spool command",
+            source: "Full spool opening in the lifting direction (eq. 2.44)",
+        },
+    ),
+    Variable::real_local(
+        "filter.p_lp",
+        vr::P_LP,
+        "Pa",
+        "bar",
+        "Filter state: low-passed pressure x, x' = omega_f (p - x)",
+    ),
+];
+
+const DOCUMENTATION: &str = r#"<p>High-pass filtered pressure feedback of thesis section 6.1 (Fig. 6.1, 6.2).
+The fed-back pressure <i>p</i> (p4) passes G<sub>f</sub>(s) = K<sub>f</sub> s / (s/&omega;<sub>f</sub> + 1) (eq. 6.2),
+giving a flow Q<sub>f</sub> [m&sup3;/s]; the pressure-compensated valve turns it into spool opening with its rated flow
+Q<sub>rated</sub> (25 l/min per unit opening): u<sub>comp</sub> = Q<sub>f</sub>/Q<sub>rated</sub>,
+u = clamp(u<sub>ref</sub> + u<sub>comp</sub>, u<sub>min</sub>, u<sub>max</sub>).
+A falling pressure opens the valve further in the lowering direction (u &lt; 0), a rising one closes it.</p>
+<p>Realisation: x' = &omega;<sub>f</sub>(p &minus; x), Q<sub>f</sub> = K<sub>f</sub>&omega;<sub>f</sub>(p &minus; x), advanced exactly
+for inputs that are constant or linear over a step (set the slope with fmi2SetRealInputDerivatives, order 1), so any
+communication step gives the same result. The filter starts at rest at the initial pressure (x = p at the end of
+initialisation): no kick at t = 0. Defaults: experiment B (K<sub>f</sub> = 1.24e-11 m<sup>4</sup>s<sup>2</sup>/kg,
+&omega;<sub>f</sub> = 35.8 rad/s, Table 7.2).</p>"#;
+
+/// The controller's parameters and filter state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PressureFeedbackController {
+    feedback: HighPassFeedback,
+    enable: bool,
+    u_min: f64,
+    u_max: f64,
+    /// Low-passed pressure x [Pa].
+    x: f64,
+}
+
+impl PressureFeedbackController {
+    fn from_values(values: &Values, x: f64) -> Result<Self, String> {
+        let (u_min, u_max) = (values.real(vr::U_MIN), values.real(vr::U_MAX));
+        if u_min >= u_max {
+            return Err(format!("u_min = {u_min} must be less than u_max = {u_max}"));
+        }
+        let feedback = HighPassFeedback {
+            k_f: values.real(vr::K_F),
+            omega_f: values.real(vr::OMEGA_F),
+            q_rated: values.real(vr::Q_RATED),
+        };
+        Ok(PressureFeedbackController {
+            feedback,
+            enable: values.boolean(vr::ENABLE),
+            u_min,
+            u_max,
+            x,
+        })
+    }
+
+    /// (u_comp, unclamped u) for the current inputs.
+    fn command(&self, values: &Values) -> (f64, f64) {
+        let u_comp = if self.enable {
+            self.feedback.u_comp(values.real(vr::P), self.x)
+        } else {
+            0.0
+        };
+        (u_comp, values.real(vr::U_REF) + u_comp)
+    }
+}
+
+impl Model for PressureFeedbackController {
+    const INFO: ModelInfo = ModelInfo {
+        identifier: "PressureFeedbackController",
+        description: "High-pass filtered pressure feedback for a pressure-compensated valve with counterbalance valve (thesis section 6.1)",
+        version: "1.0.0",
+        start_time: 0.0,
+        stop_time: 15.0,
+        step_size: 1e-3,
+        default_tolerance: 1e-6,
+        log_categories: &[("logSaturation", "Spool command clamped at u_min or u_max")],
+        can_interpolate_inputs: true,
+        documentation: DOCUMENTATION,
+    };
+    const VARIABLES: &'static [Variable] = VARIABLES;
+
+    fn initialize(values: &Values) -> Result<Self, String> {
+        Self::from_values(values, values.real(vr::P))
+    }
+
+    fn retune(&mut self, values: &Values) -> Result<(), String> {
+        *self = Self::from_values(values, self.x)?;
+        Ok(())
+    }
+
+    fn outputs(&self, values: &mut Values) {
+        let (u_comp, u) = self.command(values);
+        values.set_real(vr::U_COMP, u_comp);
+        values.set_real(vr::U, u.clamp(self.u_min, self.u_max));
+        values.set_real(vr::P_LP, self.x);
+    }
+
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        _tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        let dp = values.position(vr::P).map_or(0.0, |i| input_derivatives[i]);
+        self.x = self.feedback.advance(self.x, values.real(vr::P), dp, h);
+        let (_, u) = self.command(values);
+        if u < self.u_min || u > self.u_max {
+            log.info(
+                "logSaturation",
+                &format!(
+                    "t = {}: u_ref + u_comp = {u} clamped to [{}, {}]",
+                    t + h,
+                    self.u_min,
+                    self.u_max
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    fn save(&self) -> Vec<f64> {
+        vec![self.x]
+    }
+
+    fn load(values: &Values, state: &[f64]) -> Result<Self, String> {
+        match state {
+            [x] if x.is_finite() => Self::from_values(values, *x),
+            _ => Err(format!("expected one finite filter state, got {state:?}")),
+        }
+    }
+}
