@@ -38,40 +38,27 @@ fn root() -> &'static Path {
 }
 
 fn target_dir() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"))
+    std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root().join("target"))
 }
 
 fn pack(out: &Path) -> Result<(), String> {
     let fmus = models::all();
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut build = Command::new(cargo);
-    build
-        .current_dir(root())
-        .args(["build", "--release", "--quiet"]);
+    build.current_dir(root()).args(["build", "--release", "--quiet"]);
     for f in &fmus {
         build.args(["-p", f.package]);
     }
-    let status = build
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    let status = build.status().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
         return Err(format!("cargo build failed ({status})"));
     }
-    let out = if out.is_absolute() {
-        out.to_path_buf()
-    } else {
-        root().join(out)
-    };
+    let out = if out.is_absolute() { out.to_path_buf() } else { root().join(out) };
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     for f in &fmus {
-        let lib = target_dir()
-            .join("release")
-            .join(format!("lib{}.so", f.identifier));
+        let lib = target_dir().join("release").join(format!("lib{}.so", f.identifier));
         let fmu = out.join(format!("{}.fmu", f.identifier));
-        f.write(&lib, &fmu)
-            .map_err(|e| format!("{}: {e}", fmu.display()))?;
+        f.write(&lib, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
         println!("{}", fmu.display());
     }
     Ok(())
@@ -96,10 +83,7 @@ fn xml(check: bool) -> Result<(), String> {
     if stale.is_empty() {
         Ok(())
     } else {
-        Err(format!(
-            "out of date (run `boomsim xml`): {}",
-            stale.join(", ")
-        ))
+        Err(format!("out of date (run `boomsim xml`): {}", stale.join(", ")))
     }
 }
 

@@ -46,18 +46,10 @@ pub struct Unit {
 pub const BASE_NAMES: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
 
 const fn u(name: &'static str, base: [i32; 8], display: &'static [DisplayUnit]) -> Unit {
-    Unit {
-        name,
-        base,
-        display,
-    }
+    Unit { name, base, display }
 }
 const fn d(name: &'static str, factor: f64) -> DisplayUnit {
-    DisplayUnit {
-        name,
-        factor,
-        offset: 0.0,
-    }
+    DisplayUnit { name, factor, offset: 0.0 }
 }
 
 /// Every unit a boomsim model may declare. A model variable's unit must be one of these names
@@ -70,11 +62,7 @@ pub const UNITS: &[Unit] = &[
     u("m/s", [0, 1, -1, 0, 0, 0, 0, 0], &[d("mm/s", 1e3)]),
     u("m/s2", [0, 1, -2, 0, 0, 0, 0, 0], &[]),
     u("m2", [0, 2, 0, 0, 0, 0, 0, 0], &[d("mm2", 1e6)]),
-    u(
-        "m3",
-        [0, 3, 0, 0, 0, 0, 0, 0],
-        &[d("cm3", 1e6), d("l", 1e3)],
-    ),
+    u("m3", [0, 3, 0, 0, 0, 0, 0, 0], &[d("cm3", 1e6), d("l", 1e3)]),
     u("m3/s", [0, 3, -1, 0, 0, 0, 0, 0], &[d("l/min", 6e4)]),
     u("m3/(s.Pa)", [-1, 4, 1, 0, 0, 0, 0, 0], &[]),
     u("m4.s2/kg", [-1, 4, 2, 0, 0, 0, 0, 0], &[]),
@@ -86,22 +74,10 @@ pub const UNITS: &[Unit] = &[
     u("N.m/rad", [1, 2, -2, 0, 0, 0, 0, -1], &[]),
     u("N.m.s/rad", [1, 2, -1, 0, 0, 0, 0, -1], &[]),
     u("N/m", [1, 0, -2, 0, 0, 0, 0, 0], &[]),
-    u(
-        "Pa",
-        [1, -1, -2, 0, 0, 0, 0, 0],
-        &[d("bar", 1e-5), d("MPa", 1e-6)],
-    ),
+    u("Pa", [1, -1, -2, 0, 0, 0, 0, 0], &[d("bar", 1e-5), d("MPa", 1e-6)]),
     u("Pa/s", [1, -1, -3, 0, 0, 0, 0, 0], &[d("bar/s", 1e-5)]),
-    u(
-        "rad",
-        [0, 0, 0, 0, 0, 0, 0, 1],
-        &[d("deg", 180.0 / std::f64::consts::PI)],
-    ),
-    u(
-        "rad/s",
-        [0, 0, -1, 0, 0, 0, 0, 1],
-        &[d("deg/s", 180.0 / std::f64::consts::PI)],
-    ),
+    u("rad", [0, 0, 0, 0, 0, 0, 0, 1], &[d("deg", 180.0 / std::f64::consts::PI)]),
+    u("rad/s", [0, 0, -1, 0, 0, 0, 0, 1], &[d("deg/s", 180.0 / std::f64::consts::PI)]),
     u("rad/s2", [0, 0, -2, 0, 0, 0, 0, 1], &[]),
 ];
 

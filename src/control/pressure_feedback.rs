@@ -62,19 +62,14 @@ pub const FEEDBACK_SPECS: [ParamSpec; 3] = [
         display_unit: "l/min",
         min: 1e-6,
         max: 1.0,
-        description:
-            "Valve flow per unit spool opening; turns the feedback flow into spool opening",
+        description: "Valve flow per unit spool opening; turns the feedback flow into spool opening",
         source: "Rated flow of the PVG32 linear flow spool, 25 l/min (section 2.2.1)",
     },
 ];
 
 impl Default for HighPassFeedback {
     fn default() -> Self {
-        HighPassFeedback {
-            k_f: FEEDBACK_SPECS[0].default,
-            omega_f: FEEDBACK_SPECS[1].default,
-            q_rated: lpm(25.0),
-        }
+        HighPassFeedback { k_f: FEEDBACK_SPECS[0].default, omega_f: FEEDBACK_SPECS[1].default, q_rated: lpm(25.0) }
     }
 }
 
@@ -132,10 +127,7 @@ mod tests {
             let expected = p0 + a * h - a / w + (x0 - p0 + a / w) * (-w * h).exp();
             let got = f.advance(x0, p0, a, h);
             // Rounding only: a few ulps of the 1e7 Pa magnitudes involved.
-            assert!(
-                (got - expected).abs() <= 1e-8 * p0.abs(),
-                "h = {h}: {got} vs {expected}"
-            );
+            assert!((got - expected).abs() <= 1e-8 * p0.abs(), "h = {h}: {got} vs {expected}");
         }
     }
 
@@ -165,9 +157,6 @@ mod tests {
         let u = f.u_comp(5e6 + a * t, x);
         let expected = f.k_f * a / f.q_rated;
         assert!(u < 0.0);
-        assert!(
-            (u - expected).abs() <= 1e-9 * expected.abs(),
-            "{u} vs {expected}"
-        );
+        assert!((u - expected).abs() <= 1e-9 * expected.abs(), "{u} vs {expected}");
     }
 }

@@ -24,10 +24,7 @@ unsafe fn instance<'a, M: Model>(c: fmi2Component) -> Option<&'a mut Instance<M>
 }
 
 fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
-    p.downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| p.downcast_ref::<String>().cloned())
-        .unwrap_or_default()
+    p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned()).unwrap_or_default()
 }
 
 /// Runs `body` for a valid instance in an allowed state; errors are logged, panics caught.
@@ -48,18 +45,14 @@ fn call<M: Model>(
         }
         let state = inst.core.state;
         if mask & state.bit() == 0 {
-            return Err(format!(
-                "illegal call in state {state:?}; it is allowed in: {}",
-                describe(mask)
-            ));
+            return Err(format!("illegal call in state {state:?}; it is allowed in: {}", describe(mask)));
         }
         body(inst)
     }));
     match result {
         Ok(Ok(status)) => status,
         Ok(Err(message)) => {
-            inst.log
-                .status(fmi2Status::Error, &format!("{function}: {message}"));
+            inst.log.status(fmi2Status::Error, &format!("{function}: {message}"));
             fmi2Status::Error
         }
         Err(p) => {
@@ -96,9 +89,7 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mut [T
 }
 
 unsafe fn text<'a>(p: fmi2String) -> Option<&'a str> {
-    (!p.is_null())
-        .then(|| CStr::from_ptr(p).to_str().ok())
-        .flatten()
+    (!p.is_null()).then(|| CStr::from_ptr(p).to_str().ok()).flatten()
 }
 
 pub fn get_types_platform() -> *const c_char {
@@ -155,9 +146,7 @@ pub unsafe fn instantiate<M: Model>(
 }
 
 pub unsafe fn free_instance<M: Model>(c: fmi2Component) {
-    let status = call::<M>(c, "fmi2FreeInstance", allowed::FREE_INSTANCE, |_| {
-        Ok(fmi2Status::OK)
-    });
+    let status = call::<M>(c, "fmi2FreeInstance", allowed::FREE_INSTANCE, |_| Ok(fmi2Status::OK));
     if status == fmi2Status::OK {
         let mut inst = Box::from_raw(c as *mut Instance<M>);
         inst.magic = 0;
@@ -170,19 +159,14 @@ pub unsafe fn set_debug_logging<M: Model>(
     n: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    call::<M>(
-        c,
-        "fmi2SetDebugLogging",
-        allowed::SET_DEBUG_LOGGING,
-        |inst| {
-            let names = slice(categories, n, "categories")?
-                .iter()
-                .map(|&p| text(p).ok_or_else(|| "a category name is NULL or not UTF-8".to_string()))
-                .collect::<Result<Vec<_>, _>>()?;
-            inst.log.set_debug_logging(on != 0, &names)?;
-            Ok(fmi2Status::OK)
-        },
-    )
+    call::<M>(c, "fmi2SetDebugLogging", allowed::SET_DEBUG_LOGGING, |inst| {
+        let names = slice(categories, n, "categories")?
+            .iter()
+            .map(|&p| text(p).ok_or_else(|| "a category name is NULL or not UTF-8".to_string()))
+            .collect::<Result<Vec<_>, _>>()?;
+        inst.log.set_debug_logging(on != 0, &names)?;
+        Ok(fmi2Status::OK)
+    })
 }
 
 pub unsafe fn setup_experiment<M: Model>(
@@ -193,43 +177,28 @@ pub unsafe fn setup_experiment<M: Model>(
     stop_defined: fmi2Boolean,
     stop: f64,
 ) -> fmi2Status {
-    call::<M>(
-        c,
-        "fmi2SetupExperiment",
-        allowed::SETUP_EXPERIMENT,
-        |inst| {
-            inst.setup_experiment(
-                (tolerance_defined != 0).then_some(tolerance),
-                start,
-                (stop_defined != 0).then_some(stop),
-            )?;
-            Ok(fmi2Status::OK)
-        },
-    )
+    call::<M>(c, "fmi2SetupExperiment", allowed::SETUP_EXPERIMENT, |inst| {
+        inst.setup_experiment(
+            (tolerance_defined != 0).then_some(tolerance),
+            start,
+            (stop_defined != 0).then_some(stop),
+        )?;
+        Ok(fmi2Status::OK)
+    })
 }
 
 pub unsafe fn enter_initialization_mode<M: Model>(c: fmi2Component) -> fmi2Status {
-    call::<M>(
-        c,
-        "fmi2EnterInitializationMode",
-        allowed::ENTER_INITIALIZATION_MODE,
-        |inst| {
-            inst.enter_initialization_mode();
-            Ok(fmi2Status::OK)
-        },
-    )
+    call::<M>(c, "fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION_MODE, |inst| {
+        inst.enter_initialization_mode();
+        Ok(fmi2Status::OK)
+    })
 }
 
 pub unsafe fn exit_initialization_mode<M: Model>(c: fmi2Component) -> fmi2Status {
-    call::<M>(
-        c,
-        "fmi2ExitInitializationMode",
-        allowed::EXIT_INITIALIZATION_MODE,
-        |inst| {
-            inst.exit_initialization_mode()?;
-            Ok(fmi2Status::OK)
-        },
-    )
+    call::<M>(c, "fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE, |inst| {
+        inst.exit_initialization_mode()?;
+        Ok(fmi2Status::OK)
+    })
 }
 
 pub unsafe fn terminate<M: Model>(c: fmi2Component) -> fmi2Status {
@@ -264,53 +233,19 @@ unsafe fn get<M: Model, T>(
     })
 }
 
-pub unsafe fn get_real<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *mut f64,
-) -> fmi2Status {
-    get::<M, f64>(c, "fmi2GetReal", vr, n, value, "Real", |v| {
-        if let Value::Real(x) = v {
-            *x
-        } else {
-            f64::NAN
-        }
-    })
+pub unsafe fn get_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut f64) -> fmi2Status {
+    get::<M, f64>(c, "fmi2GetReal", vr, n, value, "Real", |v| if let Value::Real(x) = v { *x } else { f64::NAN })
 }
 
-pub unsafe fn get_integer<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *mut c_int,
-) -> fmi2Status {
-    get::<M, c_int>(c, "fmi2GetInteger", vr, n, value, "Integer", |v| {
-        if let Value::Integer(x) = v {
-            *x
-        } else {
-            0
-        }
-    })
+pub unsafe fn get_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> fmi2Status {
+    get::<M, c_int>(c, "fmi2GetInteger", vr, n, value, "Integer", |v| if let Value::Integer(x) = v { *x } else { 0 })
 }
 
-pub unsafe fn get_boolean<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *mut c_int,
-) -> fmi2Status {
-    get::<M, c_int>(c, "fmi2GetBoolean", vr, n, value, "Boolean", |v| {
-        matches!(v, Value::Boolean(true)) as c_int
-    })
+pub unsafe fn get_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> fmi2Status {
+    get::<M, c_int>(c, "fmi2GetBoolean", vr, n, value, "Boolean", |v| matches!(v, Value::Boolean(true)) as c_int)
 }
 
-pub unsafe fn get_string<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *mut fmi2String,
-) -> fmi2Status {
+pub unsafe fn get_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut fmi2String) -> fmi2Status {
     call::<M>(c, "fmi2GetString", allowed::GET, |inst| {
         let vrs = slice(vr, n, "vr")?;
         let out = slice_mut(value, n, "value")?;
@@ -321,9 +256,7 @@ pub unsafe fn get_string<M: Model>(
         })?;
         // The pointers stay valid until the next fmi2GetString on this instance (FMI 2.0, 2.1.7).
         inst.strings = texts;
-        out.iter_mut()
-            .zip(&inst.strings)
-            .for_each(|(o, s)| *o = s.as_ptr());
+        out.iter_mut().zip(&inst.strings).for_each(|(o, s)| *o = s.as_ptr());
         Ok(fmi2Status::OK)
     })
 }
@@ -340,78 +273,41 @@ unsafe fn set<M: Model, T: Copy>(
 ) -> fmi2Status {
     call::<M>(c, function, allowed::SET, |inst| {
         let vrs = slice(vr, n, "vr")?;
-        let values = slice(value, n, "value")?
-            .iter()
-            .map(|&x| convert(x))
-            .collect::<Result<Vec<_>, _>>()?;
+        let values = slice(value, n, "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
         inst.set(vrs, values, wanted)?;
         Ok(fmi2Status::OK)
     })
 }
 
-pub unsafe fn set_real<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *const f64,
-) -> fmi2Status {
-    set::<M, f64>(c, "fmi2SetReal", vr, n, value, "Real", |x| {
-        Ok(Value::Real(x))
-    })
+pub unsafe fn set_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const f64) -> fmi2Status {
+    set::<M, f64>(c, "fmi2SetReal", vr, n, value, "Real", |x| Ok(Value::Real(x)))
 }
 
-pub unsafe fn set_integer<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *const c_int,
-) -> fmi2Status {
-    set::<M, c_int>(c, "fmi2SetInteger", vr, n, value, "Integer", |x| {
-        Ok(Value::Integer(x))
-    })
+pub unsafe fn set_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
+    set::<M, c_int>(c, "fmi2SetInteger", vr, n, value, "Integer", |x| Ok(Value::Integer(x)))
 }
 
-pub unsafe fn set_boolean<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *const c_int,
-) -> fmi2Status {
+pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
     set::<M, c_int>(c, "fmi2SetBoolean", vr, n, value, "Boolean", |x| match x {
         FMI2_FALSE => Ok(Value::Boolean(false)),
         FMI2_TRUE => Ok(Value::Boolean(true)),
-        _ => Err(format!(
-            "{x} is not an fmi2Boolean; valid values are fmi2False (0) and fmi2True (1)"
-        )),
+        _ => Err(format!("{x} is not an fmi2Boolean; valid values are fmi2False (0) and fmi2True (1)")),
     })
 }
 
-pub unsafe fn set_string<M: Model>(
-    c: fmi2Component,
-    vr: *const u32,
-    n: usize,
-    value: *const fmi2String,
-) -> fmi2Status {
+pub unsafe fn set_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const fmi2String) -> fmi2Status {
     set::<M, fmi2String>(c, "fmi2SetString", vr, n, value, "String", |p| {
-        text(p)
-            .map(|s| Value::String(s.to_owned()))
-            .ok_or_else(|| "a string value is NULL or not UTF-8".into())
+        text(p).map(|s| Value::String(s.to_owned())).ok_or_else(|| "a string value is NULL or not UTF-8".into())
     })
 }
 
 pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     call::<M>(c, "fmi2GetFMUstate", allowed::FMU_STATE, |inst| {
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
-        if let Some(old) = (*out as *mut FmuState<M>)
-            .as_mut()
-            .filter(|s| s.magic == Instance::<M>::STATE_MAGIC)
-        {
+        if let Some(old) = (*out as *mut FmuState<M>).as_mut().filter(|s| s.magic == Instance::<M>::STATE_MAGIC) {
             old.core = inst.core.clone();
         } else {
-            let s = FmuState {
-                magic: Instance::<M>::STATE_MAGIC,
-                core: inst.core.clone(),
-            };
+            let s = FmuState { magic: Instance::<M>::STATE_MAGIC, core: inst.core.clone() };
             *out = Box::into_raw(Box::new(s)) as fmi2FMUstate;
         }
         Ok(fmi2Status::OK)
@@ -488,10 +384,7 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
         let data = slice(bytes as *const u8, size, "serializedState")?;
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
         let core = fmu_state::deserialize::<M>(data, &guid::<M>())?;
-        let s = FmuState {
-            magic: Instance::<M>::STATE_MAGIC,
-            core,
-        };
+        let s = FmuState { magic: Instance::<M>::STATE_MAGIC, core };
         *out = Box::into_raw(Box::new(s)) as fmi2FMUstate;
         Ok(fmi2Status::OK)
     })
@@ -518,19 +411,10 @@ pub unsafe fn set_real_input_derivatives<M: Model>(
     order: *const c_int,
     value: *const f64,
 ) -> fmi2Status {
-    call::<M>(
-        c,
-        "fmi2SetRealInputDerivatives",
-        allowed::SET_INPUT_DERIVATIVES,
-        |inst| {
-            inst.set_input_derivatives(
-                slice(vr, n, "vr")?,
-                slice(order, n, "order")?,
-                slice(value, n, "value")?,
-            )?;
-            Ok(fmi2Status::OK)
-        },
-    )
+    call::<M>(c, "fmi2SetRealInputDerivatives", allowed::SET_INPUT_DERIVATIVES, |inst| {
+        inst.set_input_derivatives(slice(vr, n, "vr")?, slice(order, n, "order")?, slice(value, n, "value")?)?;
+        Ok(fmi2Status::OK)
+    })
 }
 
 pub unsafe fn get_real_output_derivatives<M: Model>(c: fmi2Component) -> fmi2Status {
@@ -542,20 +426,12 @@ pub unsafe fn get_real_output_derivatives<M: Model>(c: fmi2Component) -> fmi2Sta
     )
 }
 
-pub unsafe fn do_step<M: Model>(
-    c: fmi2Component,
-    t: f64,
-    h: f64,
-    _no_set_prior: fmi2Boolean,
-) -> fmi2Status {
-    call::<M>(c, "fmi2DoStep", allowed::DO_STEP, |inst| {
-        match inst.do_step(t, h)? {
-            None => Ok(fmi2Status::OK),
-            Some(why) => {
-                inst.log
-                    .status(fmi2Status::Discard, &format!("fmi2DoStep: {why}"));
-                Ok(fmi2Status::Discard)
-            }
+pub unsafe fn do_step<M: Model>(c: fmi2Component, t: f64, h: f64, _no_set_prior: fmi2Boolean) -> fmi2Status {
+    call::<M>(c, "fmi2DoStep", allowed::DO_STEP, |inst| match inst.do_step(t, h)? {
+        None => Ok(fmi2Status::OK),
+        Some(why) => {
+            inst.log.status(fmi2Status::Discard, &format!("fmi2DoStep: {why}"));
+            Ok(fmi2Status::Discard)
         }
     })
 }
@@ -570,21 +446,11 @@ pub unsafe fn cancel_step<M: Model>(c: fmi2Component) -> fmi2Status {
 }
 
 pub unsafe fn get_status<M: Model>(c: fmi2Component) -> fmi2Status {
-    unsupported::<M>(
-        c,
-        "fmi2GetStatus",
-        allowed::GET_STATUS,
-        "no fmi2Status kind is defined for a synchronous slave",
-    )
+    unsupported::<M>(c, "fmi2GetStatus", allowed::GET_STATUS, "no fmi2Status kind is defined for a synchronous slave")
 }
 
 pub unsafe fn get_integer_status<M: Model>(c: fmi2Component) -> fmi2Status {
-    unsupported::<M>(
-        c,
-        "fmi2GetIntegerStatus",
-        allowed::GET_STATUS,
-        "FMI 2.0 defines no integer status",
-    )
+    unsupported::<M>(c, "fmi2GetIntegerStatus", allowed::GET_STATUS, "FMI 2.0 defines no integer status")
 }
 
 pub unsafe fn get_string_status<M: Model>(c: fmi2Component) -> fmi2Status {
@@ -596,36 +462,23 @@ pub unsafe fn get_string_status<M: Model>(c: fmi2Component) -> fmi2Status {
     )
 }
 
-pub unsafe fn get_real_status<M: Model>(
-    c: fmi2Component,
-    kind: c_int,
-    value: *mut f64,
-) -> fmi2Status {
+pub unsafe fn get_real_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut f64) -> fmi2Status {
     call::<M>(c, "fmi2GetRealStatus", allowed::GET_STATUS, |inst| {
         if kind != FMI2_LAST_SUCCESSFUL_TIME {
-            return Err(format!(
-                "status kind {kind} is not available; only fmi2LastSuccessfulTime (2) is"
-            ));
+            return Err(format!("status kind {kind} is not available; only fmi2LastSuccessfulTime (2) is"));
         }
         *value.as_mut().ok_or("value is NULL")? = inst.core.last_successful_time;
         Ok(fmi2Status::OK)
     })
 }
 
-pub unsafe fn get_boolean_status<M: Model>(
-    c: fmi2Component,
-    kind: c_int,
-    value: *mut fmi2Boolean,
-) -> fmi2Status {
+pub unsafe fn get_boolean_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut fmi2Boolean) -> fmi2Status {
     call::<M>(c, "fmi2GetBooleanStatus", allowed::GET_STATUS, |inst| {
         if kind != FMI2_TERMINATED {
-            return Err(format!(
-                "status kind {kind} is not available; only fmi2Terminated (3) is"
-            ));
+            return Err(format!("status kind {kind} is not available; only fmi2Terminated (3) is"));
         }
         // The slave asks to end the simulation only once a step has failed.
-        *value.as_mut().ok_or("value is NULL")? =
-            (inst.core.state == State::StepFailed) as fmi2Boolean;
+        *value.as_mut().ok_or("value is NULL")? = (inst.core.state == State::StepFailed) as fmi2Boolean;
         Ok(fmi2Status::OK)
     })
 }

@@ -39,9 +39,7 @@ macro_rules! export_fmu {
                 visible: fmi2Boolean,
                 logging_on: fmi2Boolean,
             ) -> fmi2Component {
-                api::instantiate::<M>(
-                    name, fmu_type, guid, resources, functions, visible, logging_on,
-                )
+                api::instantiate::<M>(name, fmu_type, guid, resources, functions, visible, logging_on)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
@@ -147,24 +145,15 @@ macro_rules! export_fmu {
                 api::set_string::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetFMUstate(
-                c: fmi2Component,
-                s: *mut fmi2FMUstate,
-            ) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
                 api::get_fmu_state::<M>(c, s)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetFMUstate(
-                c: fmi2Component,
-                s: fmi2FMUstate,
-            ) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, s: fmi2FMUstate) -> fmi2Status {
                 api::set_fmu_state::<M>(c, s)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2FreeFMUstate(
-                c: fmi2Component,
-                s: *mut fmi2FMUstate,
-            ) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
                 api::free_fmu_state::<M>(c, s)
             }
             #[no_mangle]
@@ -226,12 +215,7 @@ macro_rules! export_fmu {
                 api::get_real_output_derivatives::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2DoStep(
-                c: fmi2Component,
-                t: f64,
-                h: f64,
-                no_prior: fmi2Boolean,
-            ) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, no_prior: fmi2Boolean) -> fmi2Status {
                 api::do_step::<M>(c, t, h, no_prior)
             }
             #[no_mangle]
@@ -239,19 +223,11 @@ macro_rules! export_fmu {
                 api::cancel_step::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetStatus(
-                c: fmi2Component,
-                _kind: c_int,
-                _v: *mut fmi2Status,
-            ) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetStatus(c: fmi2Component, _kind: c_int, _v: *mut fmi2Status) -> fmi2Status {
                 api::get_status::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetRealStatus(
-                c: fmi2Component,
-                kind: c_int,
-                v: *mut f64,
-            ) -> fmi2Status {
+            pub unsafe extern "C" fn fmi2GetRealStatus(c: fmi2Component, kind: c_int, v: *mut f64) -> fmi2Status {
                 api::get_real_status::<M>(c, kind, v)
             }
             #[no_mangle]

@@ -56,9 +56,7 @@ pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
             }
         }
     }
-    core.input_derivatives
-        .iter()
-        .for_each(|&d| put_f64(&mut p, d));
+    core.input_derivatives.iter().for_each(|&d| put_f64(&mut p, d));
     match &core.model {
         None => p.push(0),
         Some(m) => {
@@ -83,10 +81,7 @@ pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
 /// Parses bytes written by [`serialize`] for this model and GUID.
 pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String> {
     if bytes.len() < MAGIC.len() + 4 + 4 + 8 + 4 {
-        return Err(format!(
-            "{} bytes are too few for a serialised FMU state",
-            bytes.len()
-        ));
+        return Err(format!("{} bytes are too few for a serialised FMU state", bytes.len()));
     }
     let (body, crc) = bytes.split_at(bytes.len() - 4);
     let crc = u32::from_le_bytes(crc.try_into().unwrap_or_default());
@@ -96,29 +91,19 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
     if crc32fast::hash(body) != crc {
         return Err("the serialised FMU state is corrupted (checksum mismatch)".into());
     }
-    let mut r = Reader {
-        b: body,
-        at: MAGIC.len(),
-    };
+    let mut r = Reader { b: body, at: MAGIC.len() };
     let version = u32::from_le_bytes(r.take(4)?.try_into().unwrap_or_default());
     if version != FORMAT_VERSION {
-        return Err(format!(
-            "serialised format version {version}; this FMU reads version {FORMAT_VERSION}"
-        ));
+        return Err(format!("serialised format version {version}; this FMU reads version {FORMAT_VERSION}"));
     }
     let n = u32::from_le_bytes(r.take(4)?.try_into().unwrap_or_default()) as usize;
     let their_guid = String::from_utf8_lossy(r.take(n)?).into_owned();
     if their_guid != guid {
-        return Err(format!(
-            "the state belongs to the FMU with GUID {their_guid}, not to {guid}"
-        ));
+        return Err(format!("the state belongs to the FMU with GUID {their_guid}, not to {guid}"));
     }
     let len = r.u64()? as usize;
     if len != body.len() - r.at {
-        return Err(format!(
-            "payload length {len} does not match the {} bytes present",
-            body.len() - r.at
-        ));
+        return Err(format!("payload length {len} does not match the {} bytes present", body.len() - r.at));
     }
     let state = decode_state(r.take(1)?[0])?;
     let (time, start_time, last_successful_time) = (r.f64()?, r.f64()?, r.f64()?);
@@ -132,18 +117,12 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
     let mut values = Values::new(M::VARIABLES);
     let count = r.u64()? as usize;
     if count != M::VARIABLES.len() {
-        return Err(format!(
-            "the state has {count} variables; {} has {}",
-            M::INFO.identifier,
-            M::VARIABLES.len()
-        ));
+        return Err(format!("the state has {count} variables; {} has {}", M::INFO.identifier, M::VARIABLES.len()));
     }
     for i in 0..count {
         let v = match (r.take(1)?[0], values.at(i)) {
             (0, Value::Real(_)) => Value::Real(r.f64()?),
-            (1, Value::Integer(_)) => Value::Integer(i32::from_le_bytes(
-                r.take(4)?.try_into().unwrap_or_default(),
-            )),
+            (1, Value::Integer(_)) => Value::Integer(i32::from_le_bytes(r.take(4)?.try_into().unwrap_or_default())),
             (2, Value::Boolean(_)) => Value::Boolean(r.take(1)?[0] != 0),
             (3, Value::String(_)) => {
                 let n = r.u64()? as usize;
@@ -168,10 +147,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         }
     };
     if r.at != body.len() {
-        return Err(format!(
-            "{} unexpected bytes after the state",
-            body.len() - r.at
-        ));
+        return Err(format!("{} unexpected bytes after the state", body.len() - r.at));
     }
     Ok(Core {
         state,
@@ -198,10 +174,7 @@ fn state_code(s: State) -> u8 {
     State::ALL.iter().position(|&x| x == s).unwrap_or(0) as u8
 }
 fn decode_state(c: u8) -> Result<State, String> {
-    State::ALL
-        .get(c as usize)
-        .copied()
-        .ok_or_else(|| format!("invalid state code {c}"))
+    State::ALL.get(c as usize).copied().ok_or_else(|| format!("invalid state code {c}"))
 }
 
 /// A bounds-checked cursor.
@@ -212,23 +185,16 @@ struct Reader<'a> {
 
 impl<'a> Reader<'a> {
     fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .at
-            .checked_add(n)
-            .filter(|&e| e <= self.b.len())
-            .ok_or("the serialised FMU state is truncated")?;
+        let end =
+            self.at.checked_add(n).filter(|&e| e <= self.b.len()).ok_or("the serialised FMU state is truncated")?;
         let s = &self.b[self.at..end];
         self.at = end;
         Ok(s)
     }
     fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(
-            self.take(8)?.try_into().unwrap_or_default(),
-        ))
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap_or_default()))
     }
     fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(
-            self.take(8)?.try_into().unwrap_or_default(),
-        ))
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap_or_default()))
     }
 }

@@ -5,7 +5,7 @@ use super::log::Logger;
 use super::model::{Log, Model};
 use super::state::State;
 use super::types::fmi2Status;
-use super::variables::{Causality, Initial, Kind, Value, Values, Variability, Variable};
+use super::variables::{fmi_name, Causality, Initial, Kind, Value, Values, Variability, Variable};
 
 /// Relative tolerance for matching the master's communication point with the instance time.
 pub const TIME_MATCH_RTOL: f64 = 1e-9;
@@ -95,36 +95,22 @@ impl<M: Model> Instance<M> {
 
     /// A freshly instantiated slave.
     pub fn new(log: Logger) -> Self {
-        Instance {
-            magic: Self::MAGIC,
-            log,
-            core: Core::new(),
-            strings: Vec::new(),
-        }
+        Instance { magic: Self::MAGIC, log, core: Core::new(), strings: Vec::new() }
     }
 
     /// fmi2SetupExperiment.
-    pub fn setup_experiment(
-        &mut self,
-        tolerance: Option<f64>,
-        start: f64,
-        stop: Option<f64>,
-    ) -> Result<(), String> {
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> Result<(), String> {
         if !start.is_finite() {
             return Err(format!("startTime = {start} must be finite"));
         }
         if let Some(tol) = tolerance {
             if !(tol > 0.0 && tol < 1.0) {
-                return Err(format!(
-                    "tolerance = {tol} is outside its valid range (0, 1)"
-                ));
+                return Err(format!("tolerance = {tol} is outside its valid range (0, 1)"));
             }
         }
         if let Some(stop) = stop {
             if !(stop.is_finite() && stop >= start) {
-                return Err(format!(
-                    "stopTime = {stop} must be finite and >= startTime = {start}"
-                ));
+                return Err(format!("stopTime = {stop} must be finite and >= startTime = {start}"));
             }
         }
         let c = &mut self.core;
@@ -172,19 +158,15 @@ impl<M: Model> Instance<M> {
 
     /// Looks up a value reference and checks its type.
     fn lookup(&self, vr: u32, wanted: &str) -> Result<(usize, &'static Variable), String> {
-        let i = self.core.values.position(vr).ok_or_else(|| {
-            format!(
-                "unknown value reference {vr}: {} has no such variable",
-                M::INFO.identifier
-            )
-        })?;
+        let i = self
+            .core
+            .values
+            .position(vr)
+            .ok_or_else(|| format!("unknown value reference {vr}: {} has no such variable", M::INFO.identifier))?;
         let v = &M::VARIABLES[i];
         let actual = format!("{:?}", v.base_type());
         if actual != wanted {
-            return Err(format!(
-                "variable \"{}\" (vr {vr}) is a {actual}, not a {wanted}",
-                v.name
-            ));
+            return Err(format!("variable \"{}\" (vr {vr}) is a {actual}, not a {wanted}", v.name));
         }
         Ok((i, v))
     }
@@ -215,9 +197,7 @@ impl<M: Model> Instance<M> {
             checked.push((i, value));
         }
         let before = self.core.values.clone();
-        let tunes = checked
-            .iter()
-            .any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
+        let tunes = checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
         for (i, value) in checked {
             self.core.values.put(i, value);
         }
@@ -233,32 +213,18 @@ impl<M: Model> Instance<M> {
     }
 
     /// fmi2SetRealInputDerivatives (first order only).
-    pub fn set_input_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        values: &[f64],
-    ) -> Result<(), String> {
+    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Result<(), String> {
         if !M::INFO.can_interpolate_inputs {
-            return Err(format!(
-                "{} does not interpolate inputs (canInterpolateInputs=\"false\")",
-                M::INFO.identifier
-            ));
+            return Err(format!("{} does not interpolate inputs (canInterpolateInputs=\"false\")", M::INFO.identifier));
         }
         let mut checked = Vec::with_capacity(vrs.len());
         for ((&vr, &order), &d) in vrs.iter().zip(orders).zip(values) {
             let (i, v) = self.lookup(vr, "Real")?;
             if v.causality != Causality::Input {
-                return Err(format!(
-                    "variable \"{}\" is not an input; derivatives can only be set for inputs",
-                    v.name
-                ));
+                return Err(format!("variable \"{}\" is not an input; derivatives can only be set for inputs", v.name));
             }
             if order != 1 {
-                return Err(format!(
-                    "derivative order {order} of \"{}\" is outside its valid range [1, 1]",
-                    v.name
-                ));
+                return Err(format!("derivative order {order} of \"{}\" is outside its valid range [1, 1]", v.name));
             }
             if !d.is_finite() {
                 return Err(format!("derivative of \"{}\" = {d} must be finite", v.name));
@@ -275,9 +241,7 @@ impl<M: Model> Instance<M> {
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Option<String>, String> {
         let c = &mut self.core;
         if !(h > 0.0 && h.is_finite()) {
-            return Err(format!(
-                "communicationStepSize = {h} is outside its valid range (0, inf)"
-            ));
+            return Err(format!("communicationStepSize = {h} is outside its valid range (0, inf)"));
         }
         let eps = TIME_MATCH_RTOL * c.time.abs().max(1.0);
         if !((t - c.time).abs() <= eps) {
@@ -296,14 +260,7 @@ impl<M: Model> Instance<M> {
         }
         let tolerance = c.tolerance.unwrap_or(M::INFO.default_tolerance);
         let model = c.model.as_mut().ok_or("the model is not initialised")?;
-        let result = model.do_step(
-            &c.values,
-            &c.input_derivatives,
-            t,
-            h,
-            tolerance,
-            &mut ModelLog(&self.log),
-        );
+        let result = model.do_step(&c.values, &c.input_derivatives, t, h, tolerance, &mut ModelLog(&self.log));
         c.outputs_current = false;
         match result {
             Ok(()) => {
@@ -321,10 +278,7 @@ impl<M: Model> Instance<M> {
                 c.time = e.time;
                 c.last_successful_time = e.time;
                 c.state = State::StepFailed;
-                Ok(Some(format!(
-                    "step from t = {t} with h = {h} stopped at t = {}: {}",
-                    e.time, e.message
-                )))
+                Ok(Some(format!("step from t = {t} with h = {h} stopped at t = {}: {}", e.time, e.message)))
             }
         }
     }
@@ -338,9 +292,7 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
             State::Instantiated => v.initial != Initial::Calculated || input,
             State::InitializationMode => v.initial == Initial::Exact || input,
             State::StepComplete => {
-                input
-                    || (v.causality == Causality::Parameter
-                        && v.variability == Variability::Tunable)
+                input || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
             }
             _ => false,
         };
@@ -353,8 +305,10 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
         _ => "no variable may be set in this state",
     };
     Err(format!(
-        "cannot set \"{}\" (causality={:?}, variability={:?}) in state {state:?}: {rule}",
-        v.name, v.causality, v.variability
+        "cannot set \"{}\" (causality={}, variability={}) in state {state:?}: {rule}",
+        v.name,
+        fmi_name(v.causality),
+        fmi_name(v.variability)
     ))
 }
 
@@ -363,24 +317,15 @@ fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
     match (v.kind, value) {
         (Kind::Real { min, max, unit, .. }, Value::Real(x)) => {
             if !x.is_finite() {
-                return Err(format!(
-                    "{} = {x} is not a finite number; valid range [{min}, {max}] {unit}",
-                    v.name
-                ));
+                return Err(format!("{} = {x} is not a finite number; valid range [{min}, {max}] {unit}", v.name));
             }
             if *x < min || *x > max {
-                return Err(format!(
-                    "{} = {x} is outside its valid range [{min}, {max}] {unit}",
-                    v.name
-                ));
+                return Err(format!("{} = {x} is outside its valid range [{min}, {max}] {unit}", v.name));
             }
         }
         (Kind::Integer { min, max, .. }, Value::Integer(x)) => {
             if *x < min || *x > max {
-                return Err(format!(
-                    "{} = {x} is outside its valid range [{min}, {max}]",
-                    v.name
-                ));
+                return Err(format!("{} = {x} is outside its valid range [{min}, {max}]", v.name));
             }
         }
         _ => {}

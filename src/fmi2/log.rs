@@ -7,14 +7,8 @@ use std::ffi::CString;
 pub const GENERIC_CATEGORIES: &[(&str, &str)] = &[
     ("logStatusWarning", "Messages with status fmi2Warning"),
     ("logStatusDiscard", "Messages with status fmi2Discard"),
-    (
-        "logStatusError",
-        "Messages with status fmi2Error (always delivered)",
-    ),
-    (
-        "logStatusFatal",
-        "Messages with status fmi2Fatal (always delivered)",
-    ),
+    ("logStatusError", "Messages with status fmi2Error (always delivered)"),
+    ("logStatusFatal", "Messages with status fmi2Fatal (always delivered)"),
     ("logAll", "Every message of every category"),
     ("logFmiCalls", "Each FMI function call by name"),
 ];
@@ -45,21 +39,9 @@ impl Logger {
         model_categories: &'static [(&'static str, &'static str)],
         logging_on: bool,
     ) -> Self {
-        let categories: Vec<_> = GENERIC_CATEGORIES
-            .iter()
-            .chain(model_categories)
-            .copied()
-            .collect();
-        let enabled = (0..categories.len())
-            .map(|i| logging_on || i < LOG_ALL)
-            .collect();
-        Logger {
-            callback,
-            environment,
-            instance_name: c_string(instance_name),
-            categories,
-            enabled,
-        }
+        let categories: Vec<_> = GENERIC_CATEGORIES.iter().chain(model_categories).copied().collect();
+        let enabled = (0..categories.len()).map(|i| logging_on || i < LOG_ALL).collect();
+        Logger { callback, environment, instance_name: c_string(instance_name), categories, enabled }
     }
 
     /// The instance name given to fmi2Instantiate.
@@ -79,10 +61,7 @@ impl Logger {
                 Some(i) => idx.push(i),
                 None => {
                     let known: Vec<&str> = self.categories.iter().map(|(c, _)| *c).collect();
-                    return Err(format!(
-                        "unknown log category \"{n}\"; the categories are {}",
-                        known.join(", ")
-                    ));
+                    return Err(format!("unknown log category \"{n}\"; the categories are {}", known.join(", ")));
                 }
             }
         }

@@ -34,14 +34,10 @@ impl Fmu {
     pub fn write(&self, library: &Path, out: &Path) -> zip::result::ZipResult<()> {
         let so = std::fs::read(library)?;
         let mut zip = zip::ZipWriter::new(std::fs::File::create(out)?);
-        let deflate =
-            SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+        let deflate = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         zip.start_file("modelDescription.xml", deflate)?;
         zip.write_all((self.model_description)().as_bytes())?;
-        zip.start_file(
-            format!("binaries/linux64/{}.so", self.identifier),
-            deflate.unix_permissions(0o755),
-        )?;
+        zip.start_file(format!("binaries/linux64/{}.so", self.identifier), deflate.unix_permissions(0o755))?;
         zip.write_all(&so)?;
         zip.start_file("documentation/index.html", deflate)?;
         zip.write_all((self.documentation)().as_bytes())?;
@@ -51,34 +47,17 @@ impl Fmu {
 }
 
 fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
 fn row(v: &Variable) -> String {
     let (ty, start, unit, range) = match v.kind {
-        Kind::Real {
-            start,
-            unit,
-            display_unit,
-            min,
-            max,
-        } => {
-            let unit = if display_unit.is_empty() {
-                unit.to_owned()
-            } else {
-                format!("{unit} ({display_unit})")
-            };
+        Kind::Real { start, unit, display_unit, min, max } => {
+            let unit = if display_unit.is_empty() { unit.to_owned() } else { format!("{unit} ({display_unit})") };
             let range = format!("[{}, {}]", num(min), num(max));
             ("Real", num(start), unit, range)
         }
-        Kind::Integer { start, min, max } => (
-            "Integer",
-            start.to_string(),
-            String::new(),
-            format!("[{min}, {max}]"),
-        ),
+        Kind::Integer { start, min, max } => ("Integer", start.to_string(), String::new(), format!("[{min}, {max}]")),
         Kind::Boolean { start } => ("Boolean", start.to_string(), String::new(), String::new()),
         Kind::String { start } => ("String", start.to_owned(), String::new(), String::new()),
     };

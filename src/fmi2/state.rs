@@ -66,11 +66,7 @@ pub mod allowed {
 
 /// The names of the states in a mask, for error messages.
 pub fn describe(mask: Mask) -> String {
-    let names: Vec<String> = State::ALL
-        .iter()
-        .filter(|s| mask & s.bit() != 0)
-        .map(|s| format!("{s:?}"))
-        .collect();
+    let names: Vec<String> = State::ALL.iter().filter(|s| mask & s.bit() != 0).map(|s| format!("{s:?}")).collect();
     if names.is_empty() {
         "no state".to_owned()
     } else {

@@ -40,9 +40,8 @@ pub const FMI2_TRUE: fmi2Boolean = 1;
 pub const FMI2_FALSE: fmi2Boolean = 0;
 
 /// The logger is a C variadic, printf-style function: boomsim always passes "%s" and the text.
-pub type fmi2CallbackLogger = Option<
-    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
->;
+pub type fmi2CallbackLogger =
+    Option<unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...)>;
 pub type fmi2CallbackAllocateMemory = Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>;
 pub type fmi2CallbackFreeMemory = Option<unsafe extern "C" fn(*mut c_void)>;
 pub type fmi2StepFinished = Option<unsafe extern "C" fn(fmi2ComponentEnvironment, c_int)>;

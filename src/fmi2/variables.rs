@@ -34,24 +34,10 @@ pub enum Initial {
 /// Type, start value and type-specific attributes of a variable.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Kind {
-    Real {
-        start: f64,
-        unit: &'static str,
-        display_unit: &'static str,
-        min: f64,
-        max: f64,
-    },
-    Integer {
-        start: i32,
-        min: i32,
-        max: i32,
-    },
-    Boolean {
-        start: bool,
-    },
-    String {
-        start: &'static str,
-    },
+    Real { start: f64, unit: &'static str, display_unit: &'static str, min: f64, max: f64 },
+    Integer { start: i32, min: i32, max: i32 },
+    Boolean { start: bool },
+    String { start: &'static str },
 }
 
 /// The four FMI base types, for messages and type checks.
@@ -61,6 +47,13 @@ pub enum BaseType {
     Integer,
     Boolean,
     String,
+}
+
+/// The FMI spelling of an enum value: `CalculatedParameter` -> `calculatedParameter`.
+pub fn fmi_name<T: std::fmt::Debug>(x: T) -> String {
+    let s = format!("{x:?}");
+    let mut c = s.chars();
+    c.next().map(|f| f.to_lowercase().chain(c).collect()).unwrap_or_default()
 }
 
 /// One row of a model's variable table.
@@ -91,36 +84,13 @@ impl Variable {
         kind: Kind,
         description: &'static str,
     ) -> Self {
-        Variable {
-            name,
-            vr,
-            description,
-            causality,
-            variability,
-            initial,
-            kind,
-            depends_on: &[],
-        }
+        Variable { name, vr, description, causality, variability, initial, kind, depends_on: &[] }
     }
 
     /// A tunable Real parameter from its physical description.
     pub const fn param(vr: u32, p: ParamSpec) -> Self {
-        let kind = Kind::Real {
-            start: p.default,
-            unit: p.unit,
-            display_unit: p.display_unit,
-            min: p.min,
-            max: p.max,
-        };
-        Self::new(
-            p.name,
-            vr,
-            Causality::Parameter,
-            Variability::Tunable,
-            Initial::Exact,
-            kind,
-            p.description,
-        )
+        let kind = Kind::Real { start: p.default, unit: p.unit, display_unit: p.display_unit, min: p.min, max: p.max };
+        Self::new(p.name, vr, Causality::Parameter, Variability::Tunable, Initial::Exact, kind, p.description)
     }
 
     /// A continuous Real input with start value and admissible range.
@@ -133,22 +103,8 @@ impl Variable {
         (min, max): (f64, f64),
         description: &'static str,
     ) -> Self {
-        let kind = Kind::Real {
-            start,
-            unit,
-            display_unit,
-            min,
-            max,
-        };
-        Self::new(
-            name,
-            vr,
-            Causality::Input,
-            Variability::Continuous,
-            Initial::Exact,
-            kind,
-            description,
-        )
+        let kind = Kind::Real { start, unit, display_unit, min, max };
+        Self::new(name, vr, Causality::Input, Variability::Continuous, Initial::Exact, kind, description)
     }
 
     /// A continuous Real output computed by the model (initial = calculated, no start value).
@@ -159,22 +115,8 @@ impl Variable {
         display_unit: &'static str,
         description: &'static str,
     ) -> Self {
-        let kind = Kind::Real {
-            start: 0.0,
-            unit,
-            display_unit,
-            min: NO_MIN,
-            max: NO_MAX,
-        };
-        Self::new(
-            name,
-            vr,
-            Causality::Output,
-            Variability::Continuous,
-            Initial::Calculated,
-            kind,
-            description,
-        )
+        let kind = Kind::Real { start: 0.0, unit, display_unit, min: NO_MIN, max: NO_MAX };
+        Self::new(name, vr, Causality::Output, Variability::Continuous, Initial::Calculated, kind, description)
     }
 
     /// A continuous Real local (internal state or diagnostic), initial = calculated.
@@ -185,41 +127,14 @@ impl Variable {
         display_unit: &'static str,
         description: &'static str,
     ) -> Self {
-        let kind = Kind::Real {
-            start: 0.0,
-            unit,
-            display_unit,
-            min: NO_MIN,
-            max: NO_MAX,
-        };
-        Self::new(
-            name,
-            vr,
-            Causality::Local,
-            Variability::Continuous,
-            Initial::Calculated,
-            kind,
-            description,
-        )
+        let kind = Kind::Real { start: 0.0, unit, display_unit, min: NO_MIN, max: NO_MAX };
+        Self::new(name, vr, Causality::Local, Variability::Continuous, Initial::Calculated, kind, description)
     }
 
     /// A tunable Boolean parameter.
-    pub const fn bool_param(
-        name: &'static str,
-        vr: u32,
-        start: bool,
-        description: &'static str,
-    ) -> Self {
+    pub const fn bool_param(name: &'static str, vr: u32, start: bool, description: &'static str) -> Self {
         let kind = Kind::Boolean { start };
-        Self::new(
-            name,
-            vr,
-            Causality::Parameter,
-            Variability::Tunable,
-            Initial::Exact,
-            kind,
-            description,
-        )
+        Self::new(name, vr, Causality::Parameter, Variability::Tunable, Initial::Exact, kind, description)
     }
 
     /// A fixed Integer parameter (FMI 2.0 has no structural parameters: fixed ones play that role).
@@ -231,15 +146,7 @@ impl Variable {
         description: &'static str,
     ) -> Self {
         let kind = Kind::Integer { start, min, max };
-        Self::new(
-            name,
-            vr,
-            Causality::Parameter,
-            Variability::Fixed,
-            Initial::Exact,
-            kind,
-            description,
-        )
+        Self::new(name, vr, Causality::Parameter, Variability::Fixed, Initial::Exact, kind, description)
     }
 
     /// The same variable, but fixed (settable only before initialisation ends).
@@ -301,14 +208,9 @@ pub struct Values {
 impl Values {
     /// All variables at their start values.
     pub fn new(table: &'static [Variable]) -> Self {
-        let mut index: Vec<(u32, usize)> =
-            table.iter().enumerate().map(|(i, v)| (v.vr, i)).collect();
+        let mut index: Vec<(u32, usize)> = table.iter().enumerate().map(|(i, v)| (v.vr, i)).collect();
         index.sort_unstable();
-        Values {
-            table,
-            values: table.iter().map(Variable::start_value).collect(),
-            index,
-        }
+        Values { table, values: table.iter().map(Variable::start_value).collect(), index }
     }
 
     /// The variable table.
@@ -318,10 +220,7 @@ impl Values {
 
     /// Table index of a value reference.
     pub fn position(&self, vr: u32) -> Option<usize> {
-        self.index
-            .binary_search_by_key(&vr, |&(r, _)| r)
-            .ok()
-            .map(|k| self.index[k].1)
+        self.index.binary_search_by_key(&vr, |&(r, _)| r).ok().map(|k| self.index[k].1)
     }
 
     /// The value at a table index.
@@ -340,9 +239,7 @@ impl Values {
     }
 
     fn expect(&self, vr: u32) -> &Value {
-        let i = self
-            .position(vr)
-            .unwrap_or_else(|| panic!("no variable with value reference {vr}"));
+        let i = self.position(vr).unwrap_or_else(|| panic!("no variable with value reference {vr}"));
         &self.values[i]
     }
 
@@ -372,9 +269,7 @@ impl Values {
 
     /// Sets a Real computed by the model (outputs, locals).
     pub fn set_real(&mut self, vr: u32, x: f64) {
-        let i = self
-            .position(vr)
-            .unwrap_or_else(|| panic!("no variable with value reference {vr}"));
+        let i = self.position(vr).unwrap_or_else(|| panic!("no variable with value reference {vr}"));
         self.values[i] = Value::Real(x);
     }
 }

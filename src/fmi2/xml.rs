@@ -3,7 +3,7 @@
 use super::guid::guid;
 use super::log::GENERIC_CATEGORIES;
 use super::model::Model;
-use super::variables::{Causality, Initial, Kind, Variability, Variable};
+use super::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
 use crate::units::{self, BASE_NAMES};
 use quick_xml::Writer;
 use std::io;
@@ -22,42 +22,25 @@ pub fn num(x: f64) -> String {
 }
 
 fn element(w: &mut Writer<Vec<u8>>, name: &str, attrs: &Attrs) -> io::Result<()> {
-    w.create_element(name)
-        .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
-        .write_empty()?;
+    w.create_element(name).with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str()))).write_empty()?;
     Ok(())
-}
-
-fn enum_name<T: std::fmt::Debug>(x: T) -> String {
-    let s = format!("{x:?}");
-    let mut c = s.chars();
-    c.next()
-        .map(|f| f.to_lowercase().chain(c).collect())
-        .unwrap_or_default()
 }
 
 /// The units the model's Real variables use, in table order of [`units::UNITS`].
 fn used_units<M: Model>() -> Vec<&'static units::Unit> {
     units::UNITS
         .iter()
-        .filter(|u| {
-            M::VARIABLES
-                .iter()
-                .any(|v| matches!(v.kind, Kind::Real { unit, .. } if unit == u.name))
-        })
+        .filter(|u| M::VARIABLES.iter().any(|v| matches!(v.kind, Kind::Real { unit, .. } if unit == u.name)))
         .collect()
 }
 
 fn variable_attrs(v: &Variable) -> Attrs {
-    let mut a: Attrs = vec![
-        ("name", v.name.into()),
-        ("valueReference", v.vr.to_string()),
-    ];
+    let mut a: Attrs = vec![("name", v.name.into()), ("valueReference", v.vr.to_string())];
     if !v.description.is_empty() {
         a.push(("description", v.description.into()));
     }
-    a.push(("causality", enum_name(v.causality)));
-    a.push(("variability", enum_name(v.variability)));
+    a.push(("causality", fmi_name(v.causality)));
+    a.push(("variability", fmi_name(v.variability)));
     // Written only where it differs from the FMI 2.0 default for the causality/variability.
     let default_initial = match (v.causality, v.variability) {
         (Causality::Input, _) => None,
@@ -65,7 +48,7 @@ fn variable_attrs(v: &Variable) -> Attrs {
         _ => Some(Initial::Calculated),
     };
     if default_initial != Some(v.initial) && v.causality != Causality::Input {
-        a.push(("initial", enum_name(v.initial)));
+        a.push(("initial", fmi_name(v.initial)));
     }
     a
 }
@@ -73,13 +56,7 @@ fn variable_attrs(v: &Variable) -> Attrs {
 fn type_attrs(v: &Variable) -> (&'static str, Attrs) {
     let start = v.has_start();
     match v.kind {
-        Kind::Real {
-            start: s,
-            unit,
-            display_unit,
-            min,
-            max,
-        } => {
+        Kind::Real { start: s, unit, display_unit, min, max } => {
             let mut a: Attrs = vec![("unit", unit.into())];
             if !display_unit.is_empty() {
                 a.push(("displayUnit", display_unit.into()));
@@ -102,22 +79,8 @@ fn type_attrs(v: &Variable) -> (&'static str, Attrs) {
             }
             ("Integer", a)
         }
-        Kind::Boolean { start: s } => (
-            "Boolean",
-            if start {
-                vec![("start", s.to_string())]
-            } else {
-                vec![]
-            },
-        ),
-        Kind::String { start: s } => (
-            "String",
-            if start {
-                vec![("start", s.into())]
-            } else {
-                vec![]
-            },
-        ),
+        Kind::Boolean { start: s } => ("Boolean", if start { vec![("start", s.to_string())] } else { vec![] }),
+        Kind::String { start: s } => ("String", if start { vec![("start", s.into())] } else { vec![] }),
     }
 }
 
@@ -138,9 +101,7 @@ pub fn model_description<M: Model>() -> String {
 fn write<M: Model>() -> io::Result<String> {
     let info = &M::INFO;
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-    w.write_event(quick_xml::events::Event::Decl(
-        quick_xml::events::BytesDecl::new("1.0", Some("UTF-8"), None),
-    ))?;
+    w.write_event(quick_xml::events::Event::Decl(quick_xml::events::BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let root: Attrs = vec![
         ("fmiVersion", "2.0".into()),
         ("modelName", info.identifier.into()),
@@ -149,10 +110,7 @@ fn write<M: Model>() -> io::Result<String> {
         ("author", "boomsim developers".into()),
         ("version", info.version.into()),
         ("license", "MIT OR Apache-2.0".into()),
-        (
-            "generationTool",
-            format!("boomsim {}", env!("CARGO_PKG_VERSION")),
-        ),
+        ("generationTool", format!("boomsim {}", env!("CARGO_PKG_VERSION"))),
         ("variableNamingConvention", "structured".into()),
         ("numberOfEventIndicators", "0".into()),
     ];
@@ -174,42 +132,31 @@ fn write<M: Model>() -> io::Result<String> {
                 ("providesDirectionalDerivative", flag(false)),
             ];
             element(w, "CoSimulation", &cs)?;
-            w.create_element("UnitDefinitions")
-                .write_inner_content(|w| {
-                    for u in used_units::<M>() {
-                        w.create_element("Unit")
-                            .with_attribute(("name", u.name))
-                            .write_inner_content(|w| {
-                                let base: Attrs = BASE_NAMES
-                                    .iter()
-                                    .zip(u.base)
-                                    .filter(|(_, e)| *e != 0)
-                                    .map(|(n, e)| (*n, e.to_string()))
-                                    .collect();
-                                element(w, "BaseUnit", &base)?;
-                                for d in u.display {
-                                    let mut a: Attrs =
-                                        vec![("name", d.name.into()), ("factor", num(d.factor))];
-                                    if d.offset != 0.0 {
-                                        a.push(("offset", num(d.offset)));
-                                    }
-                                    element(w, "DisplayUnit", &a)?;
-                                }
-                                Ok(())
-                            })?;
-                    }
-                    Ok(())
-                })?;
+            w.create_element("UnitDefinitions").write_inner_content(|w| {
+                for u in used_units::<M>() {
+                    w.create_element("Unit").with_attribute(("name", u.name)).write_inner_content(|w| {
+                        let base: Attrs = BASE_NAMES
+                            .iter()
+                            .zip(u.base)
+                            .filter(|(_, e)| *e != 0)
+                            .map(|(n, e)| (*n, e.to_string()))
+                            .collect();
+                        element(w, "BaseUnit", &base)?;
+                        for d in u.display {
+                            let mut a: Attrs = vec![("name", d.name.into()), ("factor", num(d.factor))];
+                            if d.offset != 0.0 {
+                                a.push(("offset", num(d.offset)));
+                            }
+                            element(w, "DisplayUnit", &a)?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
             w.create_element("LogCategories").write_inner_content(|w| {
                 for (name, description) in GENERIC_CATEGORIES.iter().chain(info.log_categories) {
-                    element(
-                        w,
-                        "Category",
-                        &vec![
-                            ("name", (*name).into()),
-                            ("description", (*description).into()),
-                        ],
-                    )?;
+                    element(w, "Category", &vec![("name", (*name).into()), ("description", (*description).into())])?;
                 }
                 Ok(())
             })?;
@@ -220,57 +167,50 @@ fn write<M: Model>() -> io::Result<String> {
                 ("stepSize", num(info.step_size)),
             ];
             element(w, "DefaultExperiment", &exp)?;
-            w.create_element("ModelVariables")
-                .write_inner_content(|w| {
-                    for v in M::VARIABLES {
-                        let attrs = variable_attrs(v);
-                        w.create_element("ScalarVariable")
-                            .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
-                            .write_inner_content(|w| {
-                                let (ty, a) = type_attrs(v);
-                                element(w, ty, &a)
-                            })?;
-                    }
-                    Ok(())
-                })?;
-            w.create_element("ModelStructure")
-                .write_inner_content(|w| {
-                    let outputs: Vec<&Variable> = M::VARIABLES
-                        .iter()
-                        .filter(|v| v.causality == Causality::Output)
-                        .collect();
-                    if !outputs.is_empty() {
-                        w.create_element("Outputs").write_inner_content(|w| {
-                            for v in &outputs {
-                                let a: Attrs = vec![
-                                    ("index", indices::<M>(&[v.vr])),
-                                    ("dependencies", indices::<M>(v.depends_on)),
-                                ];
-                                element(w, "Unknown", &a)?;
-                            }
-                            Ok(())
+            w.create_element("ModelVariables").write_inner_content(|w| {
+                for v in M::VARIABLES {
+                    let attrs = variable_attrs(v);
+                    w.create_element("ScalarVariable")
+                        .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
+                        .write_inner_content(|w| {
+                            let (ty, a) = type_attrs(v);
+                            element(w, ty, &a)
                         })?;
-                    }
-                    // FMI 2.0 section 2.2.8: outputs with initial approx/calculated and calculated
-                    // parameters; no dependencies attribute = may depend on every known.
-                    let initial: Vec<&Variable> = M::VARIABLES
-                        .iter()
-                        .filter(|v| {
-                            (v.causality == Causality::Output && v.initial != Initial::Exact)
-                                || v.causality == Causality::CalculatedParameter
-                        })
-                        .collect();
-                    if !initial.is_empty() {
-                        w.create_element("InitialUnknowns")
-                            .write_inner_content(|w| {
-                                for v in &initial {
-                                    element(w, "Unknown", &vec![("index", indices::<M>(&[v.vr]))])?;
-                                }
-                                Ok(())
-                            })?;
-                    }
-                    Ok(())
-                })?;
+                }
+                Ok(())
+            })?;
+            w.create_element("ModelStructure").write_inner_content(|w| {
+                let outputs: Vec<&Variable> =
+                    M::VARIABLES.iter().filter(|v| v.causality == Causality::Output).collect();
+                if !outputs.is_empty() {
+                    w.create_element("Outputs").write_inner_content(|w| {
+                        for v in &outputs {
+                            let a: Attrs =
+                                vec![("index", indices::<M>(&[v.vr])), ("dependencies", indices::<M>(v.depends_on))];
+                            element(w, "Unknown", &a)?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                // FMI 2.0 section 2.2.8: outputs with initial approx/calculated and calculated
+                // parameters; no dependencies attribute = may depend on every known.
+                let initial: Vec<&Variable> = M::VARIABLES
+                    .iter()
+                    .filter(|v| {
+                        (v.causality == Causality::Output && v.initial != Initial::Exact)
+                            || v.causality == Causality::CalculatedParameter
+                    })
+                    .collect();
+                if !initial.is_empty() {
+                    w.create_element("InitialUnknowns").write_inner_content(|w| {
+                        for v in &initial {
+                            element(w, "Unknown", &vec![("index", indices::<M>(&[v.vr]))])?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                Ok(())
+            })?;
             Ok(())
         })?;
     let mut s = String::from_utf8(w.into_inner()).map_err(io::Error::other)?;

@@ -8,7 +8,5 @@ use crate::fmi2::Fmu;
 
 /// Every FMU boomsim ships, with the cdylib package that exports it.
 pub fn all() -> Vec<Fmu> {
-    vec![Fmu::of::<PressureFeedbackController>(
-        "fmu-pressure-feedback-controller",
-    )]
+    vec![Fmu::of::<PressureFeedbackController>("fmu-pressure-feedback-controller")]
 }

@@ -33,40 +33,15 @@ const VARIABLES: &[Variable] = &[
         (-1.0, 1.0),
         "Operator's spool reference; < 0 lowers the load",
     ),
-    Variable::real_input(
-        "p",
-        vr::P,
-        0.0,
-        "Pa",
-        "bar",
-        P_RANGE,
-        "Fed-back pressure (p4, rod side / CBV pilot)",
-    ),
-    Variable::real_output(
-        "u",
-        vr::U,
-        "1",
-        "%",
-        "Spool command u = clamp(u_ref + u_comp, u_min, u_max)",
-    )
-    .depends(&[vr::U_REF, vr::P]),
-    Variable::real_output(
-        "u_comp",
-        vr::U_COMP,
-        "1",
-        "%",
-        "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)",
-    )
-    .depends(&[vr::P]),
+    Variable::real_input("p", vr::P, 0.0, "Pa", "bar", P_RANGE, "Fed-back pressure (p4, rod side / CBV pilot)"),
+    Variable::real_output("u", vr::U, "1", "%", "Spool command u = clamp(u_ref + u_comp, u_min, u_max)")
+        .depends(&[vr::U_REF, vr::P]),
+    Variable::real_output("u_comp", vr::U_COMP, "1", "%", "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)")
+        .depends(&[vr::P]),
     Variable::param(vr::K_F, FEEDBACK_SPECS[0]),
     Variable::param(vr::OMEGA_F, FEEDBACK_SPECS[1]),
-    Variable::param(vr::Q_RATED, FEEDBACK_SPECS[2]),
-    Variable::bool_param(
-        "enable",
-        vr::ENABLE,
-        true,
-        "Feedback on; off gives u = u_ref (experiment U)",
-    ),
+    Variable::param(vr::Q_RATED, FEEDBACK_SPECS[2]).fixed(),
+    Variable::bool_param("enable", vr::ENABLE, true, "Feedback on; off gives u = u_ref (experiment U)"),
     Variable::param(
         vr::U_MIN,
         crate::params::ParamSpec {
@@ -136,22 +111,12 @@ impl PressureFeedbackController {
             omega_f: values.real(vr::OMEGA_F),
             q_rated: values.real(vr::Q_RATED),
         };
-        Ok(PressureFeedbackController {
-            feedback,
-            enable: values.boolean(vr::ENABLE),
-            u_min,
-            u_max,
-            x,
-        })
+        Ok(PressureFeedbackController { feedback, enable: values.boolean(vr::ENABLE), u_min, u_max, x })
     }
 
     /// (u_comp, unclamped u) for the current inputs.
     fn command(&self, values: &Values) -> (f64, f64) {
-        let u_comp = if self.enable {
-            self.feedback.u_comp(values.real(vr::P), self.x)
-        } else {
-            0.0
-        };
+        let u_comp = if self.enable { self.feedback.u_comp(values.real(vr::P), self.x) } else { 0.0 };
         (u_comp, values.real(vr::U_REF) + u_comp)
     }
 }
@@ -202,12 +167,7 @@ impl Model for PressureFeedbackController {
         if u < self.u_min || u > self.u_max {
             log.info(
                 "logSaturation",
-                &format!(
-                    "t = {}: u_ref + u_comp = {u} clamped to [{}, {}]",
-                    t + h,
-                    self.u_min,
-                    self.u_max
-                ),
+                &format!("t = {}: u_ref + u_comp = {u} clamped to [{}, {}]", t + h, self.u_min, self.u_max),
             );
         }
         Ok(())

@@ -1,0 +1,126 @@
+//! In-process harness: drives a model through the generic FMI 2.0 functions with a logger that
+//! records every message, as an importer would see them.
+#![allow(dead_code)]
+
+use boomsim::fmi2::api;
+use boomsim::fmi2::guid::guid;
+use boomsim::fmi2::types::*;
+use boomsim::fmi2::Model;
+use std::ffi::{CStr, CString};
+use std::marker::PhantomData;
+use std::os::raw::{c_char, c_int, c_void};
+use std::sync::Mutex;
+
+/// Messages received by the logger: (status, category, text).
+pub type Messages = Mutex<Vec<(i32, String, String)>>;
+
+unsafe extern "C" fn record(
+    env: fmi2ComponentEnvironment,
+    _name: fmi2String,
+    status: c_int,
+    category: fmi2String,
+    format: fmi2String,
+    message: *const c_char,
+) {
+    let messages = &*(env as *const Messages);
+    assert_eq!(CStr::from_ptr(format).to_str().unwrap(), "%s", "the logger must get a \"%s\" format");
+    let text = CStr::from_ptr(message).to_string_lossy().into_owned();
+    messages.lock().unwrap().push((status, CStr::from_ptr(category).to_string_lossy().into_owned(), text));
+}
+
+unsafe extern "C" fn alloc(n: usize, size: usize) -> *mut c_void {
+    libc::calloc(n, size)
+}
+unsafe extern "C" fn free(p: *mut c_void) {
+    libc::free(p)
+}
+
+/// Callback functions whose logger records into `messages`.
+pub fn callbacks(messages: &Messages) -> fmi2CallbackFunctions {
+    // A C-variadic logger cannot be defined in stable Rust; `record` takes the one argument the
+    // FMU passes after "%s". Calling it through the variadic pointer type is ABI-compatible on
+    // the x86_64 System V ABI that this test runs on.
+    let logger = unsafe {
+        std::mem::transmute::<
+            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, *const c_char),
+            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
+        >(record)
+    };
+    fmi2CallbackFunctions {
+        logger: Some(logger),
+        allocateMemory: Some(alloc),
+        freeMemory: Some(free),
+        stepFinished: None,
+        componentEnvironment: messages as *const Messages as *mut c_void,
+    }
+}
+
+/// One instance of model `M` with its recorded messages.
+pub struct Slave<M: Model> {
+    pub c: fmi2Component,
+    pub messages: Box<Messages>,
+    _callbacks: Box<fmi2CallbackFunctions>,
+    _m: PhantomData<M>,
+}
+
+impl<M: Model> Slave<M> {
+    /// Instantiates with the right GUID.
+    pub fn new(name: &str) -> Self {
+        Self::try_new(name, &guid::<M>(), FMI2_COSIMULATION).expect("instantiation succeeds")
+    }
+
+    /// Instantiates with the given GUID and type; `Err` carries the logged messages.
+    pub fn try_new(name: &str, guid: &str, fmu_type: c_int) -> Result<Self, Vec<String>> {
+        let messages = Box::new(Messages::default());
+        let callbacks = Box::new(callbacks(&messages));
+        let (n, g) = (CString::new(name).unwrap(), CString::new(guid).unwrap());
+        let c = unsafe { api::instantiate::<M>(n.as_ptr(), fmu_type, g.as_ptr(), std::ptr::null(), &*callbacks, 0, 0) };
+        if c.is_null() {
+            return Err(messages.lock().unwrap().iter().map(|m| m.2.clone()).collect());
+        }
+        Ok(Slave { c, messages, _callbacks: callbacks, _m: PhantomData })
+    }
+
+    /// Setup, initialisation with the given Real start values, and exit: ready to step.
+    pub fn initialized(name: &str, reals: &[(u32, f64)]) -> Self {
+        let s = Self::new(name);
+        assert_eq!(unsafe { api::setup_experiment::<M>(s.c, 0, 0.0, 0.0, 0, 0.0) }, fmi2Status::OK);
+        assert_eq!(unsafe { api::enter_initialization_mode::<M>(s.c) }, fmi2Status::OK);
+        for &(vr, x) in reals {
+            assert_eq!(s.set_real(vr, x), fmi2Status::OK);
+        }
+        assert_eq!(unsafe { api::exit_initialization_mode::<M>(s.c) }, fmi2Status::OK);
+        s
+    }
+
+    pub fn set_real(&self, vr: u32, x: f64) -> fmi2Status {
+        unsafe { api::set_real::<M>(self.c, &vr, 1, &x) }
+    }
+
+    pub fn real(&self, vr: u32) -> f64 {
+        let mut x = f64::NAN;
+        assert_eq!(unsafe { api::get_real::<M>(self.c, &vr, 1, &mut x) }, fmi2Status::OK);
+        x
+    }
+
+    pub fn step(&self, t: f64, h: f64) -> fmi2Status {
+        unsafe { api::do_step::<M>(self.c, t, h, 1) }
+    }
+
+    /// The texts logged so far, and clears them.
+    pub fn take_messages(&self) -> Vec<(i32, String, String)> {
+        std::mem::take(&mut *self.messages.lock().unwrap())
+    }
+
+    /// The last message with status fmi2Error.
+    pub fn last_error(&self) -> String {
+        let m = self.messages.lock().unwrap();
+        m.iter().rev().find(|m| m.0 == fmi2Status::Error as i32).map(|m| m.2.clone()).unwrap_or_default()
+    }
+}
+
+impl<M: Model> Drop for Slave<M> {
+    fn drop(&mut self) {
+        unsafe { api::free_instance::<M>(self.c) }
+    }
+}

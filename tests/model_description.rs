@@ -1,0 +1,42 @@
+//! modelDescription.xml: the committed files are the generator's output, and every variable
+//! table obeys the FMI 2.0 rules the generator relies on.
+
+use boomsim::fmi2::{Causality, Kind, Variable};
+use boomsim::models;
+use boomsim::units::unit;
+use std::path::Path;
+
+#[test]
+fn committed_model_descriptions_are_current() {
+    for f in models::all() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("modelDescription/{}.xml", f.identifier));
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(committed == (f.model_description)(), "{} is out of date: run `boomsim xml`", path.display());
+    }
+}
+
+/// FMI 2.0 section 2.2.7: unique value references, declared units, start within range, and
+/// output dependencies on inputs only.
+fn check_table(id: &str, vars: &[Variable]) {
+    for (i, v) in vars.iter().enumerate() {
+        assert!(vars[i + 1..].iter().all(|w| w.vr != v.vr && w.name != v.name), "{id}: {} is not unique", v.name);
+        if let Kind::Real { start, unit: u, display_unit, min, max } = v.kind {
+            let declared = unit(u).unwrap_or_else(|| panic!("{id}: unit {u} of {} is not declared", v.name));
+            assert!(display_unit.is_empty() || declared.display.iter().any(|d| d.name == display_unit));
+            assert!(min <= max, "{id}: {} has min > max", v.name);
+            if v.has_start() {
+                assert!((min..=max).contains(&start), "{id}: start of {} is outside [min, max]", v.name);
+            }
+        }
+        for dep in v.depends_on {
+            let d = vars.iter().find(|w| w.vr == *dep).expect("dependency exists");
+            assert_eq!(d.causality, Causality::Input, "{id}: {} depends on non-input {}", v.name, d.name);
+        }
+    }
+}
+
+#[test]
+fn variable_tables_obey_fmi_rules() {
+    use boomsim::fmi2::Model;
+    check_table("PressureFeedbackController", models::PressureFeedbackController::VARIABLES);
+}
