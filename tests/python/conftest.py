@@ -1,0 +1,77 @@
+"""Shared helpers for the fmpy tests: paths of the packed FMUs and slaves whose log messages are
+recorded (fmpy's logger proxy formats the FMU's printf-style "%s" messages)."""
+
+import ctypes
+import pathlib
+
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+from fmpy import calloc, free
+from fmpy.logging import addLoggerProxy
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+FMU_DIR = ROOT / "target" / "fmu"
+
+
+def fmu_path(identifier):
+    path = FMU_DIR / f"{identifier}.fmu"
+    assert path.exists(), f"{path} is missing: run target/release/boomsim pack"
+    return str(path)
+
+
+class Recorder:
+    """FMI callbacks whose logger records (status, category, message)."""
+
+    def __init__(self):
+        self.messages = []
+
+        def log(env, name, status, category, message):
+            self.messages.append((status, category.decode(), message.decode()))
+
+        self._log = fmi2CallbackLoggerTYPE(log)
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = self._log
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        addLoggerProxy(ctypes.byref(self.callbacks))
+
+    def errors(self):
+        return [m for s, _, m in self.messages if s == 3]
+
+
+class Fmu:
+    """An extracted FMU: model description, value references by name, slaves with recorders."""
+
+    def __init__(self, identifier, tmp_path_factory):
+        self.path = fmu_path(identifier)
+        self.md = read_model_description(self.path)
+        self.dir = extract(self.path, unzipdir=str(tmp_path_factory.mktemp(identifier)))
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+
+    def slave(self, name="instance", guid=None, **start):
+        """An instantiated slave, set up and initialised with the given start values
+        (unless guid is given: then only instantiated)."""
+        rec = Recorder()
+        s = FMU2Slave(guid=guid or self.md.guid, unzipDirectory=self.dir,
+                      modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        s.recorder = rec
+        s.instantiate(callbacks=rec.callbacks)
+        if guid is None:
+            s.setupExperiment(startTime=0.0)
+            s.enterInitializationMode()
+            for k, v in start.items():
+                s.setReal([self.vr[k]], [v])
+            s.exitInitializationMode()
+        return s
+
+
+@pytest.fixture(scope="session")
+def controller(tmp_path_factory):
+    return Fmu("PressureFeedbackController", tmp_path_factory)
