@@ -5,6 +5,7 @@
 //!   and acceleration constraints (2.11-2.15);
 //! - [`rigid_boom`]: the kinetics (2.16-2.19) and the equation of motion in the cylinder stroke.
 
+pub mod kinematics;
 pub mod params;
 
 use std::fmt;
