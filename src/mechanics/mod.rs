@@ -7,6 +7,7 @@
 
 pub mod kinematics;
 pub mod params;
+pub mod rigid_boom;
 
 use std::fmt;
 
