@@ -8,13 +8,15 @@ use crate::params::ParamSpec;
 /// Chosen as stroke (500 mm) + 250 mm build length:
 /// - a 65/35 mm double-acting cylinder with eye or clevis mounts needs 200-300 mm beyond its stroke
 ///   (rear cap and eye, piston, gland and guide, rod eye), so 0.7..0.8 m is what a 500 mm stroke
-///   cylinder measures retracted; a length that made the boom horizontal at the 480 mm start of the
-///   experiments (0.93 m - 0.48 m = 0.45 m) is shorter than the stroke and cannot be built;
+///   cylinder measures retracted; putting the near-horizontal l_cyl = 0.93 m at the 480 mm start
+///   of the experiments would need 0.45 m, shorter than the stroke;
 /// - with l1 = 0.6 m, l2 = 0.3 m it puts the horizontal boom (theta2 = 0, l_cyl = 0.963 m) at
 ///   213 mm stroke, close to the mid-stroke operating point of the stability analysis
 ///   (x_c = 250 mm, Table 6.1), and the l_cyl = 0.93 m of experiment I ("approximately
 ///   horizontal", theta2 = -3.07 deg) at 180 mm stroke; the full stroke sweeps the boom from
-///   -20.2 deg to +28.3 deg, and the 480 mm start of chapters 6 and 7 is at +26.2 deg;
+///   -20.2 deg to +28.3 deg, and the 480 mm start of chapters 6 and 7 is at +26.2 deg (with the
+///   nomenclature's l1 = 548 mm, l2 = 410 mm, for which l_cyl = 0.93 m is horizontal to 0.03 deg,
+///   the range is -19.6 deg .. +33.5 deg and horizontal at 180 mm stroke);
 /// - cross-check: the mass m = A_c beta / (x_c omega_n^2) = 2456 kg implied by omega_n = 83.82 rad/s
 ///   at x_c = 250 mm (Table 6.1, eq. 2.81, C_1 = A_c x_c / beta) equals the static cylinder force
 ///   over g; this length gives 24.07 kN at 250 mm against m g = 24.09 kN (0.05 %). The static force
