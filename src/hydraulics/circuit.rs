@@ -106,7 +106,10 @@ impl std::fmt::Display for EquilibriumError {
         match self {
             Self::TensileLoad => write!(f, "a tensile load cannot be held by the closed circuit"),
             Self::CbvOpens { max_load } => {
-                write!(f, "load exceeds what the closed CBV holds ({max_load:.0} N)")
+                write!(
+                    f,
+                    "load exceeds what the closed CBV holds ({max_load:.0} N)"
+                )
             }
         }
     }
@@ -147,7 +150,13 @@ impl Circuit {
         let v4 = (ln.v_l4 + cyl.volume_b(x)).max(ln.v_l4 + 0.1 * cyl.v_dead_b);
         let mut dx = [0.0; N_STATES];
         dx[P1] = fl.pressure_rate(p1, q1 - q_p - q_lp, ln.v_l1, 0.0, 0.0);
-        dx[P2] = fl.pressure_rate(p2, q2 - q3 - q_la, ln.v_l2, 0.0, ln.hose_compliance(ln.v_l2));
+        dx[P2] = fl.pressure_rate(
+            p2,
+            q2 - q3 - q_la,
+            ln.v_l2,
+            0.0,
+            ln.hose_compliance(ln.v_l2),
+        );
         dx[P3] = fl.pressure_rate(p3, q3, v3, a * v, ln.hose_compliance(ln.v_l3));
         dx[P4] = fl.pressure_rate(p4, -q4 - q_lb, v4, -b * v, ln.hose_compliance(ln.v_l4));
         dx[X_V] = self.dcv.spool_rate(x_v, u_ref);
@@ -215,5 +224,205 @@ impl Circuit {
         s[P3] = p3;
         s[P4] = p4;
         Ok(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::{bar, lpm, LPM, P_ATM};
+    use nalgebra::{SMatrix, SVector};
+
+    /// The equilibrium state is stationary: the pressure rates vanish (p1 to the bisection
+    /// tolerance, which leaves a flow imbalance far below the P-port leakage), the spool and the
+    /// CBV stay closed and the cylinder force equals the load.
+    #[test]
+    fn equilibrium_is_stationary() {
+        let c = Circuit::default();
+        for f_load in [0.0, 10e3, 30e3, 60e3] {
+            let s = c.equilibrium(f_load).unwrap();
+            let e = c.evaluate(&s, 0.0, 0.25, 0.0);
+            assert!((s[P3] - f_load / c.cylinder.area_a()).abs() < 1e-6);
+            assert_eq!(e.dx[P2], 0.0);
+            assert_eq!(e.dx[P3], 0.0);
+            assert_eq!(e.dx[P4], 0.0);
+            assert_eq!(e.dx[X_V], 0.0);
+            assert_eq!(e.dx[U_CBV], 0.0);
+            assert!((e.q[0] - e.q_leak[0]).abs() < 1e-3 * e.q_leak[0]);
+            assert_eq!(e.force, f_load);
+            // p1 just below p_T + p_pcv + p_fc,pcv where the compensator closes
+            assert!(s[P1] < bar(8.0) && s[P1] > bar(7.99));
+        }
+        // p_set 210 bar on the piston holds 69.7 kN at most
+        let max = c.cylinder.area_a() * bar(210.0);
+        assert!(
+            matches!(c.equilibrium(max + 1.0), Err(EquilibriumError::CbvOpens { max_load }) if (max_load - max).abs() < 1e-6)
+        );
+        assert_eq!(c.equilibrium(-1.0), Err(EquilibriumError::TensileLoad));
+    }
+
+    /// Steady motion of the whole circuit for a constant load `f_load` and spool reference
+    /// `u`: solves dp1..dp4 = 0 (with u_cbv at its static opening) and force = f_load for
+    /// (p1, p2, p3, p4, v) by Newton's method with a difference Jacobian and backtracking.
+    /// Unknowns in bar and mm/s; residuals are the net volume flows (l/min) and the force
+    /// imbalance (kN).
+    fn steady_motion(c: &Circuit, u: f64, f_load: f64, x: f64) -> (State, f64) {
+        let cyl = &c.cylinder;
+        let (a, b) = (cyl.area_a(), cyl.area_b());
+        let k1u = c.dcv.k1() * u;
+        let volumes = [
+            c.lines.v_l1,
+            c.lines.v_l2,
+            c.lines.v_l3 + cyl.volume_a(x),
+            c.lines.v_l4 + cyl.volume_b(x),
+        ];
+        let state_of = |z: &SVector<f64, 5>| {
+            let mut s = [0.0; N_STATES];
+            for i in 0..4 {
+                s[i] = z[i] * 1e5;
+            }
+            s[X_V] = c.dcv.spool_reference(u);
+            s[U_CBV] = c.cbv.holding_opening(s[P3], s[P4], c.supply.p_t);
+            s
+        };
+        let residual = |z: &SVector<f64, 5>| {
+            let s = state_of(z);
+            let e = c.evaluate(&s, u, x, z[4] * 1e-3);
+            let mut r = SVector::<f64, 5>::zeros();
+            for i in 0..4 {
+                r[i] = e.dx[i] * volumes[i] / c.fluid.beta / LPM;
+            }
+            r[4] = (e.force - f_load) * 1e-3;
+            r
+        };
+        // initial guess: ideal compensated flow through the spool, orifice laws inverted
+        let v = 1.017 * u * c.dcv.q_rated / if u > 0.0 { a } else { b };
+        let f_fr = (v.signum()) * (a * c.friction.p_static + c.friction.c_p_bak * f_load);
+        let mut z = if u > 0.0 {
+            let p4 = (b * v / k1u).powi(2);
+            let p3 = (f_load + f_fr + p4 * b) / a;
+            let p2 = p3 + c.cbv.p_cv + bar(0.1);
+            SVector::<f64, 5>::new(
+                (p2 + bar(7.95)) / 1e5,
+                p2 / 1e5,
+                p3 / 1e5,
+                p4 / 1e5,
+                v * 1e3,
+            )
+        } else {
+            let p2 = (a * v / k1u).powi(2);
+            let u_cbv = (a * v).abs() / (c.cbv.k2() * bar(100.0).sqrt());
+            // mu_p p4 + p3 = p_set + p_fo u_cbv and p3 A - p4 B = F + F_fr
+            let rhs = c.cbv.p_set + c.cbv.p_fo_cbv * u_cbv;
+            let p4 = (rhs * a - f_load - f_fr) / (c.cbv.mu_p * a + b);
+            let p3 = rhs - c.cbv.mu_p * p4;
+            SVector::<f64, 5>::new(
+                (p4 + bar(7.95)) / 1e5,
+                p2 / 1e5,
+                p3 / 1e5,
+                p4 / 1e5,
+                v * 1e3,
+            )
+        };
+        let mut r = residual(&z);
+        for _ in 0..100 {
+            if r.norm() < 1e-10 {
+                return (state_of(&z), z[4] * 1e-3);
+            }
+            let mut j = SMatrix::<f64, 5, 5>::zeros();
+            for k in 0..5 {
+                let h = 1e-7 * z[k].abs().max(1e-3);
+                let mut zp = z;
+                zp[k] += h;
+                j.set_column(k, &((residual(&zp) - r) / h));
+            }
+            let dz = j.lu().solve(&(-r)).expect("singular Jacobian");
+            let mut step = 1.0;
+            loop {
+                let zn = z + dz * step;
+                let rn = residual(&zn);
+                if rn.norm() < r.norm() || step < 1e-6 {
+                    z = zn;
+                    r = rn;
+                    break;
+                }
+                step *= 0.5;
+            }
+        }
+        panic!("steady motion did not converge for u = {u}, F = {f_load}: {z:?}, {r:?}");
+    }
+
+    /// Load independence of the pressure-compensated flow in the complete circuit (with CBV,
+    /// leakage and friction): lifting (u > 0, flow into port A) and lowering through the CBV
+    /// (u < 0, flow into port B) at several loads. Expected: Q = u * 25 l/min times
+    /// `sqrt(dp_dcv / 7.72 bar)`, where the compensator keeps dp_dcv within its spring band
+    /// [7, 8] bar; the loads vary dp_dcv by less than p_fc * u_pcv <= 0.1 bar (u_pcv <= 0.1 when
+    /// the PCV drops >= 40 bar at <= 25.5 l/min), i.e. < 0.7 % of the flow.
+    #[test]
+    fn compensated_flow_in_circuit() {
+        let c = Circuit::default();
+        let lo = (bar(7.0) / c.dcv.dp_rated).sqrt();
+        let hi = (bar(8.0) / c.dcv.dp_rated).sqrt();
+        for u in [0.05, 0.1, 0.5, -0.05, -0.1, -0.5] {
+            let mut ratios = Vec::new();
+            for f_load in [5e3, 15e3, 30e3, 45e3] {
+                let (s, v) = steady_motion(&c, u, f_load, 0.25);
+                let e = c.evaluate(&s, u, 0.25, v);
+                let q_dcv = if u > 0.0 { e.q[1] } else { e.q[3] };
+                let ratio = q_dcv / (u * lpm(25.0));
+                println!(
+                    "u {u:5}, F {:4.0} kN: Q = {:7.4} l/min (ratio {ratio:.5}), v = {:8.3} mm/s, \
+                     p1..p4 = {:6.1} {:6.1} {:6.1} {:6.1} bar, u_cbv = {:.4}",
+                    f_load / 1e3,
+                    q_dcv / LPM,
+                    v * 1e3,
+                    s[P1] / 1e5,
+                    s[P2] / 1e5,
+                    s[P3] / 1e5,
+                    s[P4] / 1e5,
+                    s[U_CBV]
+                );
+                assert!(ratio > lo && ratio < hi, "u {u}, F {f_load}: ratio {ratio}");
+                assert!(c.supply.p_s - s[P1] >= bar(40.0));
+                ratios.push(ratio);
+            }
+            let spread = ratios.iter().cloned().fold(f64::MIN, f64::max)
+                - ratios.iter().cloned().fold(f64::MAX, f64::min);
+            assert!(spread < 0.007, "u {u}: load dependence {spread}");
+        }
+    }
+
+    /// Strong suction on the piston side (spool closed, CBV closed, rod pulled out fast):
+    /// near absolute zero the pressure rate is proportional to the absolute pressure, so the
+    /// pressure decays towards vacuum without reaching it; every output stays finite for
+    /// states far outside the physical range.
+    #[test]
+    fn suction_and_robustness() {
+        let c = Circuit::default();
+        let mut s = c.equilibrium(0.0).unwrap();
+        let (x, v) = (0.25, 0.5);
+        let v3 = c.lines.v_l3 + c.cylinder.volume_a(x);
+        for p_abs in [1e3, 10.0, 1.0, 0.1] {
+            s[P3] = -P_ATM + p_abs;
+            let e = c.evaluate(&s, 0.0, x, v);
+            assert!(e.dx[P3] < 0.0);
+            // beta_e <= p_abs (1 + p_abs / a), a = x0 P_ATM, so |dp/dt| <= beta_e A v / V -> 0
+            // with p_abs (1e-3 margin: the hose volume at vacuum is 1e-4 smaller than at 0 bar)
+            let beta_bound = p_abs * (1.0 + p_abs / (c.fluid.air_fraction * P_ATM));
+            let bound = 1.001 * beta_bound * c.cylinder.area_a() * v / v3;
+            assert!(-e.dx[P3] <= bound, "p_abs {p_abs}: {}", e.dx[P3]);
+        }
+        for p in [-1e7, -P_ATM, 0.0, 1e9] {
+            for xv in [-1.0, 0.0, 1.0] {
+                for (x, v) in [(-1.0, -10.0), (0.25, 0.0), (2.0, 10.0)] {
+                    let s = [p, p, p, p, xv, 2.0];
+                    for u_ref in [-5.0, 0.0, 5.0] {
+                        let e = c.evaluate(&s, u_ref, x, v);
+                        assert!(e.dx.iter().all(|d| d.is_finite()), "{s:?} {x} {v}");
+                        assert!(e.force.is_finite() && e.q.iter().all(|q| q.is_finite()));
+                    }
+                }
+            }
+        }
     }
 }

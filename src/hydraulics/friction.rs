@@ -22,7 +22,11 @@ pub enum FrictionModel {
 
 impl FrictionModel {
     /// All models in the order of their index (the value of the parameter `friction.model`).
-    pub const ALL: [FrictionModel; 3] = [FrictionModel::Bak, FrictionModel::Ottestad, FrictionModel::Fitted];
+    pub const ALL: [FrictionModel; 3] = [
+        FrictionModel::Bak,
+        FrictionModel::Ottestad,
+        FrictionModel::Fitted,
+    ];
 
     /// The model with index `i` (0 Bak, 1 Ottestad, 2 fitted), `None` otherwise.
     pub fn from_index(i: usize) -> Option<Self> {
@@ -80,12 +84,15 @@ impl Friction {
         match self.model {
             FrictionModel::Bak => {
                 (v / self.v_s).tanh()
-                    * (cyl.area_a() * self.p_static + self.c_p_bak * cyl.pressure_force(p3, p4).abs())
+                    * (cyl.area_a() * self.p_static
+                        + self.c_p_bak * cyl.pressure_force(p3, p4).abs())
             }
             FrictionModel::Ottestad => {
                 (v / self.v_s).tanh() * (self.stribeck_viscous(v) + self.c_p * (p4 - p3).abs())
             }
-            FrictionModel::Fitted => (self.c_tan * v).tanh() * (self.stribeck_viscous(v) + x / self.c_l),
+            FrictionModel::Fitted => {
+                (self.c_tan * v).tanh() * (self.stribeck_viscous(v) + x / self.c_l)
+            }
         }
     }
 
@@ -105,7 +112,13 @@ mod tests {
 
     fn with(model: FrictionModel) -> (Friction, Cylinder) {
         let c = Circuit::default();
-        (Friction { model, ..c.friction }, c.cylinder)
+        (
+            Friction {
+                model,
+                ..c.friction
+            },
+            c.cylinder,
+        )
     }
 
     /// Continuity and smoothness at v = 0 for every model: zero at rest, odd, and the
@@ -126,7 +139,10 @@ mod tests {
             for i in -100..=100 {
                 let v = i as f64 * 1e-5;
                 let fv = f.force(&cyl, v, x, p3, p4);
-                assert!(fv.is_finite() && fv * v >= 0.0, "{m:?} does not oppose motion");
+                assert!(
+                    fv.is_finite() && fv * v >= 0.0,
+                    "{m:?} does not oppose motion"
+                );
             }
         }
     }

@@ -188,8 +188,20 @@ impl Default for Circuit {
     fn default() -> Self {
         let mut c = Circuit {
             supply: Supply { p_s: 0.0, p_t: 0.0 },
-            pcv: Pcv { p_spring: 0.0, p_fc: 0.0, q_nom: 0.0, dp_nom: 0.0 },
-            dcv: Dcv { x_max: 0.0, x_db: 0.0, omega_v: 0.0, q_rated: 0.0, dp_rated: 0.0, dq_leak: 0.0 },
+            pcv: Pcv {
+                p_spring: 0.0,
+                p_fc: 0.0,
+                q_nom: 0.0,
+                dp_nom: 0.0,
+            },
+            dcv: Dcv {
+                x_max: 0.0,
+                x_db: 0.0,
+                omega_v: 0.0,
+                q_rated: 0.0,
+                dp_rated: 0.0,
+                dq_leak: 0.0,
+            },
             cbv: Cbv {
                 p_cv: 0.0,
                 p_fo_cv: 0.0,
@@ -223,8 +235,17 @@ impl Default for Circuit {
                 c_tan: 0.0,
                 c_l: 0.0,
             },
-            fluid: Fluid { beta: 0.0, air_fraction: 0.0 },
-            lines: Lines { v_l1: 0.0, v_l2: 0.0, v_l3: 0.0, v_l4: 0.0, c_hose: 0.0 },
+            fluid: Fluid {
+                beta: 0.0,
+                air_fraction: 0.0,
+            },
+            lines: Lines {
+                v_l1: 0.0,
+                v_l2: 0.0,
+                v_l3: 0.0,
+                v_l4: 0.0,
+                c_hose: 0.0,
+            },
             p_tr: 0.0,
         };
         for p in PARAMS {
@@ -237,12 +258,18 @@ impl Default for Circuit {
 impl Circuit {
     /// Value of the parameter `name` (SI), `None` if there is no such parameter.
     pub fn param(&self, name: &str) -> Option<f64> {
-        PARAMS.iter().find(|p| p.spec.name == name).map(|p| (p.get)(self))
+        PARAMS
+            .iter()
+            .find(|p| p.spec.name == name)
+            .map(|p| (p.get)(self))
     }
 
     /// Sets the parameter `name` to `value` (SI) after checking it against its range.
     pub fn set_param(&mut self, name: &str, value: f64) -> Result<(), ParamError> {
-        let p = PARAMS.iter().find(|p| p.spec.name == name).ok_or(ParamError::Unknown)?;
+        let p = PARAMS
+            .iter()
+            .find(|p| p.spec.name == name)
+            .ok_or(ParamError::Unknown)?;
         let (min, max) = (p.spec.min, p.spec.max);
         if !(min..=max).contains(&value) {
             return Err(ParamError::OutOfRange { min, max });
@@ -262,8 +289,16 @@ mod tests {
         let c = Circuit::default();
         for (i, p) in PARAMS.iter().enumerate() {
             let s = &p.spec;
-            assert!(PARAMS[..i].iter().all(|q| q.spec.name != s.name), "duplicate {}", s.name);
-            assert!(s.min <= s.default && s.default <= s.max, "{} default out of range", s.name);
+            assert!(
+                PARAMS[..i].iter().all(|q| q.spec.name != s.name),
+                "duplicate {}",
+                s.name
+            );
+            assert!(
+                s.min <= s.default && s.default <= s.max,
+                "{} default out of range",
+                s.name
+            );
             let u = unit(s.unit).unwrap_or_else(|| panic!("{}: unknown unit {}", s.name, s.unit));
             assert!(
                 s.display_unit.is_empty() || u.display.iter().any(|d| d.name == s.display_unit),
@@ -281,8 +316,14 @@ mod tests {
         assert_eq!(c.set_param("cbv.mu_p", 5.0), Ok(()));
         assert_eq!(c.cbv.mu_p, 5.0);
         assert_eq!(c.param("cbv.mu_p"), Some(5.0));
-        assert!(matches!(c.set_param("cbv.mu_p", 0.5), Err(ParamError::OutOfRange { .. })));
-        assert!(matches!(c.set_param("cbv.mu_p", f64::NAN), Err(ParamError::OutOfRange { .. })));
+        assert!(matches!(
+            c.set_param("cbv.mu_p", 0.5),
+            Err(ParamError::OutOfRange { .. })
+        ));
+        assert!(matches!(
+            c.set_param("cbv.mu_p", f64::NAN),
+            Err(ParamError::OutOfRange { .. })
+        ));
         assert_eq!(c.set_param("cbv.nope", 1.0), Err(ParamError::Unknown));
         assert_eq!(c.set_param("friction.model", 2.0), Ok(()));
         assert_eq!(c.friction.model, FrictionModel::Fitted);
