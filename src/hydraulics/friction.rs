@@ -43,9 +43,9 @@ impl FrictionModel {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Friction {
     pub model: FrictionModel,
-    /// Bak's force coefficient `C_p,Bak` (-), 2 % (2.2.3, proposed 2-3 % in [5]).
+    /// Bak's force coefficient `C_p,Bak` (-), 2 % (2.2.3, proposed 2-3 % by Bak, ref. 5).
     pub c_p_bak: f64,
-    /// Pressure to overcome static friction `p_static` (Pa), 1 bar (2.2.3, [5]).
+    /// Pressure to overcome static friction `p_static` (Pa), 1 bar (2.2.3, Bak, ref. 5).
     pub p_static: f64,
     /// Regularisation velocity `v_s` of Bak's and Ottestad's models (m/s): `sign(v)` is
     /// replaced by `tanh(v / v_s)`. The thesis gives none for these; 0.1 mm/s is the fitted
