@@ -1,0 +1,181 @@
+//! Cylinder friction, section 2.2.3 and 5.1.2: Bak's model (2.65, the thesis' choice for
+//! simulation), Ottestad et al. (2.63) and the fitted stroke-dependent model (5.4).
+//!
+//! [`Friction::force`] returns `F_fr` with the sign of the velocity; it is subtracted from the
+//! pressure force (eq. 2.68: `F1 - F2 - F_L - F_fr - G_rod = m a`). Every model is multiplied by
+//! a `tanh` of the velocity, so the force is smooth (C1) through `v = 0` and zero at rest.
+
+use super::cylinder::Cylinder;
+
+/// Which friction law [`Friction::force`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrictionModel {
+    /// Bak, eq. 2.65-2.67: `F_s + C_p,Bak |F1 - F2|` with `F_s = A p_static` (default; used in
+    /// all simulations of the thesis, 5.2).
+    Bak,
+    /// Ottestad, Nilsen & Hansen, eq. 2.63-2.64: Coulomb + Stribeck + viscous +
+    /// `C_p |p4 - p3|`.
+    Ottestad,
+    /// Fitted model of eq. 5.4 / Table 5.3 (Stribeck + viscous + stroke term `x_c / C_l`).
+    Fitted,
+}
+
+impl FrictionModel {
+    /// All models in the order of their index (the value of the parameter `friction.model`).
+    pub const ALL: [FrictionModel; 3] = [
+        FrictionModel::Bak,
+        FrictionModel::Ottestad,
+        FrictionModel::Fitted,
+    ];
+
+    /// The model with index `i` (0 Bak, 1 Ottestad, 2 fitted), `None` otherwise.
+    pub fn from_index(i: usize) -> Option<Self> {
+        Self::ALL.get(i).copied()
+    }
+
+    /// Index of the model in [`FrictionModel::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// Friction parameters (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Friction {
+    pub model: FrictionModel,
+    /// Bak's force coefficient `C_p,Bak` (-), 2 % (2.2.3, proposed 2-3 % by Bak, ref. 5).
+    pub c_p_bak: f64,
+    /// Pressure to overcome static friction `p_static` (Pa), 1 bar (2.2.3, Bak, ref. 5).
+    pub p_static: f64,
+    /// Regularisation velocity `v_s` of Bak's and Ottestad's models (m/s): `sign(v)` is
+    /// replaced by `tanh(v / v_s)`. The thesis gives none for these; 0.1 mm/s is the fitted
+    /// model's `1 / C_tan` (0.097 mm/s, Table 5.3), far below the 6 mm/s of a 5 % step.
+    pub v_s: f64,
+    /// Coulomb friction `F_c` (N), 273.99 N (Table 5.3).
+    pub f_c: f64,
+    /// Static friction `F_s` (N), 1155.43 N (Table 5.3).
+    pub f_s: f64,
+    /// Stribeck velocity `v_0` (m/s), 14.19 mm/s (Table 5.3).
+    pub v_0: f64,
+    /// Viscous coefficient `C_v` (N s/m), 4.06 N s/mm (Table 5.3).
+    pub c_v: f64,
+    /// Ottestad's pressure coefficient `C_p` (m^2). Not given in the thesis; the default
+    /// `0.02 A` makes it Bak's 2 % applied to the pressure difference on the piston area.
+    pub c_p: f64,
+    /// Hyperbolic tangent coefficient `C_tan` (s/m), 10.31 s/mm (Table 5.3).
+    pub c_tan: f64,
+    /// Cylinder stroke coefficient `C_l` (m/N), 34629 mm/N (Table 5.3).
+    pub c_l: f64,
+}
+
+impl Friction {
+    /// Friction force `F_fr` (N) with the sign of `v`, for rod velocity `v` (m/s), stroke `x`
+    /// (m) and chamber pressures `p3`, `p4` (Pa):
+    /// - Bak (2.65): `tanh(v / v_s) (A p_static + C_p,Bak |p3 A - p4 mu_c A|)`;
+    /// - Ottestad (2.63): `tanh(v / v_s) (F_c + (F_s - F_c) exp(-|v| / v_0) + C_v |v| +
+    ///   C_p |p4 - p3|)` (eq. 2.64 and 2.63 both take the absolute value; once is enough);
+    /// - fitted (5.4): `tanh(C_tan v) (F_c + (F_s - F_c) exp(-|v| / v_0) + C_v |v| + x / C_l)`
+    ///   with `x / C_l` evaluated in the units of Table 5.3 (mm over mm/N, equal to m over m/N).
+    ///
+    /// The thesis' 2.63 and 2.65 are magnitudes without a direction; the `tanh` factor gives
+    /// them the sign of `v` as 5.4 does. Because the bracket is bounded and `tanh(0) = 0`, the
+    /// product is C1 at `v = 0` although `|v|` is not.
+    pub fn force(&self, cyl: &Cylinder, v: f64, x: f64, p3: f64, p4: f64) -> f64 {
+        match self.model {
+            FrictionModel::Bak => {
+                (v / self.v_s).tanh()
+                    * (cyl.area_a() * self.p_static
+                        + self.c_p_bak * cyl.pressure_force(p3, p4).abs())
+            }
+            FrictionModel::Ottestad => {
+                (v / self.v_s).tanh() * (self.stribeck_viscous(v) + self.c_p * (p4 - p3).abs())
+            }
+            FrictionModel::Fitted => {
+                (self.c_tan * v).tanh() * (self.stribeck_viscous(v) + x / self.c_l)
+            }
+        }
+    }
+
+    /// Coulomb, Stribeck and viscous part shared by 2.63 and 5.4:
+    /// `F_c + (F_s - F_c) exp(-|v| / v_0) + C_v |v|`.
+    fn stribeck_viscous(&self, v: f64) -> f64 {
+        let s = v.abs();
+        self.f_c + (self.f_s - self.f_c) * (-s / self.v_0).exp() + self.c_v * s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hydraulics::circuit::Circuit;
+    use crate::units::{bar, mm};
+
+    fn with(model: FrictionModel) -> (Friction, Cylinder) {
+        let c = Circuit::default();
+        (
+            Friction {
+                model,
+                ..c.friction
+            },
+            c.cylinder,
+        )
+    }
+
+    /// Continuity and smoothness at v = 0 for every model: zero at rest, odd, and the
+    /// one-sided slopes agree.
+    #[test]
+    fn continuous_through_zero() {
+        for m in FrictionModel::ALL {
+            let (f, cyl) = with(m);
+            let (x, p3, p4) = (0.25, bar(80.0), bar(5.0));
+            assert_eq!(f.force(&cyl, 0.0, x, p3, p4), 0.0, "{m:?}");
+            let h = 1e-9;
+            let fp = f.force(&cyl, h, x, p3, p4);
+            let fm = f.force(&cyl, -h, x, p3, p4);
+            assert!((fp + fm).abs() < 1e-9 * fp.abs().max(1.0), "{m:?} not odd");
+            let slope_r = fp / h;
+            let slope_l = (f.force(&cyl, 2.0 * h, x, p3, p4) - fp) / h;
+            assert!((slope_l / slope_r - 1.0).abs() < 1e-3, "{m:?} slope jump");
+            for i in -100..=100 {
+                let v = i as f64 * 1e-5;
+                let fv = f.force(&cyl, v, x, p3, p4);
+                assert!(
+                    fv.is_finite() && fv * v >= 0.0,
+                    "{m:?} does not oppose motion"
+                );
+            }
+        }
+    }
+
+    /// Away from zero velocity the regularised laws equal the thesis formulas (tanh = 1 to
+    /// within 1e-12 at v >= 3 mm/s for v_s = 0.1 mm/s).
+    #[test]
+    fn thesis_formulas_at_speed() {
+        let (x, p3, p4, v) = (0.25, bar(80.0), bar(5.0), 0.02);
+        let (f, cyl) = with(FrictionModel::Bak);
+        let df = p3 * cyl.area_a() - p4 * cyl.mu_c() * cyl.area_a();
+        let bak = cyl.area_a() * bar(1.0) + 0.02 * df.abs();
+        assert!((f.force(&cyl, v, x, p3, p4) - bak).abs() < 1e-9 * bak);
+        assert!((f.force(&cyl, -v, x, p3, p4) + bak).abs() < 1e-9 * bak);
+
+        // Table 5.3 in its own units (N, mm/s, N s/mm, mm/N)
+        let (fc, fs, v0, cv, cl) = (273.99, 1155.43, 14.19, 4.06, 34629.0);
+        let v_mm = v / mm(1.0);
+        let strib = fc + (fs - fc) * (-v_mm / v0).exp() + cv * v_mm;
+        let (f, cyl) = with(FrictionModel::Fitted);
+        let fitted = (10.31 * v_mm).tanh() * (strib + 250.0 / cl);
+        assert!((f.force(&cyl, v, x, p3, p4) - fitted).abs() < 1e-9 * fitted);
+        let (f, cyl) = with(FrictionModel::Ottestad);
+        let ott = strib + f.c_p * (p4 - p3).abs();
+        assert!((f.force(&cyl, v, x, p3, p4) - ott).abs() < 1e-9 * ott);
+    }
+
+    #[test]
+    fn model_index_roundtrip() {
+        for (i, m) in FrictionModel::ALL.iter().enumerate() {
+            assert_eq!(FrictionModel::from_index(i), Some(*m));
+            assert_eq!(m.index(), i);
+        }
+        assert_eq!(FrictionModel::from_index(3), None);
+    }
+}
