@@ -45,8 +45,7 @@ impl Cbv {
     /// `u_cbv = (mu_p p4 + p3 - p_set - (1 + mu_p) p_T) / p_fo,cbv` (eq. 2.56), limited to
     /// [0, 1]; the input of the lag of eq. 2.57.
     pub fn holding_opening(&self, p3: f64, p4: f64, p_t: f64) -> f64 {
-        ((self.mu_p * p4 + p3 - self.p_set - (1.0 + self.mu_p) * p_t) / self.p_fo_cbv)
-            .clamp(0.0, 1.0)
+        ((self.mu_p * p4 + p3 - self.p_set - (1.0 + self.mu_p) * p_t) / self.p_fo_cbv).clamp(0.0, 1.0)
     }
 
     /// Rate of the load-holding valve opening, first-order lag
@@ -62,11 +61,7 @@ impl Cbv {
     /// load-holding valve), with the regularised root. Both branches vanish at `p2 = p3`, so
     /// the flow is continuous. `u_cbv` is clamped to [0, 1] against solver overshoot.
     pub fn flow(&self, u_cv: f64, u_cbv: f64, p2: f64, p3: f64, p_tr: f64) -> f64 {
-        let u = if p2 >= p3 {
-            u_cv
-        } else {
-            u_cbv.clamp(0.0, 1.0)
-        };
+        let u = if p2 >= p3 { u_cv } else { u_cbv.clamp(0.0, 1.0) };
         orifice::flow(self.k2(), u, p2 - p3, p_tr)
     }
 }
@@ -88,10 +83,7 @@ mod tests {
         // free flow through the check valve
         let p2 = p3 + bar(16.0);
         let q = cbv.flow(cbv.check_opening(p2, p3), 0.0, p2, p3, p_tr);
-        assert!(
-            (q / lpm(60.0) - 1.0).abs() < 1e-12,
-            "free flow at 16 bar: {q}"
-        );
+        assert!((q / lpm(60.0) - 1.0).abs() < 1e-12, "free flow at 16 bar: {q}");
         for dp in [0.0, 1.0, 2.0, 2.8] {
             let p2 = p3 + bar(dp);
             assert_eq!(cbv.flow(cbv.check_opening(p2, p3), 0.0, p2, p3, p_tr), 0.0);
@@ -102,10 +94,7 @@ mod tests {
         // piloted open load-holding valve (u_cbv = 1), reverse direction
         let p2 = p3 - bar(16.0);
         let q = cbv.flow(0.0, 1.0, p2, p3, p_tr);
-        assert!(
-            (q / -lpm(60.0) - 1.0).abs() < 1e-12,
-            "piloted flow at 16 bar: {q}"
-        );
+        assert!((q / -lpm(60.0) - 1.0).abs() < 1e-12, "piloted flow at 16 bar: {q}");
         // the closed load-holding valve holds the load
         assert_eq!(cbv.flow(0.0, 0.0, p2, p3, p_tr), 0.0);
     }
@@ -120,10 +109,7 @@ mod tests {
         assert_eq!(cbv.holding_opening(p3_crack - bar(1.0), p4, 0.0), 0.0);
         let half = cbv.holding_opening(p3_crack + 0.5 * cbv.p_fo_cbv, p4, 0.0);
         assert!((half - 0.5).abs() < 1e-12);
-        assert_eq!(
-            cbv.holding_opening(p3_crack + 2.0 * cbv.p_fo_cbv, p4, 0.0),
-            1.0
-        );
+        assert_eq!(cbv.holding_opening(p3_crack + 2.0 * cbv.p_fo_cbv, p4, 0.0), 1.0);
         // eq. 2.57: initial rate omega_cbv * 0.5 = 31.5 1/s
         assert!((cbv.holding_rate(0.0, half) - 31.5).abs() < 1e-9);
     }

@@ -106,10 +106,7 @@ impl std::fmt::Display for EquilibriumError {
         match self {
             Self::TensileLoad => write!(f, "a tensile load cannot be held by the closed circuit"),
             Self::CbvOpens { max_load } => {
-                write!(
-                    f,
-                    "load exceeds what the closed CBV holds ({max_load:.0} N)"
-                )
+                write!(f, "load exceeds what the closed CBV holds ({max_load:.0} N)")
             }
         }
     }
@@ -150,13 +147,7 @@ impl Circuit {
         let v4 = (ln.v_l4 + cyl.volume_b(x)).max(ln.v_l4 + 0.1 * cyl.v_dead_b);
         let mut dx = [0.0; N_STATES];
         dx[P1] = fl.pressure_rate(p1, q1 - q_p - q_lp, ln.v_l1, 0.0, 0.0);
-        dx[P2] = fl.pressure_rate(
-            p2,
-            q2 - q3 - q_la,
-            ln.v_l2,
-            0.0,
-            ln.hose_compliance(ln.v_l2),
-        );
+        dx[P2] = fl.pressure_rate(p2, q2 - q3 - q_la, ln.v_l2, 0.0, ln.hose_compliance(ln.v_l2));
         dx[P3] = fl.pressure_rate(p3, q3, v3, a * v, ln.hose_compliance(ln.v_l3));
         dx[P4] = fl.pressure_rate(p4, -q4 - q_lb, v4, -b * v, ln.hose_compliance(ln.v_l4));
         dx[X_V] = self.dcv.spool_rate(x_v, u_ref);
@@ -205,9 +196,7 @@ impl Circuit {
         if self.cbv.holding_opening(p3, p4, p_t) > 0.0 {
             // largest p3 with a closed valve, eq. 2.56 with u_cbv = 0
             let p3_max = self.cbv.p_set + (1.0 + self.cbv.mu_p) * p_t - self.cbv.mu_p * p4;
-            return Err(EquilibriumError::CbvOpens {
-                max_load: p3_max * cyl.area_a() - p4 * cyl.area_b(),
-            });
+            return Err(EquilibriumError::CbvOpens { max_load: p3_max * cyl.area_a() - p4 * cyl.area_b() });
         }
         let p1 = bisect(
             |p1| {
@@ -270,12 +259,7 @@ mod tests {
         let cyl = &c.cylinder;
         let (a, b) = (cyl.area_a(), cyl.area_b());
         let k1u = c.dcv.k1() * u;
-        let volumes = [
-            c.lines.v_l1,
-            c.lines.v_l2,
-            c.lines.v_l3 + cyl.volume_a(x),
-            c.lines.v_l4 + cyl.volume_b(x),
-        ];
+        let volumes = [c.lines.v_l1, c.lines.v_l2, c.lines.v_l3 + cyl.volume_a(x), c.lines.v_l4 + cyl.volume_b(x)];
         let state_of = |z: &SVector<f64, 5>| {
             let mut s = [0.0; N_STATES];
             for i in 0..4 {
@@ -302,13 +286,7 @@ mod tests {
             let p4 = (b * v / k1u).powi(2);
             let p3 = (f_load + f_fr + p4 * b) / a;
             let p2 = p3 + c.cbv.p_cv + bar(0.1);
-            SVector::<f64, 5>::new(
-                (p2 + bar(7.95)) / 1e5,
-                p2 / 1e5,
-                p3 / 1e5,
-                p4 / 1e5,
-                v * 1e3,
-            )
+            SVector::<f64, 5>::new((p2 + bar(7.95)) / 1e5, p2 / 1e5, p3 / 1e5, p4 / 1e5, v * 1e3)
         } else {
             let p2 = (a * v / k1u).powi(2);
             let u_cbv = (a * v).abs() / (c.cbv.k2() * bar(100.0).sqrt());
@@ -316,13 +294,7 @@ mod tests {
             let rhs = c.cbv.p_set + c.cbv.p_fo_cbv * u_cbv;
             let p4 = (rhs * a - f_load - f_fr) / (c.cbv.mu_p * a + b);
             let p3 = rhs - c.cbv.mu_p * p4;
-            SVector::<f64, 5>::new(
-                (p4 + bar(7.95)) / 1e5,
-                p2 / 1e5,
-                p3 / 1e5,
-                p4 / 1e5,
-                v * 1e3,
-            )
+            SVector::<f64, 5>::new((p4 + bar(7.95)) / 1e5, p2 / 1e5, p3 / 1e5, p4 / 1e5, v * 1e3)
         };
         let mut r = residual(&z);
         for _ in 0..100 {
@@ -386,8 +358,8 @@ mod tests {
                 assert!(c.supply.p_s - s[P1] >= bar(40.0));
                 ratios.push(ratio);
             }
-            let spread = ratios.iter().cloned().fold(f64::MIN, f64::max)
-                - ratios.iter().cloned().fold(f64::MAX, f64::min);
+            let spread =
+                ratios.iter().cloned().fold(f64::MIN, f64::max) - ratios.iter().cloned().fold(f64::MAX, f64::min);
             assert!(spread < 0.007, "u {u}: load dependence {spread}");
         }
     }

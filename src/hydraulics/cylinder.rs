@@ -109,11 +109,7 @@ mod tests {
         assert!((c.area_a() / a - 1.0).abs() < 1e-12);
         // mu_c = 1 - (35/65)^2
         assert!((c.mu_c() - (1.0 - (35.0f64 / 65.0).powi(2))).abs() < 1e-12);
-        assert!(
-            (c.pressure_force(bar(100.0), bar(10.0)) - (bar(100.0) - bar(10.0) * c.mu_c()) * a)
-                .abs()
-                < 1e-6
-        );
+        assert!((c.pressure_force(bar(100.0), bar(10.0)) - (bar(100.0) - bar(10.0) * c.mu_c()) * a).abs() < 1e-6);
         assert!((c.volume_a(0.25) - (50e-6 + a * 0.25)).abs() < 1e-15);
         assert!((c.volume_b(c.stroke) - 50e-6).abs() < 1e-15);
     }

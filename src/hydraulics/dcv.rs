@@ -104,15 +104,9 @@ impl Dcv {
     pub fn flows(&self, u: f64, p1: f64, p2: f64, p4: f64, p_t: f64, p_tr: f64) -> [f64; 2] {
         let k1 = self.k1();
         if u >= 0.0 {
-            [
-                orifice::flow(k1, u, p1 - p2, p_tr),
-                orifice::flow(k1, u, p4 - p_t, p_tr),
-            ]
+            [orifice::flow(k1, u, p1 - p2, p_tr), orifice::flow(k1, u, p4 - p_t, p_tr)]
         } else {
-            [
-                orifice::flow(k1, u, p2 - p_t, p_tr),
-                orifice::flow(k1, u, p1 - p4, p_tr),
-            ]
+            [orifice::flow(k1, u, p2 - p_t, p_tr), orifice::flow(k1, u, p1 - p4, p_tr)]
         }
     }
 
@@ -163,10 +157,7 @@ mod tests {
     #[test]
     fn spool_dynamics_eq_2_45() {
         let d = Circuit::default().dcv;
-        assert!(
-            (d.omega_v - 33.3).abs() < 0.05,
-            "Table 6.1 gives 33.3 rad/s"
-        );
+        assert!((d.omega_v - 33.3).abs() < 0.05, "Table 6.1 gives 33.3 rad/s");
         let (mut x, dt) = (0.0, 1e-6);
         for _ in 0..30_000 {
             x += dt * d.spool_rate(x, 1.0);
@@ -209,11 +200,7 @@ mod tests {
     #[test]
     fn shorted_circuit_fig_2_11() {
         let c = Circuit::default();
-        assert!(
-            (c.dcv.k1() - 4.74e-7).abs() < 0.005e-7,
-            "K1 = {}",
-            c.dcv.k1()
-        );
+        assert!((c.dcv.k1() - 4.74e-7).abs() < 0.005e-7, "K1 = {}", c.dcv.k1());
 
         // Analytic: cubic of eq. 2.54 in bar, LHS (2 p_fc Q / K3)^2 with Q = 25 l/min.
         let (p_fc, p_pcv, p_s): (f64, f64, f64) = (1.0, 7.0, 20.0);
@@ -280,31 +267,22 @@ mod tests {
             let mut ratios = Vec::new();
             for p_load in loads {
                 // lifting: the load is on port A (p2); lowering: on port B (p4)
-                let (p2, p4) = if u > 0.0 {
-                    (p_load, 0.0)
-                } else {
-                    (0.0, p_load)
-                };
+                let (p2, p4) = if u > 0.0 { (p_load, 0.0) } else { (0.0, p_load) };
                 let p_x = Dcv::ls_pressure(u, p2, p4, 0.0);
                 let balance = |p1: f64| {
                     let [q2, q4] = dcv.flows(u, p1, p2, p4, 0.0, p_tr);
                     let q_spool = if u > 0.0 { q2 } else { -q4 };
-                    pcv.flow(pcv.opening(p1, p_x), p_s, p1, p_tr)
-                        - q_spool
-                        - dcv.leakages(p1, p2, p4, 0.0)[0]
+                    pcv.flow(pcv.opening(p1, p_x), p_s, p1, p_tr) - q_spool - dcv.leakages(p1, p2, p4, 0.0)[0]
                 };
                 let p1 = bisect(balance, p_load, p_s, 1e-6);
                 let [q2, q4] = dcv.flows(u, p1, p2, p4, 0.0, p_tr);
                 let q = if u > 0.0 { q2 } else { q4 };
                 let ratio = q / (u * dcv.q_rated);
-                assert!(
-                    ratio > lo && ratio < hi,
-                    "u = {u}, load {p_load}: ratio {ratio}"
-                );
+                assert!(ratio > lo && ratio < hi, "u = {u}, load {p_load}: ratio {ratio}");
                 ratios.push(ratio);
             }
-            let spread = ratios.iter().cloned().fold(f64::MIN, f64::max)
-                - ratios.iter().cloned().fold(f64::MAX, f64::min);
+            let spread =
+                ratios.iter().cloned().fold(f64::MIN, f64::max) - ratios.iter().cloned().fold(f64::MAX, f64::min);
             println!("u = {u}: Q / (u 25 l/min) = {ratios:.5?}");
             assert!(spread < hi - lo, "load dependence {spread}");
         }

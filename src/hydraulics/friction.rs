@@ -22,11 +22,7 @@ pub enum FrictionModel {
 
 impl FrictionModel {
     /// All models in the order of their index (the value of the parameter `friction.model`).
-    pub const ALL: [FrictionModel; 3] = [
-        FrictionModel::Bak,
-        FrictionModel::Ottestad,
-        FrictionModel::Fitted,
-    ];
+    pub const ALL: [FrictionModel; 3] = [FrictionModel::Bak, FrictionModel::Ottestad, FrictionModel::Fitted];
 
     /// The model with index `i` (0 Bak, 1 Ottestad, 2 fitted), `None` otherwise.
     pub fn from_index(i: usize) -> Option<Self> {
@@ -83,16 +79,10 @@ impl Friction {
     pub fn force(&self, cyl: &Cylinder, v: f64, x: f64, p3: f64, p4: f64) -> f64 {
         match self.model {
             FrictionModel::Bak => {
-                (v / self.v_s).tanh()
-                    * (cyl.area_a() * self.p_static
-                        + self.c_p_bak * cyl.pressure_force(p3, p4).abs())
+                (v / self.v_s).tanh() * (cyl.area_a() * self.p_static + self.c_p_bak * cyl.pressure_force(p3, p4).abs())
             }
-            FrictionModel::Ottestad => {
-                (v / self.v_s).tanh() * (self.stribeck_viscous(v) + self.c_p * (p4 - p3).abs())
-            }
-            FrictionModel::Fitted => {
-                (self.c_tan * v).tanh() * (self.stribeck_viscous(v) + x / self.c_l)
-            }
+            FrictionModel::Ottestad => (v / self.v_s).tanh() * (self.stribeck_viscous(v) + self.c_p * (p4 - p3).abs()),
+            FrictionModel::Fitted => (self.c_tan * v).tanh() * (self.stribeck_viscous(v) + x / self.c_l),
         }
     }
 
@@ -112,13 +102,7 @@ mod tests {
 
     fn with(model: FrictionModel) -> (Friction, Cylinder) {
         let c = Circuit::default();
-        (
-            Friction {
-                model,
-                ..c.friction
-            },
-            c.cylinder,
-        )
+        (Friction { model, ..c.friction }, c.cylinder)
     }
 
     /// Continuity and smoothness at v = 0 for every model: zero at rest, odd, and the
@@ -139,10 +123,7 @@ mod tests {
             for i in -100..=100 {
                 let v = i as f64 * 1e-5;
                 let fv = f.force(&cyl, v, x, p3, p4);
-                assert!(
-                    fv.is_finite() && fv * v >= 0.0,
-                    "{m:?} does not oppose motion"
-                );
+                assert!(fv.is_finite() && fv * v >= 0.0, "{m:?} does not oppose motion");
             }
         }
     }

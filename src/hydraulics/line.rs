@@ -91,20 +91,14 @@ mod tests {
     use crate::units::{bar, lpm, CM3};
 
     fn fluid() -> Fluid {
-        Fluid {
-            beta: 1300e6,
-            air_fraction: 1e-3,
-        }
+        Fluid { beta: 1300e6, air_fraction: 1e-3 }
     }
 
     #[test]
     fn bulk_modulus_limits() {
         let f = fluid();
         // Without air the law is the thesis' constant bulk modulus.
-        let oil = Fluid {
-            air_fraction: 0.0,
-            ..f
-        };
+        let oil = Fluid { air_fraction: 0.0, ..f };
         for p in [-0.5e5, 0.0, bar(50.0), bar(300.0)] {
             assert!((oil.bulk_modulus(p) / 1300e6 - 1.0).abs() < 1e-12);
         }
@@ -113,10 +107,7 @@ mod tests {
         let p = bar(100.0);
         let expected_rel = 1300e6 * 1e-3 * P_ATM / (p + P_ATM).powi(2);
         let rel = 1.0 - f.bulk_modulus(p) / 1300e6;
-        assert!(
-            (rel / expected_rel - 1.0).abs() < 0.02,
-            "{rel} vs {expected_rel}"
-        );
+        assert!((rel / expected_rel - 1.0).abs() < 0.02, "{rel} vs {expected_rel}");
         // Near absolute zero beta_e -> p_abs.
         let p_abs = 0.05;
         assert!((f.bulk_modulus(-P_ATM + p_abs) / p_abs - 1.0).abs() < 1e-3);
@@ -128,21 +119,14 @@ mod tests {
     #[test]
     fn mass_conservation_and_no_vacuum() {
         let f = fluid();
-        let lines = Lines {
-            v_l1: 0.0,
-            v_l2: 100.0 * CM3,
-            v_l3: 0.0,
-            v_l4: 0.0,
-            c_hose: 0.00065e-5,
-        };
+        let lines = Lines { v_l1: 0.0, v_l2: 100.0 * CM3, v_l3: 0.0, v_l4: 0.0, c_hose: 0.00065e-5 };
         let c_wall = lines.hose_compliance(lines.v_l2);
         let v0_dead = lines.v_l2;
         let area = 3.3e-3;
         // piston stroke x(t) = 0.05 sin(2 pi t); inflow: 20 l/min, then strong suction of
         // -40 l/min from t = 0.5 s (drains the volume to vacuum), then refill from t = 1.5 s.
         let x = |t: f64| 0.05 * (2.0 * std::f64::consts::PI * t).sin();
-        let xdot =
-            |t: f64| 0.05 * 2.0 * std::f64::consts::PI * (2.0 * std::f64::consts::PI * t).cos();
+        let xdot = |t: f64| 0.05 * 2.0 * std::f64::consts::PI * (2.0 * std::f64::consts::PI * t).cos();
         let q = |t: f64| {
             if t < 0.5 {
                 lpm(20.0)
@@ -180,9 +164,6 @@ mod tests {
         }
         // strong suction really reached near-vacuum, but never absolute zero
         assert!(p_min > -P_ATM, "p_min = {p_min}");
-        assert!(
-            p_min < -0.9 * P_ATM,
-            "suction too weak for the test: p_min = {p_min}"
-        );
+        assert!(p_min < -0.9 * P_ATM, "suction too weak for the test: p_min = {p_min}");
     }
 }

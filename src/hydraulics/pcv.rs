@@ -54,11 +54,7 @@ mod tests {
         let u = pcv.opening(0.0, 0.0);
         assert_eq!(u, 1.0);
         let q = pcv.flow(u, bar(6.0), 0.0, c.p_tr);
-        assert!(
-            (q / lpm(100.0) - 1.0).abs() < 1e-12,
-            "Q(6 bar) = {} l/min",
-            q / lpm(1.0)
-        );
+        assert!((q / lpm(100.0) - 1.0).abs() < 1e-12, "Q(6 bar) = {} l/min", q / lpm(1.0));
         let q = pcv.flow(u, bar(1.5), 0.0, c.p_tr);
         assert!((q / lpm(50.0) - 1.0).abs() < 1e-12);
     }

@@ -5,10 +5,7 @@
 /// the kinks of the clamped valve openings, where Newton's method can cycle.
 pub fn bisect(mut f: impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64, tol: f64) -> f64 {
     let f_lo = f(lo);
-    debug_assert!(
-        f_lo * f(hi) <= 0.0,
-        "bisect: root not bracketed in [{lo}, {hi}]"
-    );
+    debug_assert!(f_lo * f(hi) <= 0.0, "bisect: root not bracketed in [{lo}, {hi}]");
     let lo_negative = f_lo < 0.0;
     while (hi - lo).abs() > tol {
         let mid = 0.5 * (lo + hi);

@@ -49,12 +49,7 @@ impl Triangle {
         let [b1, b2, b3, b4, b5, b6, b7, b8] = p.b;
         let (ux, uy) = (p.l1 + b4 - b7, b5 + b6);
         let (lx, ly) = (p.l2 + b2 - b1, b8 - b3);
-        Self {
-            w1: ux.hypot(uy),
-            w2: lx.hypot(ly),
-            phi1: ly.atan2(lx),
-            phi2: uy.atan2(ux),
-        }
+        Self { w1: ux.hypot(uy), w2: lx.hypot(ly), phi1: ly.atan2(lx), phi2: uy.atan2(ux) }
     }
 
     /// Angle at A between A -> B and A -> C, eq. (2.3).
@@ -109,9 +104,7 @@ impl Body {
         Self {
             m_d,
             e_cm: (p.m_arm * arm + p.m_pl * payload) / m_d,
-            j_b: p.m_arm * p.l_arm * p.l_arm / 12.0
-                + p.m_arm * arm.norm_squared()
-                + p.m_pl * payload.norm_squared(),
+            j_b: p.m_arm * p.l_arm * p.l_arm / 12.0 + p.m_arm * arm.norm_squared() + p.m_pl * payload.norm_squared(),
         }
     }
 
@@ -199,16 +192,8 @@ impl BoomKinematics {
         phi_q
     }
 
-    fn solve(
-        &self,
-        q: &Vector3<f64>,
-        rhs: Vector3<f64>,
-        l_cyl: f64,
-    ) -> Result<Vector3<f64>, MechanicsError> {
-        self.jacobian(q)
-            .lu()
-            .solve(&rhs)
-            .ok_or(MechanicsError::SingularJacobian { l_cyl })
+    fn solve(&self, q: &Vector3<f64>, rhs: Vector3<f64>, l_cyl: f64) -> Result<Vector3<f64>, MechanicsError> {
+        self.jacobian(q).lu().solve(&rhs).ok_or(MechanicsError::SingularJacobian { l_cyl })
     }
 
     /// Solves the position constraints (2.11) for q by Newton-Raphson, starting from the boom
@@ -218,11 +203,7 @@ impl BoomKinematics {
     /// step after that is of order 1e-24, so the result is exact to rounding. The triangle has a
     /// mirror solution (C on the other side of A-B); a guess on the rig's side (e.g. theta2 = 0)
     /// finds the rig's configuration.
-    pub fn solve_position(
-        &self,
-        l_cyl: f64,
-        theta2_guess: f64,
-    ) -> Result<Vector3<f64>, MechanicsError> {
+    pub fn solve_position(&self, l_cyl: f64, theta2_guess: f64) -> Result<Vector3<f64>, MechanicsError> {
         const MAX_ITERATIONS: usize = 50;
         let r_d = self.point(theta2_guess, -self.s_db);
         let mut q = Vector3::new(r_d.x, r_d.y, theta2_guess);
@@ -237,12 +218,7 @@ impl BoomKinematics {
     }
 
     /// Velocity q_dot from the velocity constraints, eq. (2.13).
-    pub fn velocity(
-        &self,
-        q: &Vector3<f64>,
-        l_cyl: f64,
-        l_dot: f64,
-    ) -> Result<Vector3<f64>, MechanicsError> {
+    pub fn velocity(&self, q: &Vector3<f64>, l_cyl: f64, l_dot: f64) -> Result<Vector3<f64>, MechanicsError> {
         self.solve(q, Vector3::new(0.0, 0.0, 2.0 * l_cyl * l_dot), l_cyl)
     }
 
@@ -338,14 +314,8 @@ mod tests {
         let (qp, qm) = (k.q(l(h)), k.q(l(-h)));
         let fd_dot = (qp - qm) / (2.0 * h);
         let fd_ddot = (qp - 2.0 * q + qm) / (h * h);
-        assert!(
-            (q_dot - fd_dot).amax() < 1e-6 * q_dot.amax(),
-            "{q_dot} vs {fd_dot}"
-        );
-        assert!(
-            (q_ddot - fd_ddot).amax() < 1e-6 * q_ddot.amax(),
-            "{q_ddot} vs {fd_ddot}"
-        );
+        assert!((q_dot - fd_dot).amax() < 1e-6 * q_dot.amax(), "{q_dot} vs {fd_dot}");
+        assert!((q_ddot - fd_ddot).amax() < 1e-6 * q_ddot.amax(), "{q_ddot} vs {fd_ddot}");
         // The closed-form derivatives of theta2 give the same velocity.
         let (_, d1, _) = k.triangle().theta2_derivatives(l0);
         assert!((q_dot.z - d1 * v).abs() < 1e-12);

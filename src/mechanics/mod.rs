@@ -16,12 +16,7 @@ use std::fmt;
 pub enum MechanicsError {
     /// The triangle joint-B / lower pin A / upper pin C does not close for every cylinder length
     /// in `[l_min, l_max]`: it needs `|w1 - w2| < l_cyl < w1 + w2` (eq. 2.3).
-    TriangleOpen {
-        l_min: f64,
-        l_max: f64,
-        w1: f64,
-        w2: f64,
-    },
+    TriangleOpen { l_min: f64, l_max: f64, w1: f64, w2: f64 },
     /// Newton-Raphson on the position constraints (2.11) did not converge.
     NoConvergence { l_cyl: f64 },
     /// The constraint Jacobian of (2.13) is singular (cylinder axis through the joint).
@@ -31,12 +26,7 @@ pub enum MechanicsError {
 impl fmt::Display for MechanicsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            Self::TriangleOpen {
-                l_min,
-                l_max,
-                w1,
-                w2,
-            } => write!(
+            Self::TriangleOpen { l_min, l_max, w1, w2 } => write!(
                 f,
                 "cylinder lengths {l_min} m..{l_max} m do not close the triangle with w1 = {w1} m \
                  and w2 = {w2} m (need {} m < l_cyl < {} m)",
@@ -44,16 +34,10 @@ impl fmt::Display for MechanicsError {
                 w1 + w2
             ),
             Self::NoConvergence { l_cyl } => {
-                write!(
-                    f,
-                    "position constraints (2.11) did not converge at l_cyl = {l_cyl} m"
-                )
+                write!(f, "position constraints (2.11) did not converge at l_cyl = {l_cyl} m")
             }
             Self::SingularJacobian { l_cyl } => {
-                write!(
-                    f,
-                    "singular constraint Jacobian (2.13) at l_cyl = {l_cyl} m"
-                )
+                write!(f, "singular constraint Jacobian (2.13) at l_cyl = {l_cyl} m")
             }
         }
     }

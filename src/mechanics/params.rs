@@ -35,16 +35,7 @@ const fn spec(
     description: &'static str,
     source: &'static str,
 ) -> ParamSpec {
-    ParamSpec {
-        name,
-        default,
-        unit,
-        display_unit,
-        min,
-        max,
-        description,
-        source,
-    }
+    ParamSpec { name, default, unit, display_unit, min, max, description, source }
 }
 
 const NOMENCLATURE: &str = "thesis nomenclature, list of parameters; Fig. 2.1";
@@ -152,11 +143,7 @@ impl Default for BoomParams {
     /// The defaults of [`SPECS`]: chapter 3.1 geometry (l1 = 0.6 m, l2 = 0.3 m) and payload.
     fn default() -> Self {
         Self::from_lookup(|name| {
-            SPECS
-                .iter()
-                .find(|s| s.name == name)
-                .unwrap_or_else(|| panic!("no ParamSpec named {name}"))
-                .default
+            SPECS.iter().find(|s| s.name == name).unwrap_or_else(|| panic!("no ParamSpec named {name}")).default
         })
     }
 }
@@ -189,11 +176,7 @@ mod tests {
                 "{}: display unit",
                 s.name
             );
-            assert!(
-                s.min <= s.default && s.default <= s.max,
-                "{}: default in range",
-                s.name
-            );
+            assert!(s.min <= s.default && s.default <= s.max, "{}: default in range", s.name);
         }
     }
 }

@@ -83,12 +83,7 @@ impl RigidBoom {
         let t = kin.triangle();
         let (l_min, l_max) = (p.l_retracted, p.l_retracted + stroke);
         if !((t.w1 - t.w2).abs() < l_min && l_max < t.w1 + t.w2) {
-            return Err(MechanicsError::TriangleOpen {
-                l_min,
-                l_max,
-                w1: t.w1,
-                w2: t.w2,
-            });
+            return Err(MechanicsError::TriangleOpen { l_min, l_max, w1: t.w1, w2: t.w2 });
         }
         let b7 = p.b[6];
         Ok(Self {
@@ -118,8 +113,7 @@ impl RigidBoom {
         Eom {
             m_eff: body.j_b * d1 * d1 + self.m_rod,
             c_v2: body.j_b * d1 * d2,
-            f_gravity: self.g
-                * (body.m_d * body.lever(theta2) * d1 + self.m_rod * t.theta1(l).sin()),
+            f_gravity: self.g * (body.m_d * body.lever(theta2) * d1 + self.m_rod * t.theta1(l).sin()),
         }
     }
 
@@ -179,20 +173,9 @@ impl RigidBoom {
             0.0, 0.0, t.w1 * (theta1 - theta2 + t.phi2).sin(),
         );
         let m = Matrix3::from_diagonal(&Vector3::new(body.m_d, body.m_d, body.j_b));
-        let b = Vector3::new(
-            0.0,
-            body.m_d * self.g,
-            body.lever(theta2) * body.m_d * self.g,
-        );
-        let f = r
-            .lu()
-            .solve(&(m * q_ddot + b))
-            .ok_or(MechanicsError::SingularJacobian { l_cyl: l })?;
-        Ok(Reactions {
-            r_bx: f.x,
-            r_by: f.y,
-            f_cyl: f.z,
-        })
+        let b = Vector3::new(0.0, body.m_d * self.g, body.lever(theta2) * body.m_d * self.g);
+        let f = r.lu().solve(&(m * q_ddot + b)).ok_or(MechanicsError::SingularJacobian { l_cyl: l })?;
+        Ok(Reactions { r_bx: f.x, r_by: f.y, f_cyl: f.z })
     }
 }
 
@@ -222,23 +205,17 @@ mod tests {
         let p = BoomParams::default();
         let body = *boom.kinematics().body();
         let (t_end, h) = (2.0, 1e-3);
-        let force = |t: f64, x: f64| {
-            boom.static_force(x) + 5000.0 * (std::f64::consts::PI * t / t_end).sin()
-        };
+        let force = |t: f64, x: f64| boom.static_force(x) + 5000.0 * (std::f64::consts::PI * t / t_end).sin();
         let rhs = |t: f64, y: Vector3<f64>| {
             let f = force(t, y.x);
-            let rod_weight =
-                p.m_rod * p.g * boom.kinematics().triangle().theta1(boom.l_cyl(y.x)).sin();
+            let rod_weight = p.m_rod * p.g * boom.kinematics().triangle().theta1(boom.l_cyl(y.x)).sin();
             Vector3::new(y.y, boom.acceleration(y.x, y.y, f), (f - rod_weight) * y.y)
         };
         let energy = |y: &Vector3<f64>| {
             let l = boom.l_cyl(y.x);
             let q = boom.kinematics().solve_position(l, 0.0).unwrap();
             let q_dot = boom.kinematics().velocity(&q, l, y.y).unwrap();
-            (
-                0.5 * body.j_b * q_dot.z * q_dot.z + 0.5 * p.m_rod * y.y * y.y,
-                body.m_d * p.g * q.y,
-            )
+            (0.5 * body.j_b * q_dot.z * q_dot.z + 0.5 * p.m_rod * y.y * y.y, body.m_d * p.g * q.y)
         };
         let y0 = Vector3::new(0.05, 0.0, 0.0);
         let mut y = y0;
@@ -260,10 +237,7 @@ mod tests {
             y.x * 1e3,
             y.y
         );
-        assert!(
-            y.x > 0.3 && dt > 100.0,
-            "the trajectory must exercise the stroke and the velocity term"
-        );
+        assert!(y.x > 0.3 && dt > 100.0, "the trajectory must exercise the stroke and the velocity term");
         assert!(error < 1e-9, "{work} vs {}", dt + dv);
     }
 
@@ -275,13 +249,8 @@ mod tests {
     fn equation_of_motion_matches_kinetics() {
         let boom = boom();
         let p = BoomParams::default();
-        for (x, v, f) in [
-            (0.0, 0.0, 30e3),
-            (0.1, 0.2, 20e3),
-            (0.25, -0.3, 24e3),
-            (0.48, 0.5, 15e3),
-            (0.5, -0.1, 28e3),
-        ] {
+        for (x, v, f) in [(0.0, 0.0, 30e3), (0.1, 0.2, 20e3), (0.25, -0.3, 24e3), (0.48, 0.5, 15e3), (0.5, -0.1, 28e3)]
+        {
             let a = boom.acceleration(x, v, f);
             let r = boom.reactions(x, v, a).unwrap();
             let theta1 = boom.kinematics().triangle().theta1(boom.l_cyl(x));
@@ -341,10 +310,7 @@ mod tests {
         let expected = moment / arm + p.m_rod * p.g * cy / l;
         let boom = boom();
         let x = l - p.l_retracted;
-        println!(
-            "horizontal boom: l_cyl = {l:.5} m, stroke {:.1} mm, F = {expected:.1} N",
-            x * 1e3
-        );
+        println!("horizontal boom: l_cyl = {l:.5} m, stroke {:.1} mm, F = {expected:.1} N", x * 1e3);
         assert!((boom.static_force(x) - expected).abs() < 1e-12 * expected);
         assert!(boom.acceleration(x, 0.0, expected).abs() < 1e-12);
     }
@@ -357,11 +323,7 @@ mod tests {
     fn report_operating_range() {
         let boom = boom();
         let (lo, hi) = (boom.state(0.0, 0.0).theta2, boom.state(STROKE, 0.0).theta2);
-        println!(
-            "theta2 over the stroke: {:.2} deg .. {:.2} deg",
-            lo / DEG,
-            hi / DEG
-        );
+        println!("theta2 over the stroke: {:.2} deg .. {:.2} deg", lo / DEG, hi / DEG);
         assert!(lo < 0.0 && hi > 0.0);
         for x in [0.0, mm(250.0), mm(480.0)] {
             let s = boom.state(x, 0.0);
@@ -387,21 +349,9 @@ mod tests {
 
     #[test]
     fn open_triangle_is_rejected() {
-        let p = BoomParams {
-            l_retracted: 0.3,
-            ..BoomParams::default()
-        };
-        assert!(matches!(
-            RigidBoom::new(&p, STROKE),
-            Err(MechanicsError::TriangleOpen { .. })
-        ));
-        let p = BoomParams {
-            l_retracted: 1.5,
-            ..BoomParams::default()
-        };
-        assert!(matches!(
-            RigidBoom::new(&p, STROKE),
-            Err(MechanicsError::TriangleOpen { .. })
-        ));
+        let p = BoomParams { l_retracted: 0.3, ..BoomParams::default() };
+        assert!(matches!(RigidBoom::new(&p, STROKE), Err(MechanicsError::TriangleOpen { .. })));
+        let p = BoomParams { l_retracted: 1.5, ..BoomParams::default() };
+        assert!(matches!(RigidBoom::new(&p, STROKE), Err(MechanicsError::TriangleOpen { .. })));
     }
 }
