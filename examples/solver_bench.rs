@@ -106,8 +106,6 @@ struct Problem {
 }
 
 fn problems() -> Vec<Problem> {
-    let h = Hydraulic;
-    let p0 = 1.1e7;
     vec![
         Problem {
             name: "robertson",
@@ -125,11 +123,8 @@ fn problems() -> Vec<Problem> {
         },
         Problem {
             name: "hydraulic",
-            x0: {
-                let _ = &h;
-                vec![p0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
-            },
-            sys: Box::new(h),
+            sys: Box::new(Hydraulic),
+            x0: vec![1.1e7, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             t_out: (1..=1000).map(|k| 1e-3 * k as f64).collect(),
             nominal: vec![1e7, 0.1, 0.1, 1.0, 1e-3, 0.1, 1e-3, 0.1, 1e-3, 0.1],
         },
@@ -147,6 +142,7 @@ struct Work {
 }
 
 type Trajectory = Vec<Vec<f64>>;
+type Runner<'a> = Box<dyn Fn() -> Result<(Trajectory, Work), String> + 'a>;
 
 fn run_radau(p: &Problem, rtol: f64) -> Result<(Trajectory, Work), String> {
     let n = p.x0.len();
@@ -284,7 +280,7 @@ fn main() {
             .unwrap_or(f64::NAN);
         println!("{:<11} ref check: diffsol BDF at rtol 1e-10 vs reference: {check:.2} tol units", p.name);
         for &rtol in &rtols {
-            let methods: [(&str, Box<dyn Fn() -> Result<(Trajectory, Work), String>>); 4] = [
+            let methods: [(&str, Runner); 4] = [
                 ("radau5 (ours)", Box::new(|| run_radau(&p, rtol))),
                 ("diffsol bdf", Box::new(|| run_diffsol(&p, rtol, Diffsol::Bdf))),
                 ("diffsol esdirk34", Box::new(|| run_diffsol(&p, rtol, Diffsol::Esdirk34))),

@@ -53,8 +53,8 @@ pub(crate) fn solve<T: ComplexField<RealField = f64> + Copy>(
     b: &mut [T],
 ) {
     let n = lu.nrows();
-    for k in 0..n {
-        b.swap(k, piv[k]);
+    for (k, &p) in piv.iter().enumerate() {
+        b.swap(k, p);
     }
     for j in 0..n {
         let bj = b[j];

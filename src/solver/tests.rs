@@ -142,29 +142,33 @@ fn oil_err(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 }
 
 /// The FMU calls `integrate` once per communication step. Communication steps 1e-5, 1e-3 and
-/// 0.1 s must give the same state at t = 0.2 s as a tight reference (rtol 1e-10) within the
-/// tolerance: the weighted error (1 = exactly the requested tolerance) must stay below 10,
-/// the usual margin between local tolerance and global error of an error-controlled method.
+/// 0.1 s must give the state at t = 0.2 s of a tight reference (rtol 1e-10) within the
+/// tolerance. The weighted error (1 = exactly the requested tolerance) must stay below 3: the
+/// step-size controller bounds the *local* error by 1 unit, and over ~30 periods of the lightly
+/// damped (0.5 %) 150 Hz oil-column mode the global error accumulates to a few units (measured
+/// 0.14, 0.34 and 1.09 for the three communication steps).
 #[test]
 fn communication_step_does_not_change_trajectory() {
     let (reference, _) = run_oil(1e-10, 0.2, 0.2);
     for comm in [1e-5, 1e-3, 0.1] {
         let (x, st) = run_oil(1e-6, comm, 0.2);
         let e = oil_err(&x, &reference);
-        assert!(e < 10.0, "comm step {comm}: weighted error {e}, {x:?} vs {reference:?}, {st:?}");
+        assert!(e < 3.0, "comm step {comm}: weighted error {e}, {x:?} vs {reference:?}, {st:?}");
     }
 }
 
 /// Global error shrinks with rtol: on the oil column, each 100x tighter rtol must cut the
-/// error (measured in units of the 1e-6 tolerance) by at least 10x, and rtol = 1e-6 must be
-/// within 10 tolerance units of the reference (see above for the margin).
+/// error (measured in units of the 1e-6 tolerance) by at least 10x (proportionality to rtol
+/// would be 100x; the order-5 result is more accurate than the order-3 estimate that controls
+/// it, so the ratio varies; measured 112x and 270x), and rtol = 1e-6 must be within 3 tolerance
+/// units of the reference (margin as in the previous test).
 #[test]
 fn error_scales_with_tolerance() {
     let (reference, _) = run_oil(1e-11, 0.2, 0.2);
     let errs: Vec<f64> =
         [1e-4, 1e-6, 1e-8].iter().map(|&r| oil_err(&run_oil(r, 0.2, 0.2).0, &reference)).collect();
     assert!(errs[0] > 10.0 * errs[1] && errs[1] > 10.0 * errs[2], "{errs:?}");
-    assert!(errs[1] < 10.0, "{errs:?}");
+    assert!(errs[1] < 3.0, "{errs:?}");
 }
 
 /// `rhs` turns NaN after t = 0.5 (as a model leaving its valid range would). The solver must
