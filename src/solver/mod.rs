@@ -9,7 +9,7 @@ use nalgebra::DMatrix;
 use std::fmt;
 
 mod lu;
-mod radau5;
+pub mod radau5;
 #[cfg(test)]
 mod tests;
 
@@ -87,7 +87,7 @@ pub enum SolveErrorKind {
 pub struct SolveError {
     /// What went wrong.
     pub kind: SolveErrorKind,
-    /// Time of the last accepted state (the state left in `x`).
+    /// Time of the last accepted state (the state left in `x`); NaN for errors of the setters.
     pub t: f64,
     /// Step size of the last attempt.
     pub h: f64,
@@ -107,7 +107,11 @@ impl fmt::Display for FailureCause {
 
 impl fmt::Display for SolveError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "integration stopped at t = {:e} s (step {:e} s): ", self.t, self.h)?;
+        write!(
+            f,
+            "integration stopped at t = {:e} s (step {:e} s): ",
+            self.t, self.h
+        )?;
         match &self.kind {
             SolveErrorKind::StepSizeTooSmall(c) => write!(f, "step size below minimum ({c})"),
             SolveErrorKind::TooManyRejections(c) => write!(f, "too many rejected steps ({c})"),
