@@ -6,7 +6,7 @@
 //! `Z = (z1, z2, z3)`, `z_i = y(t + c_i h) - y(t)`, solve `Z = h (A ⊗ I) F(Z)`. The simplified
 //! Newton iteration uses the transformation `T⁻¹ A⁻¹ T = diag(γ, [[α, -β], [β, α]])`, so each
 //! iteration solves one real system with `γ/h·I - J` and one complex system with
-//! `(α + iβ)/h·I - J`; both are LU-factorised once per step size (see [`super::lu`]).
+//! `(α + iβ)/h·I - J`; both are LU-factorised (partial pivoting, `lu.rs`) once per step size.
 //! Convergence is judged by the contraction rate `θ` (stop when `θ/(1-θ)·‖ΔZ‖ ≤ κ`,
 //! `κ = max(10ε/rtol, min(0.03, √rtol))`; abort and reduce `h` if `θ ≥ 0.99` or the predicted
 //! error after 7 iterations is too large). Starting values extrapolate the collocation polynomial
