@@ -192,8 +192,7 @@ fn run_radau(p: &Problem, rtol: f64) -> Result<(Trajectory, Work), String> {
     let mut t = 0.0;
     let mut out = Vec::with_capacity(p.t_out.len());
     for &t1 in &p.t_out {
-        s.integrate(p.sys.as_ref(), t, &mut x, t1)
-            .map_err(|e| e.to_string())?;
+        s.integrate(p.sys.as_ref(), t, &mut x, t1).map_err(|e| e.to_string())?;
         out.push(x.clone());
         t = t1;
     }
@@ -236,43 +235,15 @@ impl Rodas4 {
     const A: [[f64; 4]; 4] = [
         [1.544, 0.0, 0.0, 0.0],
         [0.9466785280815826, 0.2557011698983284, 0.0, 0.0],
-        [
-            3.314825187068521,
-            2.896124015972201,
-            0.9986419139977817,
-            0.0,
-        ],
-        [
-            1.221224509226641,
-            6.019134481288629,
-            12.53708332932087,
-            -0.687886036105895,
-        ],
+        [3.314825187068521, 2.896124015972201, 0.9986419139977817, 0.0],
+        [1.221224509226641, 6.019134481288629, 12.53708332932087, -0.687886036105895],
     ];
     const CC: [[f64; 5]; 5] = [
         [-5.6688, 0.0, 0.0, 0.0, 0.0],
         [-2.430093356833875, -0.2063599157091915, 0.0, 0.0, 0.0],
-        [
-            -0.1073529058151375,
-            -9.594562251023355,
-            -20.47028614809616,
-            0.0,
-            0.0,
-        ],
-        [
-            7.496443313967647,
-            -10.24680431464352,
-            -33.99990352819905,
-            11.7089089320616,
-            0.0,
-        ],
-        [
-            8.083246795921522,
-            -7.981132988064893,
-            -31.52159432874371,
-            16.31930543123136,
-            -6.058818238834054,
-        ],
+        [-0.1073529058151375, -9.594562251023355, -20.47028614809616, 0.0, 0.0],
+        [7.496443313967647, -10.24680431464352, -33.99990352819905, 11.7089089320616, 0.0],
+        [8.083246795921522, -7.981132988064893, -31.52159432874371, 16.31930543123136, -6.058818238834054],
     ];
 
     fn new(n: usize, rtol: f64, atol: Vec<f64>) -> Self {
@@ -294,13 +265,7 @@ impl Rodas4 {
         }
     }
 
-    fn integrate(
-        &mut self,
-        sys: &dyn OdeSystem,
-        t0: f64,
-        x: &mut [f64],
-        t_end: f64,
-    ) -> Result<(), String> {
+    fn integrate(&mut self, sys: &dyn OdeSystem, t0: f64, x: &mut [f64], t_end: f64) -> Result<(), String> {
         let n = self.n;
         let plan = |t: f64, h: f64| {
             let rest = t_end - t;
@@ -346,11 +311,7 @@ impl Rodas4 {
                 return Err(format!("step size too small at t = {t}"));
             }
             let fac = 1.0 / (h * Self::GAMMA);
-            let e = DMatrix::from_fn(
-                n,
-                n,
-                |i, j| if i == j { fac } else { 0.0 } - self.jac[(i, j)],
-            );
+            let e = DMatrix::from_fn(n, n, |i, j| if i == j { fac } else { 0.0 } - self.jac[(i, j)]);
             let lu = e.lu();
             self.work.lu += 1;
             // Stages.
@@ -361,10 +322,7 @@ impl Rodas4 {
                     let ts = if s < 4 { t + Self::C[s - 1] * h } else { t + h };
                     for i in 0..n {
                         self.tmp[i] = if s < 5 {
-                            self.y[i]
-                                + (0..s)
-                                    .map(|j| Self::A[s - 1][j] * self.k[j][i])
-                                    .sum::<f64>()
+                            self.y[i] + (0..s).map(|j| Self::A[s - 1][j] * self.k[j][i]).sum::<f64>()
                         } else {
                             self.ynew[i] + self.k[4][i]
                         };
@@ -381,16 +339,11 @@ impl Rodas4 {
                         r += h * Self::D[s] * self.fx[i];
                     }
                     if s > 0 {
-                        r += (0..s)
-                            .map(|j| Self::CC[s - 1][j] * self.k[j][i])
-                            .sum::<f64>()
-                            / h;
+                        r += (0..s).map(|j| Self::CC[s - 1][j] * self.k[j][i]).sum::<f64>() / h;
                     }
                     self.tmp[i] = r;
                 }
-                let sol = lu
-                    .solve(&nalgebra::DVector::from_column_slice(&self.tmp))
-                    .ok_or("singular")?;
+                let sol = lu.solve(&nalgebra::DVector::from_column_slice(&self.tmp)).ok_or("singular")?;
                 self.k[s].copy_from_slice(sol.as_slice());
                 if s == 5 {
                     for i in 0..n {
@@ -452,11 +405,7 @@ impl Rodas4 {
 }
 
 fn run_rodas(p: &Problem, rtol: f64) -> Result<(Trajectory, Work), String> {
-    let mut s = Rodas4::new(
-        p.x0.len(),
-        rtol,
-        p.nominal.iter().map(|v| v * rtol).collect(),
-    );
+    let mut s = Rodas4::new(p.x0.len(), rtol, p.nominal.iter().map(|v| v * rtol).collect());
     let mut x = p.x0.clone();
     let mut t = 0.0;
     let mut out = Vec::with_capacity(p.t_out.len());
@@ -491,18 +440,11 @@ fn main() {
     );
     for p in problems() {
         let (reference, _) = run_radau(&p, 1e-12).expect("reference run");
-        let check = run_rodas(&p, 1e-10)
-            .map(|(o, _)| err_tol_units(&p, 1e-10, &o, &reference))
-            .unwrap_or(f64::NAN);
-        println!(
-            "{:<11} ref check: RODAS4 at rtol 1e-10 vs reference: {check:.2} tol units",
-            p.name
-        );
+        let check = run_rodas(&p, 1e-10).map(|(o, _)| err_tol_units(&p, 1e-10, &o, &reference)).unwrap_or(f64::NAN);
+        println!("{:<11} ref check: RODAS4 at rtol 1e-10 vs reference: {check:.2} tol units", p.name);
         for &rtol in &rtols {
-            let methods: [(&str, Runner); 2] = [
-                ("radau5", Box::new(|| run_radau(&p, rtol))),
-                ("rodas4", Box::new(|| run_rodas(&p, rtol))),
-            ];
+            let methods: [(&str, Runner); 2] =
+                [("radau5", Box::new(|| run_radau(&p, rtol))), ("rodas4", Box::new(|| run_rodas(&p, rtol)))];
             for (name, run) in methods {
                 // Best of several repetitions (at least 3, at least 0.3 s in total).
                 let (mut best, mut total, mut reps) = (f64::INFINITY, 0.0, 0);

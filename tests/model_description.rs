@@ -39,4 +39,5 @@ fn check_table(id: &str, vars: &[Variable]) {
 fn variable_tables_obey_fmi_rules() {
     use boomsim::fmi2::Model;
     check_table("PressureFeedbackController", models::PressureFeedbackController::VARIABLES);
+    check_table("HydraulicBoom", models::HydraulicBoom::VARIABLES);
 }

@@ -24,9 +24,6 @@ pub struct Cylinder {
     pub v_dead_a: f64,
     /// Dead volume of the rod-side chamber `V_CH2` (m^3), 50 cm^3 (assumed, 5.1.1).
     pub v_dead_b: f64,
-    /// Mass of rod and piston `m_rod` (kg), 5 kg. Not used by the hydraulics: the mechanics
-    /// adds it to the moving mass and its weight `G_rod = m_rod g sin(theta_1)` (eq. 2.62).
-    pub m_rod: f64,
     /// End-stop contact stiffness (N/m). The thesis has no end stops; 1e8 N/m lets a stop
     /// yield 0.9 mm under the largest pressure force (280 bar on the piston, 93 kN).
     pub k_stop: f64,

@@ -296,16 +296,6 @@ pub const PARAMS: &[Param] = &[
         "parameter list, 5.1.1 (assumed)"
     ),
     param!(
-        "cylinder.m_rod",
-        cylinder.m_rod,
-        5.0,
-        "kg",
-        "",
-        [0.0, 1000.0],
-        "Mass of rod and piston (used by the mechanics)",
-        "parameter list, eq. 2.62"
-    ),
-    param!(
         "cylinder.k_stop",
         cylinder.k_stop,
         1e8,
@@ -539,7 +529,6 @@ impl Default for Circuit {
                 stroke: 0.0,
                 v_dead_a: 0.0,
                 v_dead_b: 0.0,
-                m_rod: 0.0,
                 k_stop: 0.0,
                 c_stop: 0.0,
             },

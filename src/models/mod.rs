@@ -1,12 +1,17 @@
 //! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].
 
+pub mod hydraulic_boom;
 pub mod pressure_feedback_controller;
 
+pub use hydraulic_boom::HydraulicBoom;
 pub use pressure_feedback_controller::PressureFeedbackController;
 
 use crate::fmi2::Fmu;
 
 /// Every FMU boomsim ships, with the cdylib package that exports it.
 pub fn all() -> Vec<Fmu> {
-    vec![Fmu::of::<PressureFeedbackController>("fmu-pressure-feedback-controller")]
+    vec![
+        Fmu::of::<PressureFeedbackController>("fmu-pressure-feedback-controller"),
+        Fmu::of::<HydraulicBoom>("fmu-hydraulic-boom"),
+    ]
 }

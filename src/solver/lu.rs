@@ -7,10 +7,7 @@
 use nalgebra::{ComplexField, DMatrix};
 
 /// Factorises `a` in place. Returns `false` if a pivot is zero or not finite (singular matrix).
-pub(crate) fn factor<T: ComplexField<RealField = f64> + Copy>(
-    a: &mut DMatrix<T>,
-    piv: &mut [usize],
-) -> bool {
+pub(crate) fn factor<T: ComplexField<RealField = f64> + Copy>(a: &mut DMatrix<T>, piv: &mut [usize]) -> bool {
     let n = a.nrows();
     for k in 0..n {
         let mut p = k;
@@ -47,11 +44,7 @@ pub(crate) fn factor<T: ComplexField<RealField = f64> + Copy>(
 }
 
 /// Solves `A x = b` in place (`b` becomes `x`) with the factors from [`factor`].
-pub(crate) fn solve<T: ComplexField<RealField = f64> + Copy>(
-    lu: &DMatrix<T>,
-    piv: &[usize],
-    b: &mut [T],
-) {
+pub(crate) fn solve<T: ComplexField<RealField = f64> + Copy>(lu: &DMatrix<T>, piv: &[usize], b: &mut [T]) {
     let n = lu.nrows();
     for (k, &p) in piv.iter().enumerate() {
         b.swap(k, p);
@@ -83,9 +76,7 @@ mod tests {
     fn solves_real_and_complex_systems() {
         let a = DMatrix::from_row_slice(3, 3, &[0.0, 2.0, 1.0, 4.0, 1.0, -1.0, 1.0, -3.0, 2.0]);
         let x = [1.0, -2.0, 0.5];
-        let b: Vec<f64> = (0..3)
-            .map(|i| (0..3).map(|j| a[(i, j)] * x[j]).sum())
-            .collect();
+        let b: Vec<f64> = (0..3).map(|i| (0..3).map(|j| a[(i, j)] * x[j]).sum()).collect();
         let (mut lu, mut piv, mut y) = (a.clone(), [0usize; 3], b.clone());
         assert!(factor(&mut lu, &mut piv));
         solve(&lu, &piv, &mut y);
@@ -93,14 +84,8 @@ mod tests {
             assert!((y[i] - x[i]).abs() < 1e-14);
         }
         let ac = a.map(|v| Complex::new(v, 0.5 * v + 1.0));
-        let xc = [
-            Complex::new(1.0, 1.0),
-            Complex::new(0.0, -2.0),
-            Complex::new(3.0, 0.0),
-        ];
-        let bc: Vec<_> = (0..3)
-            .map(|i| (0..3).map(|j| ac[(i, j)] * xc[j]).sum())
-            .collect();
+        let xc = [Complex::new(1.0, 1.0), Complex::new(0.0, -2.0), Complex::new(3.0, 0.0)];
+        let bc: Vec<_> = (0..3).map(|i| (0..3).map(|j| ac[(i, j)] * xc[j]).sum()).collect();
         let (mut luc, mut yc) = (ac, bc);
         assert!(factor(&mut luc, &mut piv));
         solve(&luc, &piv, &mut yc);

@@ -107,11 +107,7 @@ impl fmt::Display for FailureCause {
 
 impl fmt::Display for SolveError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "integration stopped at t = {:e} s (step {:e} s): ",
-            self.t, self.h
-        )?;
+        write!(f, "integration stopped at t = {:e} s (step {:e} s): ", self.t, self.h)?;
         match &self.kind {
             SolveErrorKind::StepSizeTooSmall(c) => write!(f, "step size below minimum ({c})"),
             SolveErrorKind::TooManyRejections(c) => write!(f, "too many rejected steps ({c})"),
