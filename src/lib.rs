@@ -5,6 +5,7 @@
 //! [`models`] composes it into FMU models; [`fmi2`] exposes any model through the C ABI.
 
 pub mod analysis;
+pub mod bench;
 pub mod control;
 pub mod fmi2;
 pub mod hydraulics;

@@ -24,6 +24,15 @@ enum Cmd {
         #[arg(long, default_value = "target/fmu")]
         out: PathBuf,
     },
+    /// Time the lowering scenarios U and B in-process and through the C ABI (1 ms steps, rtol 1e-6).
+    Bench {
+        /// Print a JSON list of {case, boom, via, simulated_s, wall_s, rtf, steps, rhs_evals, jac_evals}.
+        #[arg(long)]
+        json: bool,
+        /// Simulated time per case [s].
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+    },
     /// Write modelDescription/<ModelIdentifier>.xml from the variable tables.
     Xml {
         /// Compare instead of writing; fail if a committed file differs from the generator.
@@ -41,18 +50,24 @@ fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root().join("target"))
 }
 
-fn pack(out: &Path) -> Result<(), String> {
-    let fmus = models::all();
+/// Builds every FMU crate in release mode.
+fn build_fmus() -> Result<(), String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut build = Command::new(cargo);
     build.current_dir(root()).args(["build", "--release", "--quiet"]);
-    for f in &fmus {
+    for f in models::all() {
         build.args(["-p", f.package]);
     }
     let status = build.status().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
         return Err(format!("cargo build failed ({status})"));
     }
+    Ok(())
+}
+
+fn pack(out: &Path) -> Result<(), String> {
+    build_fmus()?;
+    let fmus = models::all();
     let out = if out.is_absolute() { out.to_path_buf() } else { root().join(out) };
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     for f in &fmus {
@@ -61,6 +76,53 @@ fn pack(out: &Path) -> Result<(), String> {
         f.write(&lib, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
         println!("{}", fmu.display());
     }
+    Ok(())
+}
+
+fn bench(json: bool, duration: f64) -> Result<(), String> {
+    build_fmus()?;
+    let libs = target_dir().join("release");
+    let results = boomsim::bench::run_all(&libs, duration)?;
+    let cycle_in = boomsim::bench::controller_cycle(
+        &mut boomsim::bench::InProcess::<models::PressureFeedbackController>::new(1e-6, &[])?,
+        200_000,
+    )?;
+    let cycle_c = boomsim::bench::controller_cycle(
+        &mut boomsim::bench::CAbi::new::<models::PressureFeedbackController>(
+            &libs.join("libPressureFeedbackController.so"),
+            1e-6,
+            &[],
+        )?,
+        200_000,
+    )?;
+    if json {
+        let list: Vec<_> = results.iter().map(|r| r.to_json()).collect();
+        println!("{}", serde_json::to_string_pretty(&list).map_err(|e| e.to_string())?);
+        return Ok(());
+    }
+    println!(
+        "{:<5} {:<8} {:<11} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8}",
+        "case", "boom", "via", "sim s", "wall s", "rtf", "steps", "rhs", "jac"
+    );
+    for r in &results {
+        println!(
+            "{:<5} {:<8} {:<11} {:>8.1} {:>8.4} {:>8.0} {:>8} {:>10} {:>8}",
+            r.case,
+            r.boom,
+            r.via,
+            r.simulated_s,
+            r.wall_s,
+            r.rtf(),
+            r.steps,
+            r.rhs_evals,
+            r.jac_evals
+        );
+    }
+    println!(
+        "controller setReal+doStep+getReal: {:.0} ns in-process, {:.0} ns through the C ABI",
+        cycle_in * 1e9,
+        cycle_c * 1e9
+    );
     Ok(())
 }
 
@@ -90,6 +152,7 @@ fn xml(check: bool) -> Result<(), String> {
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Cmd::Pack { out } => pack(&out),
+        Cmd::Bench { json, duration } => bench(json, duration),
         Cmd::Xml { check } => xml(check),
     };
     match result {

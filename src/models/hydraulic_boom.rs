@@ -43,6 +43,10 @@ pub mod vr {
     pub const X_V: u32 = 20;
     pub const U_PCV: u32 = 21;
     pub const P_X: u32 = 22;
+    pub const SOLVER_STEPS: u32 = 23;
+    pub const SOLVER_REJECTED: u32 = 24;
+    pub const SOLVER_RHS: u32 = 25;
+    pub const SOLVER_JACOBIANS: u32 = 26;
     pub const X0: u32 = 30;
     /// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
     pub const HYDRAULICS: u32 = 100;
@@ -66,7 +70,7 @@ const fn out(name: &'static str, r: u32, unit: &'static str, display: &'static s
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 24] = [
+const OWN: [Variable; 28] = [
     Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
         "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
     out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
@@ -91,6 +95,10 @@ const OWN: [Variable; 24] = [
     Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
     Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
     Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
+    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
+    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
+    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
+    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
     Variable::param(vr::X0, START_STROKE).fixed(),
 ];
 
@@ -211,11 +219,6 @@ pub struct HydraulicBoom {
 }
 
 impl HydraulicBoom {
-    /// The solver's work counters (for benchmarks).
-    pub fn solver(&self) -> &Radau5 {
-        &self.solver
-    }
-
     fn with_state(values: &Values, state: [f64; N_STATES]) -> Result<Self, String> {
         let plant = RigidPlant::from_values(values)?;
         Ok(HydraulicBoom { plant, state, solver: Radau5::new(N_STATES) })
@@ -276,6 +279,10 @@ impl Model for HydraulicBoom {
             (vr::X_V, s[circuit::X_V]),
             (vr::U_PCV, e.u_pcv),
             (vr::P_X, e.p_x),
+            (vr::SOLVER_STEPS, self.solver.stats().accepted_steps as f64),
+            (vr::SOLVER_REJECTED, self.solver.stats().rejected_steps as f64),
+            (vr::SOLVER_RHS, self.solver.stats().rhs_evals as f64),
+            (vr::SOLVER_JACOBIANS, self.solver.stats().jacobian_evals as f64),
         ];
         for (r, x) in outputs {
             values.set_real(r, x);
@@ -322,12 +329,10 @@ impl Model for HydraulicBoom {
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        if saved.len() != N_STATES + Radau5::STATE_LEN || saved.iter().any(|x| !x.is_finite()) {
-            return Err(format!("expected {} finite numbers, got {}", N_STATES + Radau5::STATE_LEN, saved.len()));
-        }
-        let mut m = Self::with_state(values, saved[..N_STATES].try_into().expect("length checked"))?;
-        let solver_state = saved[N_STATES..].try_into().expect("length checked");
-        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        let state = saved.get(..N_STATES).filter(|s| s.iter().all(|x| x.is_finite()));
+        let state = state.ok_or_else(|| format!("expected {N_STATES} finite states, got {saved:?}"))?;
+        let mut m = Self::with_state(values, state.try_into().expect("length checked"))?;
+        m.solver.load_state(&saved[N_STATES..]).map_err(|e| e.to_string())?;
         Ok(m)
     }
 }

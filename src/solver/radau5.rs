@@ -30,8 +30,11 @@
 //!
 //! **Communication points.** Steps never pass `t_end`; if the wanted step reaches `t_end` it is
 //! cut to land exactly, if it covers more than half the rest, the rest is split into two equal
-//! steps. Each `integrate` call starts with a fresh Jacobian (inputs may have changed) and the
-//! carried step-size hint, the only persistent state ([`Radau5::save_state`]).
+//! steps. Each `integrate` call starts with the carried step-size hint and, as between steps, the
+//! Jacobian of the previous call unless the last Newton contraction asked for a new one: it is
+//! only the iteration matrix, so a stale one (inputs changed) costs iterations, never accuracy,
+//! and a Newton failure recomputes it. Hint, contraction and Jacobian are the persistent state
+//! ([`Radau5::save_state`]), so a restored integrator continues bit-identically.
 
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
@@ -46,7 +49,7 @@ const NIT: u32 = 7;
 /// Safety factor of the step-size controller.
 const SAFE: f64 = 0.9;
 /// Reuse the Jacobian while the Newton contraction rate is below this.
-const THET: f64 = 0.001;
+const THET: f64 = 0.01;
 /// `h_new/h >= 1/FACL`.
 const FACL: f64 = 5.0;
 /// `h_new/h <= 1/FACR`.
@@ -108,6 +111,9 @@ pub struct Radau5 {
     max_step: f64,
     max_steps: u64,
     h_hint: f64,
+    /// Newton contraction rate of the last step; with `jac_valid`, decides Jacobian reuse.
+    theta: f64,
+    jac_valid: bool,
     stats: SolverStats,
     gamma: f64,
     alpha: f64,
@@ -140,9 +146,6 @@ struct NewtonFail {
 }
 
 impl Radau5 {
-    /// Number of `f64` in [`save_state`](Self::save_state).
-    pub const STATE_LEN: usize = 1;
-
     /// An integrator for systems of dimension `n` with `rtol = 1e-6`, `atol_i = 1e-6`, no step
     /// limit and at most 100 000 steps per `integrate` call.
     pub fn new(n: usize) -> Self {
@@ -155,6 +158,8 @@ impl Radau5 {
             max_step: f64::INFINITY,
             max_steps: 100_000,
             h_hint: 0.0,
+            theta: THET,
+            jac_valid: false,
             stats: SolverStats::default(),
             gamma,
             alpha,
@@ -240,22 +245,37 @@ impl Radau5 {
         self.stats = SolverStats::default();
     }
 
-    /// Forgets the step-size hint, e.g. after a discontinuity in the model.
+    /// Forgets the step-size hint and the Jacobian, e.g. after a discontinuity in the model.
     pub fn reset(&mut self) {
         self.h_hint = 0.0;
+        self.jac_valid = false;
     }
 
-    /// The persistent state carried between calls: `[step-size hint]` (0 = none).
-    pub fn save_state(&self) -> [f64; Self::STATE_LEN] {
-        [self.h_hint]
+    /// Number of `f64` in [`save_state`](Self::save_state): `3 + n²`.
+    pub fn state_len(&self) -> usize {
+        3 + self.n * self.n
+    }
+
+    /// The persistent state carried between calls: step-size hint (0 = none), last Newton
+    /// contraction, Jacobian validity (0/1) and the Jacobian (column-major).
+    pub fn save_state(&self) -> Vec<f64> {
+        let mut s = vec![self.h_hint, self.theta, self.jac_valid as u8 as f64];
+        s.extend_from_slice(self.jac.as_slice());
+        s
     }
 
     /// Restores a state from [`save_state`](Self::save_state).
-    pub fn load_state(&mut self, s: &[f64; Self::STATE_LEN]) -> Result<(), SolveError> {
-        if !(s[0] >= 0.0 && s[0].is_finite()) {
-            return Err(invalid(format!("step-size hint {} is not finite and >= 0", s[0])));
+    pub fn load_state(&mut self, s: &[f64]) -> Result<(), SolveError> {
+        if s.len() != self.state_len() || s.iter().any(|v| !v.is_finite()) {
+            return Err(invalid(format!("expected {} finite numbers, got {}", self.state_len(), s.len())));
+        }
+        if !(s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || s[2] == 1.0)) {
+            return Err(invalid(format!("step-size hint {}, contraction {}, flag {} are invalid", s[0], s[1], s[2])));
         }
         self.h_hint = s[0];
+        self.theta = s[1];
+        self.jac_valid = s[2] == 1.0;
+        self.jac.as_mut_slice().copy_from_slice(&s[3..]);
         Ok(())
     }
 
@@ -301,8 +321,8 @@ impl Radau5 {
         let mut h_nat = if self.h_hint > 0.0 { self.h_hint } else { H_INITIAL }.min(self.max_step);
         let (mut h, mut last) = plan(t, t_end, h_nat);
         let (mut first, mut reject) = (true, false);
-        let (mut need_jac, mut need_lu, mut caljac) = (true, true, false);
-        let (mut theta, mut hold) = (THET, h);
+        let (mut need_jac, mut need_lu, mut caljac) = (!self.jac_valid || self.theta > THET, true, false);
+        let (mut theta, mut hold) = (self.theta, h);
         let (mut hacc, mut erracc, mut n_acc) = (0.0, 0.0, 0u64);
         let (mut n_rej_row, mut n_attempts) = (0u32, 0u64);
         let mut fail: Option<FailureCause> = None;
@@ -340,6 +360,7 @@ impl Radau5 {
                     return Err(SolveError { kind: SolveErrorKind::NonFiniteJacobian, t, h });
                 }
                 caljac = true;
+                self.jac_valid = true;
                 need_jac = false;
                 need_lu = true;
             }
@@ -419,6 +440,7 @@ impl Radau5 {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
                 let hint = if hnew < h { hnew } else { hnew.max(h_nat) };
                 self.h_hint = hint.min(self.max_step);
+                self.theta = theta;
                 x.copy_from_slice(&self.y);
                 return Ok(());
             }

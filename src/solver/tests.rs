@@ -52,7 +52,9 @@ fn convergence_order_is_five() {
         s.set_rtol(0.5).unwrap();
         s.set_atol(&[1e3; 3]).unwrap();
         s.set_max_step(h).unwrap();
-        s.load_state(&[h]).unwrap();
+        let mut saved = s.save_state();
+        saved[0] = h;
+        s.load_state(&saved).unwrap();
         let mut x = Linear::exact(0.0);
         s.integrate(&Linear, 0.0, &mut x, 1.0).unwrap();
         assert_eq!(s.stats().accepted_steps, (1.0 / h).round() as u64);

@@ -1,0 +1,303 @@
+//! `boomsim bench`: the thesis' lowering scenarios timed in-process and through the C ABI, with
+//! the integrator's work counters. Speed is reported, never asserted.
+//!
+//! Both paths drive the same FMI 2.0 functions: in-process through [`Instance`] (what the
+//! exported symbols call), through the C ABI by loading the built shared libraries with `dlopen`
+//! as an importer would.
+
+use crate::fmi2::instance::Instance;
+use crate::fmi2::log::Logger;
+use crate::fmi2::types::*;
+use crate::fmi2::{guid::guid, Model, Value};
+use crate::models::hydraulic_boom::vr as hb;
+use crate::models::pressure_feedback_controller::vr as pfc;
+use crate::models::{HydraulicBoom, PressureFeedbackController};
+use std::ffi::{c_void, CStr, CString};
+use std::os::raw::c_int;
+use std::path::Path;
+use std::time::Instant;
+
+/// One co-simulation slave, however it is reached.
+pub trait Slave {
+    fn set(&mut self, vr: u32, x: f64) -> Result<(), String>;
+    fn get(&mut self, vr: u32) -> Result<f64, String>;
+    fn step(&mut self, t: f64, h: f64) -> Result<(), String>;
+}
+
+/// A slave called in-process through the generic FMI layer.
+pub struct InProcess<M: Model>(Instance<M>);
+
+impl<M: Model> InProcess<M> {
+    /// Instantiated, set up with `rtol`, initialised with the given Real values.
+    pub fn new(rtol: f64, start: &[(u32, f64)]) -> Result<Self, String> {
+        let mut i = Instance::<M>::new(Logger::new(None, std::ptr::null_mut(), "bench", &[], false));
+        i.setup_experiment(Some(rtol), 0.0, None)?;
+        i.enter_initialization_mode();
+        for &(r, x) in start {
+            i.set(&[r], vec![Value::Real(x)], "Real")?;
+        }
+        i.exit_initialization_mode()?;
+        Ok(InProcess(i))
+    }
+}
+
+impl<M: Model> Slave for InProcess<M> {
+    fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
+        self.0.set(&[vr], vec![Value::Real(x)], "Real")
+    }
+    fn get(&mut self, vr: u32) -> Result<f64, String> {
+        let mut x = [0.0];
+        self.0.get(&[vr], &mut x, "Real", |v| if let Value::Real(x) = v { *x } else { f64::NAN })?;
+        Ok(x[0])
+    }
+    fn step(&mut self, t: f64, h: f64) -> Result<(), String> {
+        match self.0.do_step(t, h)? {
+            None => Ok(()),
+            Some(why) => Err(why),
+        }
+    }
+}
+
+type Instantiate = unsafe extern "C" fn(
+    fmi2String,
+    c_int,
+    fmi2String,
+    fmi2String,
+    *const fmi2CallbackFunctions,
+    c_int,
+    c_int,
+) -> fmi2Component;
+type Component = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
+type Setup = unsafe extern "C" fn(fmi2Component, c_int, f64, f64, c_int, f64) -> fmi2Status;
+type RealIo = unsafe extern "C" fn(fmi2Component, *const u32, usize, *mut f64) -> fmi2Status;
+type DoStep = unsafe extern "C" fn(fmi2Component, f64, f64, c_int) -> fmi2Status;
+type Free = unsafe extern "C" fn(fmi2Component);
+
+/// A slave loaded from its shared library and called through the exported C functions.
+pub struct CAbi {
+    lib: *mut c_void,
+    c: fmi2Component,
+    get_real: RealIo,
+    set_real: RealIo,
+    do_step: DoStep,
+    free: Free,
+    _callbacks: Box<fmi2CallbackFunctions>,
+}
+
+/// The benchmark's logger: messages are not needed here, only a valid callback. Defined with the
+/// fixed arguments only (C-variadic definitions are not stable Rust); calling it through the
+/// variadic pointer type is ABI-compatible on x86_64 System V, the platform boomsim ships for.
+unsafe extern "C" fn quiet(_: fmi2ComponentEnvironment, _: fmi2String, _: c_int, _: fmi2String, _: fmi2String) {}
+unsafe extern "C" fn calloc(n: usize, size: usize) -> *mut c_void {
+    libc::calloc(n, size)
+}
+unsafe extern "C" fn free(p: *mut c_void) {
+    libc::free(p)
+}
+
+impl CAbi {
+    /// Loads `library`, instantiates model `M` and initialises it like [`InProcess::new`].
+    pub fn new<M: Model>(library: &Path, rtol: f64, start: &[(u32, f64)]) -> Result<Self, String> {
+        let path = CString::new(library.to_string_lossy().as_bytes()).map_err(|e| e.to_string())?;
+        // SAFETY: dlopen/dlsym with NUL-terminated names; each symbol is cast to the signature
+        // the FMI 2.0 headers give it.
+        unsafe {
+            let lib = libc::dlopen(path.as_ptr(), libc::RTLD_NOW | libc::RTLD_LOCAL);
+            if lib.is_null() {
+                return Err(format!(
+                    "dlopen {}: {}",
+                    library.display(),
+                    CStr::from_ptr(libc::dlerror()).to_string_lossy()
+                ));
+            }
+            let sym = |name: &CStr| {
+                let p = libc::dlsym(lib, name.as_ptr());
+                if p.is_null() {
+                    Err(format!("{} does not export {}", library.display(), name.to_string_lossy()))
+                } else {
+                    Ok(p)
+                }
+            };
+            let logger = std::mem::transmute::<
+                unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String),
+                unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
+            >(quiet);
+            let callbacks = Box::new(fmi2CallbackFunctions {
+                logger: Some(logger),
+                allocateMemory: Some(calloc),
+                freeMemory: Some(free),
+                stepFinished: None,
+                componentEnvironment: std::ptr::null_mut(),
+            });
+            let instantiate: Instantiate = std::mem::transmute(sym(c"fmi2Instantiate")?);
+            let setup: Setup = std::mem::transmute(sym(c"fmi2SetupExperiment")?);
+            let enter: Component = std::mem::transmute(sym(c"fmi2EnterInitializationMode")?);
+            let exit: Component = std::mem::transmute(sym(c"fmi2ExitInitializationMode")?);
+            let (name, id) = (c"bench", CString::new(guid::<M>()).map_err(|e| e.to_string())?);
+            let c = instantiate(name.as_ptr(), FMI2_COSIMULATION, id.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
+            if c.is_null() {
+                return Err(format!("fmi2Instantiate of {} failed", library.display()));
+            }
+            let mut s = CAbi {
+                lib,
+                c,
+                get_real: std::mem::transmute(sym(c"fmi2GetReal")?),
+                set_real: std::mem::transmute(sym(c"fmi2SetReal")?),
+                do_step: std::mem::transmute(sym(c"fmi2DoStep")?),
+                free: std::mem::transmute(sym(c"fmi2FreeInstance")?),
+                _callbacks: callbacks,
+            };
+            check(setup(c, 1, rtol, 0.0, 0, 0.0), "fmi2SetupExperiment")?;
+            check(enter(c), "fmi2EnterInitializationMode")?;
+            for &(r, x) in start {
+                s.set(r, x)?;
+            }
+            check(exit(c), "fmi2ExitInitializationMode")?;
+            Ok(s)
+        }
+    }
+}
+
+fn check(status: fmi2Status, function: &str) -> Result<(), String> {
+    match status {
+        fmi2Status::OK | fmi2Status::Warning => Ok(()),
+        s => Err(format!("{function} returned {s:?}")),
+    }
+}
+
+impl Slave for CAbi {
+    fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
+        // SAFETY: a live component, one value reference and one value.
+        check(unsafe { (self.set_real)(self.c, &vr, 1, &x as *const f64 as *mut f64) }, "fmi2SetReal")
+    }
+    fn get(&mut self, vr: u32) -> Result<f64, String> {
+        let mut x = 0.0;
+        check(unsafe { (self.get_real)(self.c, &vr, 1, &mut x) }, "fmi2GetReal")?;
+        Ok(x)
+    }
+    fn step(&mut self, t: f64, h: f64) -> Result<(), String> {
+        check(unsafe { (self.do_step)(self.c, t, h, 1) }, "fmi2DoStep")
+    }
+}
+
+impl Drop for CAbi {
+    fn drop(&mut self) {
+        // SAFETY: the component and library were created in `new` and are released once.
+        unsafe {
+            (self.free)(self.c);
+            libc::dlclose(self.lib);
+        }
+    }
+}
+
+/// One benchmark result (the `--json` record).
+#[derive(Debug, Clone)]
+pub struct BenchResult {
+    pub case: &'static str,
+    pub boom: &'static str,
+    pub via: &'static str,
+    pub simulated_s: f64,
+    pub wall_s: f64,
+    pub steps: u64,
+    pub rhs_evals: u64,
+    pub jac_evals: u64,
+}
+
+impl BenchResult {
+    /// Real-time factor: simulated time over wall time.
+    pub fn rtf(&self) -> f64 {
+        self.simulated_s / self.wall_s
+    }
+
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "case": self.case, "boom": self.boom, "via": self.via, "simulated_s": self.simulated_s,
+            "wall_s": self.wall_s, "rtf": self.rtf(), "steps": self.steps, "rhs_evals": self.rhs_evals,
+            "jac_evals": self.jac_evals,
+        })
+    }
+}
+
+/// Communication step of every case (the thesis' logging rate and the runner's default).
+pub const STEP: f64 = 1e-3;
+/// Relative tolerance of every case.
+pub const RTOL: f64 = 1e-6;
+
+/// Case U (section 7.1): lowering from 480 mm with u = -0.1, no compensation, `duration` s.
+pub fn case_u(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
+    plant.set(hb::U_REF, -0.1)?;
+    let n = (duration / STEP).round() as usize;
+    (0..n).try_for_each(|k| plant.step(k as f64 * STEP, STEP))
+}
+
+/// Case B (Table 7.2): lowering with u_ref = -0.05 through the controller with the experiment-B
+/// filter; Gauss-Seidel coupling p4 -> controller -> valve.u_ref (the plant has no direct
+/// feedthrough, so there is no algebraic loop).
+pub fn case_b(plant: &mut dyn Slave, controller: &mut dyn Slave, duration: f64) -> Result<(), String> {
+    controller.set(pfc::U_REF, -0.05)?;
+    let n = (duration / STEP).round() as usize;
+    for k in 0..n {
+        let t = k as f64 * STEP;
+        controller.set(pfc::P, plant.get(hb::P4)?)?;
+        plant.set(hb::U_REF, controller.get(pfc::U)?)?;
+        plant.step(t, STEP)?;
+        controller.step(t, STEP)?;
+    }
+    Ok(())
+}
+
+/// Runs `case` on `plant` and reads the solver counters afterwards.
+fn timed(
+    case: &'static str,
+    via: &'static str,
+    plant: &mut dyn Slave,
+    run: impl FnOnce(&mut dyn Slave) -> Result<(), String>,
+    duration: f64,
+) -> Result<BenchResult, String> {
+    let start = Instant::now();
+    run(plant)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let count = |plant: &mut dyn Slave, r| plant.get(r).map(|x| x as u64);
+    Ok(BenchResult {
+        case,
+        boom: "rigid",
+        via,
+        simulated_s: duration,
+        wall_s,
+        steps: count(plant, hb::SOLVER_STEPS)?,
+        rhs_evals: count(plant, hb::SOLVER_RHS)?,
+        jac_evals: count(plant, hb::SOLVER_JACOBIANS)?,
+    })
+}
+
+/// Every benchmark: cases U and B, in-process and through the C ABI of the libraries in
+/// `library_dir` (`lib<ModelIdentifier>.so`, as `cargo build --release` leaves them).
+pub fn run_all(library_dir: &Path, duration: f64) -> Result<Vec<BenchResult>, String> {
+    let plant_start = [];
+    let lib = |id: &str| library_dir.join(format!("lib{id}.so"));
+    let (hb_lib, pfc_lib) = (lib(HydraulicBoom::INFO.identifier), lib(PressureFeedbackController::INFO.identifier));
+    let mut out = Vec::new();
+    let mut p = InProcess::<HydraulicBoom>::new(RTOL, &plant_start)?;
+    out.push(timed("U", "in-process", &mut p, |p| case_u(p, duration), duration)?);
+    let mut p = CAbi::new::<HydraulicBoom>(&hb_lib, RTOL, &plant_start)?;
+    out.push(timed("U", "c-abi", &mut p, |p| case_u(p, duration), duration)?);
+    let mut p = InProcess::<HydraulicBoom>::new(RTOL, &plant_start)?;
+    let mut c = InProcess::<PressureFeedbackController>::new(RTOL, &[(pfc::P, p.get(hb::P4)?)])?;
+    out.push(timed("B", "in-process", &mut p, |p| case_b(p, &mut c, duration), duration)?);
+    let mut p = CAbi::new::<HydraulicBoom>(&hb_lib, RTOL, &plant_start)?;
+    let mut c = CAbi::new::<PressureFeedbackController>(&pfc_lib, RTOL, &[(pfc::P, p.get(hb::P4)?)])?;
+    out.push(timed("B", "c-abi", &mut p, |p| case_b(p, &mut c, duration), duration)?);
+    Ok(out)
+}
+
+/// Cost of one setReal + doStep + getReal cycle of the controller, in seconds, over `n` cycles.
+pub fn controller_cycle(slave: &mut dyn Slave, n: usize) -> Result<f64, String> {
+    let start = Instant::now();
+    for k in 0..n {
+        let t = k as f64 * STEP;
+        slave.set(pfc::P, 50e5 + 1e5 * (t * 20.0).sin())?;
+        slave.step(t, STEP)?;
+        std::hint::black_box(slave.get(pfc::U)?);
+    }
+    Ok(start.elapsed().as_secs_f64() / n as f64)
+}
