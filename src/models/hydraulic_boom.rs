@@ -104,6 +104,32 @@ const OWN: [Variable; 28] = [
 
 const N_VARS: usize = OWN.len() + PARAMS.len() + BOOM_SPECS.len();
 
+/// Whether a hydraulic parameter selects a variant (an index): exposed as an Integer.
+const fn is_selector(name: &str) -> bool {
+    let (a, b) = (name.as_bytes(), b"friction.model");
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// The FMU variable of hydraulic parameter `k`.
+const fn hydraulic_param(k: usize) -> Variable {
+    let (r, p) = (vr::HYDRAULICS + k as u32, PARAMS[k].spec);
+    if is_selector(p.name) {
+        Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
+    } else {
+        Variable::param(r, p).fixed()
+    }
+}
+
 /// The table: own variables, then every hydraulic and boom parameter (fixed: set them before
 /// initialisation ends).
 const TABLE: [Variable; N_VARS] = {
@@ -115,7 +141,7 @@ const TABLE: [Variable; N_VARS] = {
     }
     let mut k = 0;
     while k < PARAMS.len() {
-        t[OWN.len() + k] = Variable::param(vr::HYDRAULICS + k as u32, PARAMS[k].spec).fixed();
+        t[OWN.len() + k] = hydraulic_param(k);
         k += 1;
     }
     let mut k = 0;
@@ -167,7 +193,8 @@ impl RigidPlant {
     pub fn from_values(values: &Values) -> Result<Self, String> {
         let mut circuit = Circuit::default();
         for (k, p) in PARAMS.iter().enumerate() {
-            (p.set)(&mut circuit, values.real(vr::HYDRAULICS + k as u32));
+            let r = vr::HYDRAULICS + k as u32;
+            (p.set)(&mut circuit, if is_selector(p.spec.name) { values.integer(r) as f64 } else { values.real(r) });
         }
         let cyl = &circuit.cylinder;
         if cyl.d_rod >= cyl.d_piston {
