@@ -55,16 +55,17 @@ class Fmu:
         self.dir = extract(self.path, unzipdir=str(tmp_path_factory.mktemp(identifier)))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
 
-    def slave(self, name="instance", guid=None, **start):
-        """An instantiated slave, set up and initialised with the given start values
-        (unless guid is given: then only instantiated)."""
+    def slave(self, name="instance", guid=None, tolerance=None, **start):
+        """An instantiated slave, set up (with the relative tolerance `tolerance`, None: the
+        FMU's default) and initialised with the given start values (unless guid is given: then
+        only instantiated). Structured names go in as **{"start.x": 0.3}."""
         rec = Recorder()
         s = FMU2Slave(guid=guid or self.md.guid, unzipDirectory=self.dir,
                       modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
         s.recorder = rec
         s.instantiate(callbacks=rec.callbacks)
         if guid is None:
-            s.setupExperiment(startTime=0.0)
+            s.setupExperiment(tolerance=tolerance, startTime=0.0)
             s.enterInitializationMode()
             for k, v in start.items():
                 s.setReal([self.vr[k]], [v])
@@ -75,3 +76,8 @@ class Fmu:
 @pytest.fixture(scope="session")
 def controller(tmp_path_factory):
     return Fmu("PressureFeedbackController", tmp_path_factory)
+
+
+@pytest.fixture(scope="session")
+def boom(tmp_path_factory):
+    return Fmu("HydraulicBoom", tmp_path_factory)
