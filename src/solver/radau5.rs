@@ -30,11 +30,8 @@
 //!
 //! **Communication points.** Steps never pass `t_end`; if the wanted step reaches `t_end` it is
 //! cut to land exactly, if it covers more than half the rest, the rest is split into two equal
-//! steps. Each `integrate` call starts with the carried step-size hint and, as between steps, the
-//! Jacobian of the previous call unless the last Newton contraction asked for a new one: it is
-//! only the iteration matrix, so a stale one (inputs changed) costs iterations, never accuracy,
-//! and a Newton failure recomputes it. Hint, contraction and Jacobian are the persistent state
-//! ([`Radau5::save_state`]), so a restored integrator continues bit-identically.
+//! steps. Each `integrate` call starts with a fresh Jacobian (inputs may have changed) and the
+//! carried step-size hint, the only persistent state ([`Radau5::save_state`]).
 
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
@@ -111,9 +108,6 @@ pub struct Radau5 {
     max_step: f64,
     max_steps: u64,
     h_hint: f64,
-    /// Newton contraction rate of the last step; with `jac_valid`, decides Jacobian reuse.
-    theta: f64,
-    jac_valid: bool,
     stats: SolverStats,
     gamma: f64,
     alpha: f64,
@@ -146,6 +140,9 @@ struct NewtonFail {
 }
 
 impl Radau5 {
+    /// Number of `f64` in [`save_state`](Self::save_state).
+    pub const STATE_LEN: usize = 1;
+
     /// An integrator for systems of dimension `n` with `rtol = 1e-6`, `atol_i = 1e-6`, no step
     /// limit and at most 100 000 steps per `integrate` call.
     pub fn new(n: usize) -> Self {
@@ -158,8 +155,6 @@ impl Radau5 {
             max_step: f64::INFINITY,
             max_steps: 100_000,
             h_hint: 0.0,
-            theta: THET,
-            jac_valid: false,
             stats: SolverStats::default(),
             gamma,
             alpha,
@@ -201,10 +196,16 @@ impl Radau5 {
     /// Sets the absolute tolerances, one per state (positive, finite).
     pub fn set_atol(&mut self, atol: &[f64]) -> Result<(), SolveError> {
         if atol.len() != self.n {
-            return Err(invalid(format!("atol has {} entries, expected {}", atol.len(), self.n)));
+            return Err(invalid(format!(
+                "atol has {} entries, expected {}",
+                atol.len(),
+                self.n
+            )));
         }
         if let Some(a) = atol.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
-            return Err(invalid(format!("atol entry {a} is not positive and finite")));
+            return Err(invalid(format!(
+                "atol entry {a} is not positive and finite"
+            )));
         }
         self.atol.copy_from_slice(atol);
         Ok(())
@@ -245,37 +246,25 @@ impl Radau5 {
         self.stats = SolverStats::default();
     }
 
-    /// Forgets the step-size hint and the Jacobian, e.g. after a discontinuity in the model.
+    /// Forgets the step-size hint, e.g. after a discontinuity in the model.
     pub fn reset(&mut self) {
         self.h_hint = 0.0;
-        self.jac_valid = false;
     }
 
-    /// Number of `f64` in [`save_state`](Self::save_state): `3 + n²`.
-    pub fn state_len(&self) -> usize {
-        3 + self.n * self.n
-    }
-
-    /// The persistent state carried between calls: step-size hint (0 = none), last Newton
-    /// contraction, Jacobian validity (0/1) and the Jacobian (column-major).
-    pub fn save_state(&self) -> Vec<f64> {
-        let mut s = vec![self.h_hint, self.theta, self.jac_valid as u8 as f64];
-        s.extend_from_slice(self.jac.as_slice());
-        s
+    /// The persistent state carried between calls: `[step-size hint]` (0 = none).
+    pub fn save_state(&self) -> [f64; Self::STATE_LEN] {
+        [self.h_hint]
     }
 
     /// Restores a state from [`save_state`](Self::save_state).
-    pub fn load_state(&mut self, s: &[f64]) -> Result<(), SolveError> {
-        if s.len() != self.state_len() || s.iter().any(|v| !v.is_finite()) {
-            return Err(invalid(format!("expected {} finite numbers, got {}", self.state_len(), s.len())));
-        }
-        if !(s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || s[2] == 1.0)) {
-            return Err(invalid(format!("step-size hint {}, contraction {}, flag {} are invalid", s[0], s[1], s[2])));
+    pub fn load_state(&mut self, s: &[f64; Self::STATE_LEN]) -> Result<(), SolveError> {
+        if !(s[0] >= 0.0 && s[0].is_finite()) {
+            return Err(invalid(format!(
+                "step-size hint {} is not finite and >= 0",
+                s[0]
+            )));
         }
         self.h_hint = s[0];
-        self.theta = s[1];
-        self.jac_valid = s[2] == 1.0;
-        self.jac.as_mut_slice().copy_from_slice(&s[3..]);
         Ok(())
     }
 
@@ -293,10 +282,20 @@ impl Radau5 {
     ) -> Result<(), SolveError> {
         let n = self.n;
         if sys.dim() != n || x.len() != n {
-            return Err(invalid_at(t0, format!("system dimension {} / state length {} != {n}", sys.dim(), x.len())));
+            return Err(invalid_at(
+                t0,
+                format!(
+                    "system dimension {} / state length {} != {n}",
+                    sys.dim(),
+                    x.len()
+                ),
+            ));
         }
         if !(t0.is_finite() && t_end.is_finite() && t_end >= t0) {
-            return Err(invalid_at(t0, format!("time interval [{t0}, {t_end}] is not valid")));
+            return Err(invalid_at(
+                t0,
+                format!("time interval [{t0}, {t_end}] is not valid"),
+            ));
         }
         if x.iter().any(|v| !v.is_finite()) {
             return Err(invalid_at(t0, "initial state is not finite".into()));
@@ -309,7 +308,11 @@ impl Radau5 {
         sys.rhs(t, &self.y, &mut self.y0);
         self.stats.rhs_evals += 1;
         if !all_finite(&self.y0) {
-            return Err(SolveError { kind: SolveErrorKind::NonFiniteInitialRhs, t, h: 0.0 });
+            return Err(SolveError {
+                kind: SolveErrorKind::NonFiniteInitialRhs,
+                t,
+                h: 0.0,
+            });
         }
         self.update_scal();
 
@@ -318,11 +321,16 @@ impl Radau5 {
         let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_end.abs());
         let cfac = SAFE * (1 + 2 * NIT) as f64;
 
-        let mut h_nat = if self.h_hint > 0.0 { self.h_hint } else { H_INITIAL }.min(self.max_step);
+        let mut h_nat = if self.h_hint > 0.0 {
+            self.h_hint
+        } else {
+            H_INITIAL
+        }
+        .min(self.max_step);
         let (mut h, mut last) = plan(t, t_end, h_nat);
         let (mut first, mut reject) = (true, false);
-        let (mut need_jac, mut need_lu, mut caljac) = (!self.jac_valid || self.theta > THET, true, false);
-        let (mut theta, mut hold) = (self.theta, h);
+        let (mut need_jac, mut need_lu, mut caljac) = (true, true, false);
+        let (mut theta, mut hold) = (THET, h);
         let (mut hacc, mut erracc, mut n_acc) = (0.0, 0.0, 0u64);
         let (mut n_rej_row, mut n_attempts) = (0u32, 0u64);
         let mut fail: Option<FailureCause> = None;
@@ -352,15 +360,22 @@ impl Radau5 {
             n_attempts += 1;
             if n_attempts > self.max_steps {
                 x.copy_from_slice(&self.y);
-                return Err(SolveError { kind: SolveErrorKind::TooManySteps(self.max_steps), t, h });
+                return Err(SolveError {
+                    kind: SolveErrorKind::TooManySteps(self.max_steps),
+                    t,
+                    h,
+                });
             }
             if need_jac {
                 if !self.compute_jacobian(sys, t) {
                     x.copy_from_slice(&self.y);
-                    return Err(SolveError { kind: SolveErrorKind::NonFiniteJacobian, t, h });
+                    return Err(SolveError {
+                        kind: SolveErrorKind::NonFiniteJacobian,
+                        t,
+                        h,
+                    });
                 }
                 caljac = true;
-                self.jac_valid = true;
                 need_jac = false;
                 need_lu = true;
             }
@@ -440,7 +455,6 @@ impl Radau5 {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
                 let hint = if hnew < h { hnew } else { hnew.max(h_nat) };
                 self.h_hint = hint.min(self.max_step);
-                self.theta = theta;
                 x.copy_from_slice(&self.y);
                 return Ok(());
             }
@@ -546,7 +560,10 @@ impl Radau5 {
     ) -> Result<u32, NewtonFail> {
         let n = self.n;
         let (fac1, alphn, betan) = (self.gamma / h, self.alpha / h, self.beta / h);
-        let diverged = NewtonFail { cause: FailureCause::NewtonFailure, hfac: 0.5 };
+        let diverged = NewtonFail {
+            cause: FailureCause::NewtonFailure,
+            hfac: 0.5,
+        };
         self.faccon = self.faccon.max(UROUND).powf(0.8);
         *theta = THET;
         let (mut dynold, mut thqold) = (0.0, 0.0);
@@ -564,7 +581,10 @@ impl Radau5 {
             }
             self.stats.rhs_evals += 3;
             if !(all_finite(&self.z[0]) && all_finite(&self.z[1]) && all_finite(&self.z[2])) {
-                return Err(NewtonFail { cause: FailureCause::NonFiniteRhs, hfac: 0.5 });
+                return Err(NewtonFail {
+                    cause: FailureCause::NonFiniteRhs,
+                    hfac: 0.5,
+                });
             }
             // Right-hand sides of the transformed systems, then solve.
             let mut dyno = 0.0;
@@ -582,14 +602,20 @@ impl Radau5 {
                 self.z[1][i] = self.zc[i].re;
                 self.z[2][i] = self.zc[i].im;
                 let s = self.scal[i];
-                dyno += (self.z[0][i] / s).powi(2) + (self.z[1][i] / s).powi(2) + (self.z[2][i] / s).powi(2);
+                dyno += (self.z[0][i] / s).powi(2)
+                    + (self.z[1][i] / s).powi(2)
+                    + (self.z[2][i] / s).powi(2);
             }
             self.stats.newton_iterations += 1;
             newt += 1;
             let dyno = (dyno / (3 * n) as f64).sqrt();
             if newt > 1 && newt < NIT {
                 let thq = dyno / dynold;
-                *theta = if newt == 2 { thq } else { (thq * thqold).sqrt() };
+                *theta = if newt == 2 {
+                    thq
+                } else {
+                    (thq * thqold).sqrt()
+                };
                 thqold = thq;
                 if *theta < 0.99 {
                     self.faccon = *theta / (1.0 - *theta);
@@ -597,7 +623,10 @@ impl Radau5 {
                     if dyth >= 1.0 {
                         let qnewt = dyth.clamp(1e-4, 20.0);
                         let hfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
-                        return Err(NewtonFail { cause: FailureCause::NewtonFailure, hfac });
+                        return Err(NewtonFail {
+                            cause: FailureCause::NewtonFailure,
+                            hfac,
+                        });
                     }
                 } else {
                     return Err(diverged);
@@ -625,7 +654,13 @@ impl Radau5 {
     }
 
     /// Scaled norm of the embedded error estimate (module doc), at least 1e-10.
-    fn error_estimate<S: OdeSystem + ?Sized>(&mut self, sys: &S, t: f64, h: f64, refine: bool) -> f64 {
+    fn error_estimate<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        h: f64,
+        refine: bool,
+    ) -> f64 {
         let n = self.n;
         let (h1, h2, h3) = (DD1 / h, DD2 / h, DD3 / h);
         // ftmp = (e·Z)/h, tmp = E1⁻¹ (f(t, y) + ftmp).
@@ -689,7 +724,11 @@ fn invalid(msg: String) -> SolveError {
 }
 
 fn invalid_at(t: f64, msg: String) -> SolveError {
-    SolveError { kind: SolveErrorKind::InvalidArgument(msg), t, h: 0.0 }
+    SolveError {
+        kind: SolveErrorKind::InvalidArgument(msg),
+        t,
+        h: 0.0,
+    }
 }
 
 #[cfg(test)]
