@@ -98,14 +98,8 @@ impl AnalyticDeflection {
             0.0, 0.0, -1.0, 0.0, 1.0, 0.0,
         );
         let (s1, s2, s3) = (d.particular(1, x1), d.particular(2, x1), (d.particular(2, x2), d.particular(3, x2)));
-        let u = Vector6::new(
-            -d.particular(1, 0.0).1,
-            s1.1,
-            s1.1 - s2.1,
-            s1.0 - s2.0,
-            s3.0 .1 - s3.1 .1,
-            s3.0 .0 - s3.1 .0,
-        );
+        let u =
+            Vector6::new(-d.particular(1, 0.0).1, s1.1, s1.1 - s2.1, s1.0 - s2.0, s3.0 .1 - s3.1 .1, s3.0 .0 - s3.1 .0);
         d.c = h.lu().solve(&u).ok_or(MechanicsError::SingularJacobian { l_cyl })?;
         Ok(d)
     }

@@ -204,8 +204,8 @@ impl FlexibleBoom {
 
     fn trig(&self, q: &[f64]) -> Trig {
         let mut t = Trig { s: [0.0; MAX_SECTIONS], c: [0.0; MAX_SECTIONS] };
-        for i in 0..self.n {
-            (t.s[i], t.c[i]) = q[i].sin_cos();
+        for (i, a) in q[..self.n].iter().enumerate() {
+            (t.s[i], t.c[i]) = a.sin_cos();
         }
         t
     }
@@ -214,13 +214,13 @@ impl FlexibleBoom {
         let mut r = [Vector2::zeros(); MAX_SECTIONS];
         let p = self.n_ii - 1;
         let mut c = self.b;
-        for j in 0..=p {
-            r[j] = if j < p {
+        for (j, rj) in r.iter_mut().enumerate().take(p + 1) {
+            *rj = if j < p {
                 self.len[j] * Vector2::new(t.c[j], t.s[j])
             } else {
                 Vector2::new(t.c[p] * self.pin.x - t.s[p] * self.pin.y, t.s[p] * self.pin.x + t.c[p] * self.pin.y)
             };
-            c += r[j];
+            c += *rj;
         }
         let l = c.norm();
         Pin { c, u: c / l, l, r }
@@ -228,9 +228,9 @@ impl FlexibleBoom {
 
     /// Generalised forces of gravity, springs and dampers.
     fn forces(&self, q: &[f64], qd: &[f64], t: &Trig, out: &mut [f64]) {
-        for i in 0..self.n {
+        for (i, o) in out[..self.n].iter_mut().enumerate() {
             let s = self.first[i];
-            out[i] = -self.g * ((self.m_out[i] * self.len[i] + s.x) * t.c[i] - s.y * t.s[i]);
+            *o = -self.g * ((self.m_out[i] * self.len[i] + s.x) * t.c[i] - s.y * t.s[i]);
         }
         for i in 0..self.n - 1 {
             let tau = self.k[i] * (q[i + 1] - q[i]) + self.c[i] * (qd[i + 1] - qd[i]);
@@ -333,7 +333,11 @@ impl FlexibleBoom {
                     jac[(row, col)] = (r_h[row] - r[row]) / 1e-9;
                 }
             }
-            let step = jac.clone().lu().solve(&-DVector::from_column_slice(&r)).ok_or(MechanicsError::NoConvergence { l_cyl })?;
+            let step = jac
+                .clone()
+                .lu()
+                .solve(&-DVector::from_column_slice(&r))
+                .ok_or(MechanicsError::NoConvergence { l_cyl })?;
             delta.iter_mut().zip(step.iter()).for_each(|(d, s)| *d += s);
             if step.amax() < 1e-14 {
                 let f = self.static_residual(&delta, l_cyl, &mut q, &mut r)?;
@@ -487,7 +491,12 @@ mod tests {
             let cantilever = -p.m_pl * p.g * span.powi(3) / (3.0 * beam.ei());
             let expected = cantilever * (1.0 + 0.5 / (n * n) as f64);
             let v = boom.tip_deflection(&q);
-            println!("n3 = {n:2}: {:.6} um, lumped formula {:.6} um, cantilever {:.6} um", v * 1e6, expected * 1e6, cantilever * 1e6);
+            println!(
+                "n3 = {n:2}: {:.6} um, lumped formula {:.6} um, cantilever {:.6} um",
+                v * 1e6,
+                expected * 1e6,
+                cantilever * 1e6
+            );
             assert!((v / expected - 1.0).abs() < 1e-8, "n3 = {n}: {v} vs {expected}");
         }
     }
@@ -544,7 +553,10 @@ mod tests {
             let jump = t.w1 * t.phi2.sin() * (t.theta1(0.93) - d.theta2).cos() * d.f_cyl;
             let first = -jump * d.x1 / 2.0 * (d.x_end - d.x1) / beam.ei();
             let error = v - d.tip();
-            println!("n = {n:2}: error {error:.4e} m, n error {:.4e}, first-order coefficient {first:.4e}", error * n as f64);
+            println!(
+                "n = {n:2}: error {error:.4e} m, n error {:.4e}, first-order coefficient {first:.4e}",
+                error * n as f64
+            );
             remainder.push(error * n as f64 - first);
         }
         for w in remainder.windows(2) {
@@ -583,7 +595,8 @@ mod tests {
         boom.pose(&vec![0.0; n - 1], 0.93, &mut y[..n]).unwrap();
         let (_, e0) = energy(&y);
         let h = 5e-7;
-        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp) =
+            (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
         let (mut t_max, mut drift) = (0.0f64, 0.0f64);
         for i in 0..40_000 {
             let t = i as f64 * h;
