@@ -39,6 +39,12 @@ enum Cmd {
         #[arg(long)]
         check: bool,
     },
+    /// Static deflection study of thesis 3.1.2: analytic and lumped end deflections.
+    Deflection {
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// The workspace root (this package's manifest directory).
@@ -149,11 +155,22 @@ fn xml(check: bool) -> Result<(), String> {
     }
 }
 
+fn deflection(json: bool) -> Result<(), String> {
+    let study = boomsim::mechanics::deflection_study::run().map_err(|e| e.to_string())?;
+    if json {
+        println!("{}", study.to_json());
+    } else {
+        print!("{study}");
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Cmd::Pack { out } => pack(&out),
         Cmd::Bench { json, duration } => bench(json, duration),
         Cmd::Xml { check } => xml(check),
+        Cmd::Deflection { json } => deflection(json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

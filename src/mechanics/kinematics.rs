@@ -13,7 +13,7 @@ use super::MechanicsError;
 
 /// Angle opposite the side `opp` of a triangle whose other sides are `adj1`, `adj2` (law of
 /// cosines).
-fn law_of_cosines(adj1: f64, adj2: f64, opp: f64) -> f64 {
+pub(crate) fn law_of_cosines(adj1: f64, adj2: f64, opp: f64) -> f64 {
     ((adj1 * adj1 + adj2 * adj2 - opp * opp) / (2.0 * adj1 * adj2)).acos()
 }
 

@@ -3,13 +3,58 @@
 //! - [`params`]: the boom, payload and cylinder-mechanics parameters with their descriptions;
 //! - [`kinematics`]: the vector triangle (2.1-2.7), mass centre (2.8) and the position, velocity
 //!   and acceleration constraints (2.11-2.15);
-//! - [`rigid_boom`]: the kinetics (2.16-2.19) and the equation of motion in the cylinder stroke.
+//! - [`rigid_boom`]: the kinetics (2.16-2.19) and the equation of motion in the cylinder stroke;
+//! - [`deflection`]: the analytic static deflection (2.20-2.33);
+//! - [`flexible_boom`]: the lumped flexible beam (2.34-2.39, 3.1.2);
+//! - [`deflection_study`]: the static deflection study of 3.1.2 (`boomsim deflection`).
+//!
+//! [`BoomMechanics`] is what a hydraulic model needs from either boom.
 
+pub mod deflection;
+pub mod deflection_study;
+pub mod flexible_boom;
 pub mod kinematics;
 pub mod params;
 pub mod rigid_boom;
 
 use std::fmt;
+
+use nalgebra::Vector2;
+
+/// A boom driven by the cylinder: generalised coordinates q (velocities q_dot) from which the
+/// cylinder stroke follows, and the accelerations under a cylinder force. The cylinder force
+/// `f_cyl` is the net force on the rod (pressure forces minus friction); the boom adds the rod
+/// mass and weight itself.
+pub trait BoomMechanics {
+    /// Number of generalised coordinates.
+    fn dof(&self) -> usize;
+    /// Cylinder stroke x = l_cyl(q) - l_retracted.
+    fn stroke(&self, q: &[f64]) -> f64;
+    /// Stroke rate dx/dt = (dl_cyl/dq) q_dot.
+    fn stroke_rate(&self, q: &[f64], qd: &[f64]) -> f64;
+    /// Writes q_ddot into `out` (length [`dof`](Self::dof)); allocation-free.
+    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]);
+    /// Rest configuration at stroke `x` and the cylinder force that holds it.
+    fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError>;
+    /// Payload mass centre in the global frame (origin: lower cylinder pin A).
+    fn payload(&self, q: &[f64]) -> Vector2<f64>;
+    /// Kinetic and potential energy (J), see the implementations for what they include.
+    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy;
+}
+
+/// A static equilibrium: coordinates and the holding cylinder force on the rod (N).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equilibrium {
+    pub q: Vec<f64>,
+    pub f_cyl: f64,
+}
+
+/// Mechanical energy (J).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub potential: f64,
+}
 
 /// Why a boom geometry or configuration cannot be evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,6 +66,8 @@ pub enum MechanicsError {
     NoConvergence { l_cyl: f64 },
     /// The constraint Jacobian of (2.13) is singular (cylinder axis through the joint).
     SingularJacobian { l_cyl: f64 },
+    /// The lumped beam's layout is impossible (section counts, mount position).
+    InvalidBeam(&'static str),
 }
 
 impl fmt::Display for MechanicsError {
@@ -39,6 +86,7 @@ impl fmt::Display for MechanicsError {
             Self::SingularJacobian { l_cyl } => {
                 write!(f, "singular constraint Jacobian (2.13) at l_cyl = {l_cyl} m")
             }
+            Self::InvalidBeam(why) => write!(f, "lumped beam: {why}"),
         }
     }
 }

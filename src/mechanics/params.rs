@@ -142,10 +142,95 @@ impl BoomParams {
 impl Default for BoomParams {
     /// The defaults of [`SPECS`]: chapter 3.1 geometry (l1 = 0.6 m, l2 = 0.3 m) and payload.
     fn default() -> Self {
-        Self::from_lookup(|name| {
-            SPECS.iter().find(|s| s.name == name).unwrap_or_else(|| panic!("no ParamSpec named {name}")).default
-        })
+        Self::from_lookup(|name| default_of(SPECS, name))
     }
+}
+
+/// Every parameter of the arm's cross-section and of the lumped flexible beam (thesis 2.1.3,
+/// 2.1.4, 3.1.2), SI. Kept apart from [`SPECS`] so that the rigid-boom FMU's variable table does
+/// not change; `boom.n2` and `boom.n3` are structural (integer) parameters.
+#[rustfmt::skip]
+pub const BEAM_SPECS: &[ParamSpec] = &[
+    spec("boom.w_arm", 0.100, "m", "mm", 0.02, 1.0,
+        "Width of the arm's hollow rectangular section (eq. 2.26)",
+        "not in the thesis: the analytic end deflection of 3.1.2 experiment I (22.29 mm, eq. 2.23-2.33) \
+         needs 100.03 mm, i.e. the standard 150x100x6 rectangular hollow section"),
+    spec("boom.h_arm", 0.150, "m", "mm", 0.02, 1.0,
+        "Height of the arm's hollow rectangular section (eq. 2.26)", NOMENCLATURE),
+    spec("boom.t_arm", 0.006, "m", "mm", 0.001, 0.1,
+        "Wall thickness of the arm's hollow rectangular section (eq. 2.26)", NOMENCLATURE),
+    spec("boom.E", 210e9, "Pa", "MPa", 1e9, 1e12,
+        "Young's modulus of the arm", NOMENCLATURE),
+    spec("boom.xi", 0.02, "1", "%", 0.0, 1.0,
+        "Damping ratio of the lumped beam's torsional dampers (eq. 2.36-2.38)", "section 2.1.4, [3, p. 97]"),
+    spec("boom.x_mount", 0.590, "m", "mm", 0.01, 3.0,
+        "Joint B to the boundary between beam parts II and III at the upper cylinder mount",
+        "section 3.1.2, Table 3.1 (the pin itself is at x1 = w1 cos(phi2), eq. 2.25)"),
+    spec("boom.n2", 4.0, "1", "", 0.0, 16.0,
+        "Sections of beam part II, joint B to the cylinder mount (0: rigid)", "section 3.1.2, experiment III"),
+    spec("boom.n3", 5.0, "1", "", 1.0, 16.0,
+        "Sections of beam part III, cylinder mount to the arm's end", "section 3.1.2, experiment II"),
+];
+
+/// The cross-section and lumped-beam parameters as numbers (SI); names and ranges are in
+/// [`BEAM_SPECS`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeamParams {
+    pub w_arm: f64,
+    pub h_arm: f64,
+    pub t_arm: f64,
+    pub e: f64,
+    pub xi: f64,
+    pub x_mount: f64,
+    /// Sections of part II; 0 makes part II one rigid body.
+    pub n2: usize,
+    pub n3: usize,
+}
+
+impl BeamParams {
+    /// Reads every parameter of [`BEAM_SPECS`] by name; `n2`, `n3` are rounded.
+    pub fn from_lookup(value: impl Fn(&str) -> f64) -> Self {
+        Self {
+            w_arm: value("boom.w_arm"),
+            h_arm: value("boom.h_arm"),
+            t_arm: value("boom.t_arm"),
+            e: value("boom.E"),
+            xi: value("boom.xi"),
+            x_mount: value("boom.x_mount"),
+            n2: value("boom.n2").round() as usize,
+            n3: value("boom.n3").round() as usize,
+        }
+    }
+
+    /// Second area moment of the hollow rectangle, eq. (2.26).
+    pub fn i_z(&self) -> f64 {
+        let (w, h, t) = (self.w_arm, self.h_arm, self.t_arm);
+        (w * h.powi(3) - (w - 2.0 * t) * (h - 2.0 * t).powi(3)) / 12.0
+    }
+
+    /// Bending stiffness E I_z (eq. 2.21).
+    pub fn ei(&self) -> f64 {
+        self.e * self.i_z()
+    }
+
+    /// The width w_arm for which (2.26) gives `i_z` at this height and thickness ((2.26) is
+    /// linear in w_arm).
+    pub fn width_for(&self, i_z: f64) -> f64 {
+        let (h, t) = (self.h_arm, self.t_arm);
+        let inner = (h - 2.0 * t).powi(3);
+        (12.0 * i_z - 2.0 * t * inner) / (h.powi(3) - inner)
+    }
+}
+
+impl Default for BeamParams {
+    /// The defaults of [`BEAM_SPECS`].
+    fn default() -> Self {
+        Self::from_lookup(|name| default_of(BEAM_SPECS, name))
+    }
+}
+
+fn default_of(specs: &[ParamSpec], name: &str) -> f64 {
+    specs.iter().find(|s| s.name == name).unwrap_or_else(|| panic!("no ParamSpec named {name}")).default
 }
 
 #[cfg(test)]
@@ -156,20 +241,31 @@ mod tests {
     #[test]
     fn specs_and_struct_name_the_same_parameters() {
         let used = RefCell::new(Vec::new());
-        BoomParams::from_lookup(|n| {
+        let record = |n: &str| {
             used.borrow_mut().push(n.to_string());
             1.0
-        });
+        };
+        BoomParams::from_lookup(record);
+        BeamParams::from_lookup(record);
         let mut used = used.into_inner();
-        let mut named: Vec<String> = SPECS.iter().map(|s| s.name.to_string()).collect();
+        let mut named: Vec<String> = SPECS.iter().chain(BEAM_SPECS).map(|s| s.name.to_string()).collect();
         used.sort();
         named.sort();
         assert_eq!(used, named);
     }
 
+    /// (2.26) for the 150x100x6 section by hand: (0.1 * 0.15^3 - 0.088 * 0.138^3) / 12
+    /// = 8.85247e-6 m^4 (sharp corners); `width_for` inverts it. 1e-6: the hand value has six digits; the inverse is exact to rounding.
+    #[test]
+    fn hollow_section_moment() {
+        let b = BeamParams::default();
+        assert!((b.i_z() / 8.85247e-6 - 1.0).abs() < 1e-6, "{}", b.i_z());
+        assert!((b.width_for(b.i_z()) - b.w_arm).abs() < 1e-12);
+    }
+
     #[test]
     fn specs_are_well_formed() {
-        for s in SPECS {
+        for s in SPECS.iter().chain(BEAM_SPECS) {
             let unit = crate::units::unit(s.unit).unwrap_or_else(|| panic!("{}: unit", s.name));
             assert!(
                 s.display_unit.is_empty() || unit.display.iter().any(|d| d.name == s.display_unit),

@@ -24,7 +24,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 use super::kinematics::BoomKinematics;
 use super::params::BoomParams;
-use super::MechanicsError;
+use super::{BoomMechanics, Energy, Equilibrium, MechanicsError};
 
 /// The rigid boom driven by the cylinder stroke.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -176,6 +176,44 @@ impl RigidBoom {
         let b = Vector3::new(0.0, body.m_d * self.g, body.lever(theta2) * body.m_d * self.g);
         let f = r.lu().solve(&(m * q_ddot + b)).ok_or(MechanicsError::SingularJacobian { l_cyl: l })?;
         Ok(Reactions { r_bx: f.x, r_by: f.y, f_cyl: f.z })
+    }
+}
+
+/// The rigid boom with q = [stroke x], q_dot = [v].
+impl BoomMechanics for RigidBoom {
+    fn dof(&self) -> usize {
+        1
+    }
+
+    fn stroke(&self, q: &[f64]) -> f64 {
+        q[0]
+    }
+
+    fn stroke_rate(&self, _q: &[f64], qd: &[f64]) -> f64 {
+        qd[0]
+    }
+
+    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]) {
+        out[0] = self.acceleration(q[0], qd[0], f_cyl);
+    }
+
+    fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError> {
+        Ok(Equilibrium { q: vec![x], f_cyl: self.static_force(x) })
+    }
+
+    fn payload(&self, q: &[f64]) -> Vector2<f64> {
+        self.state(q[0], 0.0).payload
+    }
+
+    /// J_B theta2_dot^2 / 2 + m_rod v^2 / 2 and m_D g y_D (module doc; the rod weight has no
+    /// potential here either).
+    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy {
+        let body = self.kin.body();
+        let omega = self.state(q[0], qd[0]).theta2_dot;
+        Energy {
+            kinetic: 0.5 * body.j_b * omega * omega + 0.5 * self.m_rod * qd[0] * qd[0],
+            potential: body.m_d * self.g * self.kin.q(self.l_cyl(q[0])).y,
+        }
     }
 }
 
