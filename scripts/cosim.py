@@ -1,0 +1,388 @@
+"""Coupled co-simulation of the two boomsim FMUs through fmpy (FMI 2.0 Co-Simulation).
+
+    HydraulicBoom.p4 --> PressureFeedbackController.p
+    operator reference u_ref(t) (time table) --> PressureFeedbackController.u_ref
+    PressureFeedbackController.u --> HydraulicBoom.valve.u_ref
+
+Usage:
+    .venv/bin/python scripts/cosim.py scripts/scenarios/B.toml [--boom rigid] [--step 1e-3]
+        [--stop-time 15] [--hold] [--out out/cosim]
+writes <out>/<scenario>-<boom>.csv and .png (p3, p4, cylinder velocity, u_ref / u_comp / u).
+
+Coupling (Gauss-Seidel, loop-free). The plant's outputs do not depend directly on valve.u_ref
+(the spool has dynamics); the controller has direct feedthrough p -> u. One communication step
+[t_k, t_k+1] is
+    plant.doStep(t_k, h)                         with valve.u_ref = u_k held over the step
+    p4_k+1 = plant.p4
+    controller.setRealInputDerivatives(p, (p4_k+1 - p4_k) / h)      (unless --hold)
+    controller.doStep(t_k, h)                    the filter sees p4 linear over the step
+    controller.p = p4_k+1, controller.u_ref = u_ref(t_k+1);  u_k+1 = controller.u
+    plant.valve.u_ref = u_k+1
+The controller therefore *interpolates* p4 (the plant has already been stepped, so the slope is
+known, not guessed): no extrapolation is needed, and the filter state is exact for a
+piecewise-linear p4. What the coupling cannot remove is the hold of u: the command applied over
+[t_k, t_k+1] is computed from p4(t_k), i.e. the feedback acts with up to one communication step of
+delay (h/2 on average, a phase lag of omega*h/2). That limits the usable step (see
+scripts/README.md and `scripts/regress --step-sweep`).
+
+The scenario files (scripts/scenarios/*.toml) are documented in scripts/scenarios/README.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import pathlib
+import sys
+import tomllib
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+FMU_DIR = ROOT / "target" / "fmu"
+SCENARIO_DIR = ROOT / "scripts" / "scenarios"
+
+#: Names the flexible-boom switch may get in HydraulicBoom (structural parameter, Integer or
+#: Boolean). Until one of them exists the FMU has the rigid boom only.
+FLEXIBLE_SWITCH = ("boom.flexible", "boom.model", "boom.type")
+
+#: Recorded columns: (CSV name, source, FMU variable).
+PLANT_OUT = ["p1", "p2", "p3", "p4", "valve.u", "cbv.u_cbv", "cylinder.x", "cylinder.v", "Q3", "Q4"]
+CTRL_OUT = ["u", "u_comp"]
+COLUMNS = ["time", "u_ref", "u_comp", "u_cmd"] + PLANT_OUT
+
+
+class Skip(Exception):
+    """A scenario variant that cannot run with the FMUs at hand (reason in the message)."""
+
+
+# --------------------------------------------------------------------------- scenarios
+
+
+def load_scenario(path) -> dict:
+    path = pathlib.Path(path)
+    if not path.exists() and (SCENARIO_DIR / f"{path}.toml").exists():
+        path = SCENARIO_DIR / f"{path}.toml"  # a scenario id
+    with open(path, "rb") as f:
+        sc = tomllib.load(f)
+    sc.setdefault("id", path.stem)
+    sc["file"] = str(path)
+    sc.setdefault("booms", ["rigid"])
+    sc.setdefault("stop_time", 15.0)
+    sc.setdefault("start_stroke", 0.480)
+    sc.setdefault("plant", {})
+    ctrl = sc.setdefault("controller", {})
+    ctrl.setdefault("enable", True)
+    starts = ctrl.setdefault("feedback_start", "t0")
+    sc["starts"] = [starts] if isinstance(starts, str) else list(starts)
+    if not ctrl["enable"]:
+        sc["starts"] = ["t0"]
+    sc.setdefault("step", 1e-3)
+    ref = np.asarray(sc["reference"], dtype=float)
+    if ref.ndim != 2 or ref.shape[1] != 2 or np.any(np.diff(ref[:, 0]) < 0):
+        raise ValueError(f"{path}: reference must be [[t, u_ref], ...] with non-decreasing t")
+    sc["reference"] = ref
+    return sc
+
+
+def all_scenarios() -> list[dict]:
+    order = {"U": 0, "A": 1, "S": 2, "B": 3}
+    paths = sorted(SCENARIO_DIR.glob("*.toml"), key=lambda p: (order.get(p.stem, 4), p.stem))
+    return [load_scenario(p) for p in paths]
+
+
+def reference(table: np.ndarray, t: float) -> float:
+    """Operator reference: piecewise linear through the table rows, right-continuous at
+    repeated times (a row pair [t, a], [t, b] is a step from a to b at t); held after the end."""
+    ts, us = table[:, 0], table[:, 1]
+    i = np.searchsorted(ts, t, side="right")
+    if i == 0:
+        return float(us[0])
+    if i >= len(ts):
+        return float(us[-1])
+    t0, t1, u0, u1 = ts[i - 1], ts[i], us[i - 1], us[i]
+    return float(u0 + (u1 - u0) * (t - t0) / (t1 - t0))
+
+
+# --------------------------------------------------------------------------- FMUs
+
+
+class FmuFile:
+    """An extracted FMU: model description and value references by name."""
+
+    _cache: dict[str, "FmuFile"] = {}
+
+    def __init__(self, identifier: str, fmu_dir=FMU_DIR):
+        from fmpy import extract, read_model_description
+
+        self.path = str(pathlib.Path(fmu_dir) / f"{identifier}.fmu")
+        if not pathlib.Path(self.path).exists():
+            raise FileNotFoundError(f"{self.path} is missing: run `cargo build --release && target/release/boomsim pack`")
+        self.md = read_model_description(self.path)
+        self.dir = extract(self.path)
+        self.vars = {v.name: v for v in self.md.modelVariables}
+        self.vr = {n: v.valueReference for n, v in self.vars.items()}
+
+    @classmethod
+    def get(cls, identifier: str) -> "FmuFile":
+        if identifier not in cls._cache:
+            cls._cache[identifier] = FmuFile(identifier)
+        return cls._cache[identifier]
+
+    def slave(self, name: str):
+        from fmpy.fmi2 import FMU2Slave
+
+        s = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
+                      modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        s.instantiate()
+        return s
+
+    def set(self, slave, name: str, value):
+        v = self.vars[name]
+        if v.type == "Real":
+            slave.setReal([v.valueReference], [float(value)])
+        elif v.type == "Boolean":
+            slave.setBoolean([v.valueReference], [bool(value)])
+        elif v.type in ("Integer", "Enumeration"):
+            slave.setInteger([v.valueReference], [int(value)])
+        else:
+            raise TypeError(f"{name}: unsupported type {v.type}")
+
+
+def boom_switch(plant: FmuFile, boom: str):
+    """(name, value) of the structural parameter selecting `boom`, or None for the rigid boom of
+    an FMU without the switch; raises Skip when the FMU cannot give `boom`."""
+    name = next((n for n in FLEXIBLE_SWITCH if n in plant.vars), None)
+    if boom == "rigid":
+        return None if name is None else (name, 0 if plant.vars[name].type != "Boolean" else False)
+    if boom == "flexible":
+        if name is None:
+            raise Skip("HydraulicBoom has the rigid boom only (no flexible-boom switch "
+                       f"{' / '.join(FLEXIBLE_SWITCH)} in its modelDescription yet)")
+        return name, (1 if plant.vars[name].type != "Boolean" else True)
+    raise ValueError(f"unknown boom {boom!r} (rigid or flexible)")
+
+
+# --------------------------------------------------------------------------- run
+
+
+def variant_name(scenario: dict, boom: str, feedback_start: str = "t0") -> str:
+    """`<id>-<boom>`, with `-cbv` appended for feedback_start = cbv_open."""
+    return f"{scenario['id']}-{boom}" + ("-cbv" if feedback_start == "cbv_open" else "")
+
+
+@dataclasses.dataclass
+class Result:
+    scenario: dict
+    boom: str
+    step: float
+    interpolate: bool
+    data: dict  # column -> np.ndarray
+    feedback_on_at: float | None  # time the feedback was switched on (feedback_start)
+    feedback_start: str = "t0"
+    status: str = "ok"
+
+    @property
+    def name(self) -> str:
+        return variant_name(self.scenario, self.boom, self.feedback_start)
+
+
+def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
+        interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
+        tolerance: float | None = None) -> Result:
+    """Co-simulate one scenario variant. `record_every` thins the recorded rows (default: one
+    row per millisecond or per step, whichever is coarser)."""
+    plant_f, ctrl_f = FmuFile.get("HydraulicBoom"), FmuFile.get("PressureFeedbackController")
+    switch = boom_switch(plant_f, boom)
+    t_end = scenario["stop_time"] if stop_time is None else stop_time
+    step = scenario["step"] if step is None else step
+    n = int(round(t_end / step))
+    if abs(n * step - t_end) > 1e-9 * t_end:
+        raise ValueError(f"stop time {t_end} is not a multiple of the step {step}")
+    if record_every is None:
+        record_every = max(1, int(round(1e-3 / step)))
+    ctrl_cfg = scenario["controller"]
+    fb_start = feedback_start or scenario["starts"][0]
+    if fb_start not in ("t0", "cbv_open"):
+        raise ValueError(f"feedback_start must be 't0' or 'cbv_open', got {fb_start!r}")
+    enable = bool(ctrl_cfg["enable"])
+    table = scenario["reference"]
+
+    plant = plant_f.slave(f"{scenario['id']}.plant")
+    ctrl = ctrl_f.slave(f"{scenario['id']}.controller")
+    vp, vc = plant_f.vr, ctrl_f.vr
+    try:
+        for s in (plant, ctrl):
+            s.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
+            s.enterInitializationMode()
+        plant_f.set(plant, "start.x", scenario["start_stroke"])
+        if switch:
+            plant_f.set(plant, *switch)
+        for name, value in scenario["plant"].items():
+            plant_f.set(plant, name, value)
+        plant.exitInitializationMode()
+        p4 = plant.getReal([vp["p4"]])[0]
+
+        def init_controller(t0: float, feedback: bool, first: bool):
+            """(Re-)initialise the controller at t0: its filter starts at rest at the present p4."""
+            if not first:
+                ctrl.reset()
+                ctrl.setupExperiment(tolerance=tolerance, startTime=t0, stopTime=t_end)
+                ctrl.enterInitializationMode()
+            for name in ("K_f", "omega_f", "u_min", "u_max"):
+                if name in ctrl_cfg:
+                    ctrl_f.set(ctrl, name, ctrl_cfg[name])
+            ctrl_f.set(ctrl, "enable", feedback)
+            ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, t0)])
+            ctrl.exitInitializationMode()
+
+        on = enable and fb_start == "t0"
+        init_controller(0.0, on, True)
+        fb_on_at = 0.0 if on else None
+
+        out_p = [vp[k] for k in PLANT_OUT]
+        i_p4, i_cbv = PLANT_OUT.index("p4"), PLANT_OUT.index("cbv.u_cbv")
+        out_c = [vc["u"], vc["u_comp"]]
+        rows = []
+        y = plant.getReal(out_p)
+        t = 0.0
+        u_ref = reference(table, 0.0)
+        for k in range(n + 1):
+            t = k * step
+            u, u_comp = ctrl.getReal(out_c)
+            plant.setReal([vp["valve.u_ref"]], [u])
+            if k % record_every == 0:
+                rows.append([t, u_ref, u_comp, u, *y])
+            if k == n:
+                break
+            plant.doStep(t, step)
+            y = plant.getReal(out_p)
+            p4_next = y[i_p4]
+            if interpolate:
+                ctrl.setRealInputDerivatives([vc["p"]], [1], [(p4_next - p4) / step])
+            ctrl.doStep(t, step)
+            p4 = p4_next
+            u_ref = reference(table, t + step)
+            if enable and not on and y[i_cbv] > 0.0:
+                # feedback_start = "cbv_open": the feedback starts when the CBV cracks open, from
+                # rest (the controller is re-initialised: filter state = present p4, no kick)
+                on, fb_on_at = True, t + step
+                init_controller(t + step, True, False)
+            ctrl.setReal([vc["p"], vc["u_ref"]], [p4, u_ref])
+        data = np.array(rows)
+    finally:
+        for s in (plant, ctrl):
+            try:
+                s.terminate()
+            except Exception:  # noqa: BLE001 - terminate after an error may be refused
+                pass
+            s.freeInstance()
+    return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at,
+                  fb_start)
+
+
+# --------------------------------------------------------------------------- output
+
+BAR = 1e5
+
+
+def write_csv(res: Result, path):
+    cols = list(res.data)
+    arr = np.column_stack([res.data[c] for c in cols])
+    header = ",".join(cols)
+    np.savetxt(path, arr, delimiter=",", header=header, comments="", fmt="%.9g")
+
+
+def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
+    """p3/p4, cylinder velocity and spool openings over time, like thesis Fig. 6.7-6.12
+    (simulation) and 7.1-7.6 (rig); the sign is flipped so lowering shows as a positive
+    opening, as in the thesis' simulation tool."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    d = res.data
+    t = d["time"]
+    sc = res.scenario
+    fig, axes = plt.subplots(3, 2, sharex="col", figsize=(13, 9), constrained_layout=True,
+                             gridspec_kw={"width_ratios": [3, 2]})
+    q_rated = 25e-3 / 60
+    a_rod = math.pi / 4 * (0.065**2 - 0.035**2)
+    u_ss = abs(sc["reference"][-1, 1])
+    for col, t_max in ((0, t[-1]), (1, min(zoom, t[-1]))):
+        ax = axes[:, col]
+        a = ax[0]
+        a.plot(t, d["p3"] / BAR, label="p3 piston side")
+        a.plot(t, d["p4"] / BAR, label="p4 rod side (fed back)")
+        a.plot(t, d["p2"] / BAR, label="p2 CBV back pressure", lw=0.8, alpha=0.7)
+        a.set_ylabel("pressure [bar]")
+        a = ax[1]
+        a.plot(t, -d["cylinder.v"] * 1e3, label="v_c (lowering > 0)")
+        a.axhline(q_rated * u_ss / a_rod * 1e3, color="k", ls=":", lw=1, label="Q_rated |u_ref| / A_rod")
+        a.set_ylabel("lowering velocity [mm/s]")
+        a = ax[2]
+        a.plot(t, -d["u_ref"], label="u_ref (operator)")
+        a.plot(t, -d["u_comp"], label="u_comp (feedback)")
+        a.plot(t, -d["valve.u"], label="u (main spool opening)")
+        a.set_ylabel("spool opening, lowering > 0 [-]")
+        a.set_xlabel("time [s]")
+        a.set_xlim(0, t_max)
+        for a in ax:
+            a.grid(alpha=0.3)
+            if col == 0:
+                a.legend(loc="upper right", fontsize=8)
+        ax[0].set_title("whole record" if col == 0 else f"first {t_max:g} s", fontsize=9)
+    c = sc["controller"]
+    filt = (f"K_f = {c['K_f']:.3g} m^4s^2/kg, omega_f = {c['omega_f']:.4g} rad/s" if c["enable"]
+            else "no compensation")
+    if c["enable"] and res.feedback_on_at not in (None, 0.0):
+        filt += f", feedback on at {res.feedback_on_at:.3f} s (CBV open)"
+    title = f"{sc['id']} ({res.boom} boom): u_ref = {sc['reference'][-1, 1]:+.2f}, {filt}, communication step {res.step:g} s"
+    if metrics:
+        tm = metrics.get("t_motion")
+        title += "\nload starts lowering (CBV flow) at " + (f"{tm:.2f} s" if tm is not None else "- (never)")
+        ts = metrics.get("t_settle")
+        title += f"; p3 settles (2 %) at {ts:.2f} s" if ts is not None else "; p3 does not settle (2 %)"
+    fig.suptitle(title, fontsize=10)
+    axes[0, 0].figure.align_ylabels(axes[:, 0])
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("scenario", help="scenario file or id (e.g. B or scripts/scenarios/B.toml)")
+    ap.add_argument("--boom", default=None, help="rigid or flexible (default: every boom of the scenario)")
+    ap.add_argument("--step", type=float, default=None,
+                    help="communication step [s] (default: the scenario's `step`, else 1e-3)")
+    ap.add_argument("--stop-time", type=float, default=None)
+    ap.add_argument("--hold", action="store_true", help="hold p4 over a step in the controller (no slope)")
+    ap.add_argument("--feedback-start", choices=("t0", "cbv_open"), default=None,
+                    help="only this feedback start (default: every start listed by the scenario)")
+    ap.add_argument("--out", default=str(ROOT / "out" / "cosim"))
+    args = ap.parse_args(argv)
+    sys.path.insert(0, str(pathlib.Path(__file__).parent))
+    from metrics import compute
+
+    sc = load_scenario(args.scenario)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    variants = [(b, f) for b in ([args.boom] if args.boom else sc["booms"])
+                for f in ([args.feedback_start] if args.feedback_start else sc["starts"])]
+    for boom, fb in variants:
+        try:
+            res = run(sc, boom, args.step, args.stop_time, not args.hold, feedback_start=fb)
+        except Skip as e:
+            print(f"{variant_name(sc, boom, fb)}: skipped: {e}")
+            continue
+        m = compute(res)
+        write_csv(res, out / f"{res.name}.csv")
+        plot(res, out / f"{res.name}.png", m)
+        print(f"{res.name}: " + ", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}"
+                                          for k, v in m.items()))
+
+
+if __name__ == "__main__":
+    main()

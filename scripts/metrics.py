@@ -1,0 +1,143 @@
+"""Metrics of one co-simulation result (definitions in scripts/README.md, section Metrics).
+
+All metrics are computed from the recorded rows of cosim.Result.data (SI units in, display units
+out: bar, mm/s, s, Hz, spool units).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+BAR = 1e5
+#: Rated flow of the PVG32 spool per unit opening (thesis 2.2.1) and the cylinder areas
+#: (parameter list: bore 65 mm, rod 35 mm): the independent expectation of the lowering speed.
+Q_RATED = 25e-3 / 60
+A_PISTON = math.pi / 4 * 0.065**2
+A_ROD_SIDE = math.pi / 4 * (0.065**2 - 0.035**2)
+#: Settling band: 2 % (thesis 6.2 and Table 6.3 use the 2 % criterion).
+BAND = 0.02
+#: Window of the peak-to-peak values [s].
+WINDOW = 1.0
+#: Motion start: the cylinder lowers faster than this fraction of the expected steady speed.
+MOTION_FRACTION = 0.1
+
+
+def expected_velocity(u_ref: float) -> float:
+    """Steady lowering speed of the uncompensated, pressure-compensated valve: the rated flow
+    times the opening into the rod side, v = -Q_rated |u| / A_rod_side [m/s] (< 0: lowering)."""
+    return -Q_RATED * abs(u_ref) / A_ROD_SIDE
+
+
+def moving_average(y: np.ndarray, n: int) -> np.ndarray:
+    """Centred moving average over n samples, the window shrinking at both ends."""
+    c = np.concatenate([[0.0], np.cumsum(y)])
+    i = np.arange(len(y))
+    lo = np.clip(i - n // 2, 0, len(y))
+    hi = np.clip(i + n - n // 2, 0, len(y))
+    return (c[hi] - c[lo]) / (hi - lo)
+
+
+def settling_time(t: np.ndarray, y: np.ndarray, band: float = BAND, tail: float = 2.0):
+    """2 % settling time: the first time after which |y - y_f(t)| stays within band * |y_f(t)|,
+    where the final value y_f(t) is the straight line fitted to the last `tail` seconds
+    (p3 drifts slowly as the boom lowers and the load arm changes, so a constant final value
+    would call a settled run unsettled). None if y is outside the band at any time of that last
+    part: it has not settled within the record."""
+    tail_ = t >= t[-1] - tail
+    y_f = np.polyval(np.polyfit(t[tail_], y[tail_], 1), t)
+    out = np.abs(y - y_f) > band * np.abs(y_f)
+    if not out.any():
+        return float(t[0])
+    last = int(np.nonzero(out)[0][-1])
+    if tail_[last]:
+        return None
+    return float(t[last + 1])
+
+
+def window_ptp(t: np.ndarray, y: np.ndarray, window: float = WINDOW) -> np.ndarray:
+    """Peak-to-peak of y in consecutive windows [0, w), [w, 2w), ..."""
+    k = np.floor((t - t[0]) / window + 1e-9).astype(int)
+    n = int(round((t[-1] - t[0]) / window))
+    return np.array([np.ptp(y[k == i]) for i in range(n) if np.any(k == i)])
+
+
+def dominant_frequency(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """(frequency [Hz], amplitude) of the largest peak of the Hann-windowed spectrum of the
+    detrended y, refined by parabolic interpolation of the log magnitude; 0.3 Hz and up (below,
+    the slow drift of the lowering motion)."""
+    y = y - np.polyval(np.polyfit(t, y, 1), t)
+    w = np.hanning(len(y))
+    spec = np.abs(np.fft.rfft(y * w)) * 2 / w.sum()
+    f = np.fft.rfftfreq(len(y), t[1] - t[0])
+    ok = f >= 0.3
+    i = int(np.argmax(np.where(ok, spec, 0.0)))
+    if 0 < i < len(spec) - 1 and spec[i] > 0 and spec[i] >= max(spec[i - 1], spec[i + 1]):
+        a, b, c = np.log(spec[i - 1 : i + 2] + 1e-300)
+        d = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
+        return float(f[i] + np.clip(d, -0.5, 0.5) * (f[1] - f[0])), float(spec[i])
+    return float(f[i]), float(spec[i])
+
+
+def compute(res) -> dict:
+    """The regression metrics of one result (see scripts/README.md)."""
+    d = res.data
+    t, p3, v, u_comp = d["time"], d["p3"], d["cylinder.v"], d["u_comp"]
+    u_ss = float(res.scenario["reference"][-1, 1])
+    v_exp = expected_velocity(u_ss)
+    t_end = t[-1]
+    m = {}
+    ptp = window_ptp(t, p3) / BAR
+    m["p3_pp_max"] = float(ptp.max())
+    # the last third of the record (5 s of 15): the sustained oscillation, or what is left of it
+    late = t >= t_end - t_end / 3
+    m["p3_pp_late"] = float(ptp[-max(1, int(round(t_end / 3 / WINDOW))):].mean())
+    ts = settling_time(t, p3)
+    # motion start: the load lowers, i.e. oil leaves the piston side through the CBV faster
+    # than 10 % of the expected steady flow (before that the piston only creeps while the
+    # rising p4 compresses the piston-side oil against the closed CBV)
+    q_exp = abs(v_exp) * A_PISTON
+    moving = np.nonzero(-d["Q3"] > MOTION_FRACTION * q_exp)[0]
+    m["t_motion"] = float(t[moving[0]]) if len(moving) else None
+    cbv = np.nonzero(d["cbv.u_cbv"] > 0)[0]
+    m["t_cbv_open"] = float(t[cbv[0]]) if len(cbv) else None
+    if m["t_motion"] is None:
+        ts = None  # a load that never moves has not answered the step
+    elif ts is not None:
+        ts = max(ts, m["t_motion"])  # p3 may sit in the band before the load moves
+    m["t_settle"] = ts
+    m["t_settle_motion"] = None if ts is None else max(0.0, ts - m["t_motion"])
+    m["v_expected"] = v_exp * 1e3
+    # mean velocity from the motion start to the end: displacement / time
+    if m["t_motion"] is not None:
+        i0 = moving[0]
+        m["v_mean"] = float((d["cylinder.x"][-1] - d["cylinder.x"][i0]) / (t_end - t[i0]) * 1e3)
+    else:
+        m["v_mean"] = 0.0
+    m["v_steady"] = float(v[late].mean() * 1e3)
+    f, amp = dominant_frequency(t[late], p3[late])
+    m["f_dom"] = f
+    m["f_dom_amp"] = amp / BAR
+    after = t >= (ts if ts is not None else t_end - t_end / 3)
+    m["u_comp_rms"] = float(np.sqrt(np.mean(u_comp[after] ** 2)))
+    m["u_comp_max"] = float(u_comp.max())
+    return m
+
+
+#: Units and one-line definitions, for the reports.
+DEFINITIONS = {
+    "p3_pp_max": ("bar", "largest p3 peak-to-peak of the 1 s windows"),
+    "p3_pp_late": ("bar", "mean p3 peak-to-peak of the 1 s windows of the last third (10-15 s)"),
+    "t_settle": ("s", "2 % settling time of p3 to the line fitted to its last 2 s (- = not settled)"),
+    "t_settle_motion": ("s", "settling time counted from the motion start (thesis 6.2 counts from the step)"),
+    "t_motion": ("s", "motion start: CBV outflow above 10 % of the expected steady flow"),
+    "t_cbv_open": ("s", "first opening of the CBV's load-holding valve"),
+    "v_expected": ("mm/s", "-Q_rated |u_ref| / A_rod_side"),
+    "v_mean": ("mm/s", "mean velocity from the motion start to the end (displacement / time)"),
+    "v_steady": ("mm/s", "mean velocity over the last third"),
+    "f_dom": ("Hz", "dominant frequency of p3 over the last third (>= 0.3 Hz)"),
+    "f_dom_amp": ("bar", "amplitude of that spectral peak"),
+    "u_comp_rms": ("1", "RMS of u_comp after the settling time (last third if not settled)"),
+    "u_comp_max": ("1", "largest u_comp (> 0 closes the valve while lowering)"),
+}
