@@ -359,7 +359,8 @@ impl Model for HydraulicBoom {
         let state = saved.get(..N_STATES).filter(|s| s.iter().all(|x| x.is_finite()));
         let state = state.ok_or_else(|| format!("expected {N_STATES} finite states, got {saved:?}"))?;
         let mut m = Self::with_state(values, state.try_into().expect("length checked"))?;
-        let solver_state = saved[N_STATES..].try_into().map_err(|_| format!("expected {} solver numbers", Radau5::STATE_LEN))?;
+        let solver_state =
+            saved[N_STATES..].try_into().map_err(|_| format!("expected {} solver numbers", Radau5::STATE_LEN))?;
         m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
         Ok(m)
     }

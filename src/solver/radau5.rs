@@ -196,16 +196,10 @@ impl Radau5 {
     /// Sets the absolute tolerances, one per state (positive, finite).
     pub fn set_atol(&mut self, atol: &[f64]) -> Result<(), SolveError> {
         if atol.len() != self.n {
-            return Err(invalid(format!(
-                "atol has {} entries, expected {}",
-                atol.len(),
-                self.n
-            )));
+            return Err(invalid(format!("atol has {} entries, expected {}", atol.len(), self.n)));
         }
         if let Some(a) = atol.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
-            return Err(invalid(format!(
-                "atol entry {a} is not positive and finite"
-            )));
+            return Err(invalid(format!("atol entry {a} is not positive and finite")));
         }
         self.atol.copy_from_slice(atol);
         Ok(())
@@ -259,10 +253,7 @@ impl Radau5 {
     /// Restores a state from [`save_state`](Self::save_state).
     pub fn load_state(&mut self, s: &[f64; Self::STATE_LEN]) -> Result<(), SolveError> {
         if !(s[0] >= 0.0 && s[0].is_finite()) {
-            return Err(invalid(format!(
-                "step-size hint {} is not finite and >= 0",
-                s[0]
-            )));
+            return Err(invalid(format!("step-size hint {} is not finite and >= 0", s[0])));
         }
         self.h_hint = s[0];
         Ok(())
@@ -282,20 +273,10 @@ impl Radau5 {
     ) -> Result<(), SolveError> {
         let n = self.n;
         if sys.dim() != n || x.len() != n {
-            return Err(invalid_at(
-                t0,
-                format!(
-                    "system dimension {} / state length {} != {n}",
-                    sys.dim(),
-                    x.len()
-                ),
-            ));
+            return Err(invalid_at(t0, format!("system dimension {} / state length {} != {n}", sys.dim(), x.len())));
         }
         if !(t0.is_finite() && t_end.is_finite() && t_end >= t0) {
-            return Err(invalid_at(
-                t0,
-                format!("time interval [{t0}, {t_end}] is not valid"),
-            ));
+            return Err(invalid_at(t0, format!("time interval [{t0}, {t_end}] is not valid")));
         }
         if x.iter().any(|v| !v.is_finite()) {
             return Err(invalid_at(t0, "initial state is not finite".into()));
@@ -308,11 +289,7 @@ impl Radau5 {
         sys.rhs(t, &self.y, &mut self.y0);
         self.stats.rhs_evals += 1;
         if !all_finite(&self.y0) {
-            return Err(SolveError {
-                kind: SolveErrorKind::NonFiniteInitialRhs,
-                t,
-                h: 0.0,
-            });
+            return Err(SolveError { kind: SolveErrorKind::NonFiniteInitialRhs, t, h: 0.0 });
         }
         self.update_scal();
 
@@ -321,12 +298,7 @@ impl Radau5 {
         let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_end.abs());
         let cfac = SAFE * (1 + 2 * NIT) as f64;
 
-        let mut h_nat = if self.h_hint > 0.0 {
-            self.h_hint
-        } else {
-            H_INITIAL
-        }
-        .min(self.max_step);
+        let mut h_nat = if self.h_hint > 0.0 { self.h_hint } else { H_INITIAL }.min(self.max_step);
         let (mut h, mut last) = plan(t, t_end, h_nat);
         let (mut first, mut reject) = (true, false);
         let (mut need_jac, mut need_lu, mut caljac) = (true, true, false);
@@ -360,20 +332,12 @@ impl Radau5 {
             n_attempts += 1;
             if n_attempts > self.max_steps {
                 x.copy_from_slice(&self.y);
-                return Err(SolveError {
-                    kind: SolveErrorKind::TooManySteps(self.max_steps),
-                    t,
-                    h,
-                });
+                return Err(SolveError { kind: SolveErrorKind::TooManySteps(self.max_steps), t, h });
             }
             if need_jac {
                 if !self.compute_jacobian(sys, t) {
                     x.copy_from_slice(&self.y);
-                    return Err(SolveError {
-                        kind: SolveErrorKind::NonFiniteJacobian,
-                        t,
-                        h,
-                    });
+                    return Err(SolveError { kind: SolveErrorKind::NonFiniteJacobian, t, h });
                 }
                 caljac = true;
                 need_jac = false;
@@ -560,10 +524,7 @@ impl Radau5 {
     ) -> Result<u32, NewtonFail> {
         let n = self.n;
         let (fac1, alphn, betan) = (self.gamma / h, self.alpha / h, self.beta / h);
-        let diverged = NewtonFail {
-            cause: FailureCause::NewtonFailure,
-            hfac: 0.5,
-        };
+        let diverged = NewtonFail { cause: FailureCause::NewtonFailure, hfac: 0.5 };
         self.faccon = self.faccon.max(UROUND).powf(0.8);
         *theta = THET;
         let (mut dynold, mut thqold) = (0.0, 0.0);
@@ -581,10 +542,7 @@ impl Radau5 {
             }
             self.stats.rhs_evals += 3;
             if !(all_finite(&self.z[0]) && all_finite(&self.z[1]) && all_finite(&self.z[2])) {
-                return Err(NewtonFail {
-                    cause: FailureCause::NonFiniteRhs,
-                    hfac: 0.5,
-                });
+                return Err(NewtonFail { cause: FailureCause::NonFiniteRhs, hfac: 0.5 });
             }
             // Right-hand sides of the transformed systems, then solve.
             let mut dyno = 0.0;
@@ -602,20 +560,14 @@ impl Radau5 {
                 self.z[1][i] = self.zc[i].re;
                 self.z[2][i] = self.zc[i].im;
                 let s = self.scal[i];
-                dyno += (self.z[0][i] / s).powi(2)
-                    + (self.z[1][i] / s).powi(2)
-                    + (self.z[2][i] / s).powi(2);
+                dyno += (self.z[0][i] / s).powi(2) + (self.z[1][i] / s).powi(2) + (self.z[2][i] / s).powi(2);
             }
             self.stats.newton_iterations += 1;
             newt += 1;
             let dyno = (dyno / (3 * n) as f64).sqrt();
             if newt > 1 && newt < NIT {
                 let thq = dyno / dynold;
-                *theta = if newt == 2 {
-                    thq
-                } else {
-                    (thq * thqold).sqrt()
-                };
+                *theta = if newt == 2 { thq } else { (thq * thqold).sqrt() };
                 thqold = thq;
                 if *theta < 0.99 {
                     self.faccon = *theta / (1.0 - *theta);
@@ -623,10 +575,7 @@ impl Radau5 {
                     if dyth >= 1.0 {
                         let qnewt = dyth.clamp(1e-4, 20.0);
                         let hfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
-                        return Err(NewtonFail {
-                            cause: FailureCause::NewtonFailure,
-                            hfac,
-                        });
+                        return Err(NewtonFail { cause: FailureCause::NewtonFailure, hfac });
                     }
                 } else {
                     return Err(diverged);
@@ -654,13 +603,7 @@ impl Radau5 {
     }
 
     /// Scaled norm of the embedded error estimate (module doc), at least 1e-10.
-    fn error_estimate<S: OdeSystem + ?Sized>(
-        &mut self,
-        sys: &S,
-        t: f64,
-        h: f64,
-        refine: bool,
-    ) -> f64 {
+    fn error_estimate<S: OdeSystem + ?Sized>(&mut self, sys: &S, t: f64, h: f64, refine: bool) -> f64 {
         let n = self.n;
         let (h1, h2, h3) = (DD1 / h, DD2 / h, DD3 / h);
         // ftmp = (e·Z)/h, tmp = E1⁻¹ (f(t, y) + ftmp).
@@ -724,11 +667,7 @@ fn invalid(msg: String) -> SolveError {
 }
 
 fn invalid_at(t: f64, msg: String) -> SolveError {
-    SolveError {
-        kind: SolveErrorKind::InvalidArgument(msg),
-        t,
-        h: 0.0,
-    }
+    SolveError { kind: SolveErrorKind::InvalidArgument(msg), t, h: 0.0 }
 }
 
 #[cfg(test)]

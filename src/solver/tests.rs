@@ -11,11 +11,7 @@ struct Linear;
 impl Linear {
     fn exact(t: f64) -> [f64; 3] {
         let d = (-0.3 * t).exp();
-        [
-            t.sin() + (-2.0 * t).exp(),
-            d * (2.0 * t).cos(),
-            d * (2.0 * t).sin(),
-        ]
+        [t.sin() + (-2.0 * t).exp(), d * (2.0 * t).cos(), d * (2.0 * t).sin()]
     }
 }
 
@@ -40,10 +36,7 @@ impl OdeSystem for Linear {
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max)
+    a.iter().zip(b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
 }
 
 /// Fixed steps: a loose tolerance keeps the error test passing and `max_step` pins `h`; the
@@ -67,10 +60,7 @@ fn convergence_order_is_five() {
     }
     for k in 0..2 {
         let order = (errs[k] / errs[k + 1]).log2();
-        assert!(
-            (order - 5.0).abs() < 0.3,
-            "measured order {order}, errors {errs:?}"
-        );
+        assert!((order - 5.0).abs() < 0.3, "measured order {order}, errors {errs:?}");
     }
     // Far above round-off, so the ratios measure truncation error.
     assert!(errs[2] > 1e-12, "{errs:?}");
@@ -95,9 +85,7 @@ impl OdeSystem for Decay {
 /// state there matches `e^{-t}` within the tolerance (global error ~ rtol for this decay).
 #[test]
 fn lands_exactly_on_t_end() {
-    let sys = Decay {
-        t_max: Cell::new(0.0),
-    };
+    let sys = Decay { t_max: Cell::new(0.0) };
     let mut s = Radau5::new(1);
     let mut x = [1.0];
     let mut t = 0.0;
@@ -105,11 +93,7 @@ fn lands_exactly_on_t_end() {
         sys.t_max.set(f64::NEG_INFINITY);
         s.integrate(&sys, t, &mut x, t_end).unwrap();
         assert_eq!(sys.t_max.get(), t_end);
-        assert!(
-            (x[0] - (-t_end).exp()).abs() < 1e-6 * (-t_end).exp(),
-            "{} at {t_end}",
-            x[0]
-        );
+        assert!((x[0] - (-t_end).exp()).abs() < 1e-6 * (-t_end).exp(), "{} at {t_end}", x[0]);
         t = t_end;
     }
 }
@@ -136,8 +120,7 @@ impl OdeSystem for OilColumn {
 
 fn oil_tolerances(s: &mut Radau5, rtol: f64) {
     s.set_rtol(rtol).unwrap();
-    s.set_atol(&[1e2 * rtol / 1e-6, 1e-9 * rtol / 1e-6, 1e-7 * rtol / 1e-6])
-        .unwrap();
+    s.set_atol(&[1e2 * rtol / 1e-6, 1e-9 * rtol / 1e-6, 1e-7 * rtol / 1e-6]).unwrap();
 }
 
 fn run_oil(rtol: f64, comm: f64, t_end: f64) -> ([f64; 3], SolverStats) {
@@ -155,9 +138,7 @@ fn run_oil(rtol: f64, comm: f64, t_end: f64) -> ([f64; 3], SolverStats) {
 /// Weighted error `max |a - b| / (atol + rtol |b|)` with the atol of [`oil_tolerances`] at 1e-6.
 fn oil_err(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let atol = [1e2, 1e-9, 1e-7];
-    (0..3)
-        .map(|i| (a[i] - b[i]).abs() / (atol[i] + 1e-6 * b[i].abs()))
-        .fold(0.0, f64::max)
+    (0..3).map(|i| (a[i] - b[i]).abs() / (atol[i] + 1e-6 * b[i].abs())).fold(0.0, f64::max)
 }
 
 /// The FMU calls `integrate` once per communication step. Communication steps 1e-5, 1e-3 and
@@ -172,10 +153,7 @@ fn communication_step_does_not_change_trajectory() {
     for comm in [1e-5, 1e-3, 0.1] {
         let (x, st) = run_oil(1e-6, comm, 0.2);
         let e = oil_err(&x, &reference);
-        assert!(
-            e < 3.0,
-            "comm step {comm}: weighted error {e}, {x:?} vs {reference:?}, {st:?}"
-        );
+        assert!(e < 3.0, "comm step {comm}: weighted error {e}, {x:?} vs {reference:?}, {st:?}");
     }
 }
 
@@ -187,14 +165,8 @@ fn communication_step_does_not_change_trajectory() {
 #[test]
 fn error_scales_with_tolerance() {
     let (reference, _) = run_oil(1e-11, 0.2, 0.2);
-    let errs: Vec<f64> = [1e-4, 1e-6, 1e-8]
-        .iter()
-        .map(|&r| oil_err(&run_oil(r, 0.2, 0.2).0, &reference))
-        .collect();
-    assert!(
-        errs[0] > 10.0 * errs[1] && errs[1] > 10.0 * errs[2],
-        "{errs:?}"
-    );
+    let errs: Vec<f64> = [1e-4, 1e-6, 1e-8].iter().map(|&r| oil_err(&run_oil(r, 0.2, 0.2).0, &reference)).collect();
+    assert!(errs[0] > 10.0 * errs[1] && errs[1] > 10.0 * errs[2], "{errs:?}");
     assert!(errs[1] < 3.0, "{errs:?}");
 }
 
@@ -221,12 +193,7 @@ fn nan_rhs_returns_error_at_last_good_state() {
             | SolveErrorKind::TooManyRejections(FailureCause::NonFiniteRhs)
     ));
     assert!(e.t <= 0.5 && e.t > 0.5 - 1e-6, "{e}");
-    assert!(
-        (x[0] - (-e.t).exp()).abs() < 1e-6,
-        "x = {} at t = {}",
-        x[0],
-        e.t
-    );
+    assert!((x[0] - (-e.t).exp()).abs() < 1e-6, "x = {} at t = {}", x[0], e.t);
     assert!(e.to_string().contains("NaN"), "{e}");
 }
 
@@ -282,16 +249,7 @@ fn invalid_arguments_are_reported() {
     assert!(s.set_rtol(0.0).is_err());
     let e = s.integrate(&Linear, 1.0, &mut x, 0.5).unwrap_err();
     assert!(matches!(e.kind, SolveErrorKind::InvalidArgument(_)));
-    let e = s
-        .integrate(
-            &Decay {
-                t_max: Cell::new(0.0),
-            },
-            0.0,
-            &mut x,
-            1.0,
-        )
-        .unwrap_err();
+    let e = s.integrate(&Decay { t_max: Cell::new(0.0) }, 0.0, &mut x, 1.0).unwrap_err();
     assert!(matches!(e.kind, SolveErrorKind::InvalidArgument(_)));
     assert_eq!(x, [1.0; 3]);
 }
