@@ -1,22 +1,22 @@
 //! The HydraulicBoom FMU model: the circuit of thesis Fig. 2.8 ([`crate::hydraulics::circuit`])
-//! driving the rigid boom of sections 2.1.1-2.1.2 ([`crate::mechanics::rigid_boom`]), advanced
-//! inside fmi2DoStep by the stiff Radau IIA integrator ([`crate::solver`]).
+//! driving the boom, rigid (sections 2.1.1-2.1.2, [`crate::mechanics::rigid_boom`]) or lumped
+//! flexible (2.1.4, 3.1.2, [`crate::mechanics::flexible_boom`]), advanced inside fmi2DoStep by
+//! the stiff Radau IIA integrator ([`crate::solver`]).
 //!
-//! States: the circuit's six (p1..p4, spool position, load-holding opening) and the cylinder
-//! stroke and velocity. The operator's reference `valve.u_ref` is held over each step.
+//! States: the circuit's six (p1..p4, spool position, load-holding opening), then the boom's
+//! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
+//! angle of each section). The operator's reference `valve.u_ref` is held over each step.
 
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::mechanics::params::{BoomParams, SPECS as BOOM_SPECS};
+use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
+use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
 use crate::mechanics::rigid_boom::RigidBoom;
+use crate::mechanics::BoomMechanics;
 use crate::params::ParamSpec;
 use crate::solver::{OdeSystem, Radau5};
 
-/// Number of continuous states: the circuit's plus stroke and velocity.
-pub const N_STATES: usize = N_CIRCUIT + 2;
-const X: usize = N_CIRCUIT;
-const V: usize = N_CIRCUIT + 1;
 
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
@@ -48,10 +48,16 @@ pub mod vr {
     pub const SOLVER_RHS: u32 = 25;
     pub const SOLVER_JACOBIANS: u32 = 26;
     pub const X0: u32 = 30;
+    pub const FLEXIBLE: u32 = 31;
+    pub const TIP_DEFLECTION: u32 = 40;
+    /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
+    pub const SECTIONS: u32 = 41;
     /// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
     pub const HYDRAULICS: u32 = 100;
     /// Boom parameters: `BOOM + index` in [`crate::mechanics::params::SPECS`].
     pub const BOOM: u32 = 200;
+    /// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_SPECS`].
+    pub const BEAM: u32 = 250;
 }
 
 const START_STROKE: ParamSpec = ParamSpec {
@@ -70,7 +76,7 @@ const fn out(name: &'static str, r: u32, unit: &'static str, display: &'static s
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 28] = [
+const OWN: [Variable; 30] = [
     Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
         "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
     out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
@@ -100,13 +106,55 @@ const OWN: [Variable; 28] = [
     Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
     Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
     Variable::param(vr::X0, START_STROKE).fixed(),
+    Variable::bool_param("boom.flexible", vr::FLEXIBLE, true,
+        "Lumped flexible arm (boom.n2 + boom.n3 sections, eq. 2.34-2.39); false: rigid boom").fixed(),
+    out("boom.tip_deflection", vr::TIP_DEFLECTION, "m", "mm",
+        "Deflection of the arm's end normal to the rigid boom line at the same cylinder length, > 0 up (0 when rigid)"),
 ];
 
-const N_VARS: usize = OWN.len() + PARAMS.len() + BOOM_SPECS.len();
+/// Names of the section-angle outputs (structured names, 1-based as in the thesis).
+const SECTION_NAMES: [&str; MAX_SECTIONS] = [
+    "boom.section[1].phi",
+    "boom.section[2].phi",
+    "boom.section[3].phi",
+    "boom.section[4].phi",
+    "boom.section[5].phi",
+    "boom.section[6].phi",
+    "boom.section[7].phi",
+    "boom.section[8].phi",
+    "boom.section[9].phi",
+    "boom.section[10].phi",
+    "boom.section[11].phi",
+    "boom.section[12].phi",
+    "boom.section[13].phi",
+    "boom.section[14].phi",
+    "boom.section[15].phi",
+    "boom.section[16].phi",
+    "boom.section[17].phi",
+    "boom.section[18].phi",
+    "boom.section[19].phi",
+    "boom.section[20].phi",
+    "boom.section[21].phi",
+    "boom.section[22].phi",
+    "boom.section[23].phi",
+    "boom.section[24].phi",
+    "boom.section[25].phi",
+    "boom.section[26].phi",
+    "boom.section[27].phi",
+    "boom.section[28].phi",
+    "boom.section[29].phi",
+    "boom.section[30].phi",
+    "boom.section[31].phi",
+    "boom.section[32].phi",
+];
 
-/// Whether a hydraulic parameter selects a variant (an index): exposed as an Integer.
-const fn is_selector(name: &str) -> bool {
-    let (a, b) = (name.as_bytes(), b"friction.model");
+const N_VARS: usize = OWN.len() + MAX_SECTIONS + PARAMS.len() + BOOM_SPECS.len() + BEAM_SPECS.len();
+
+/// Parameters that count or select (a model index, section counts): exposed as Integers.
+const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
+
+const fn str_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
     if a.len() != b.len() {
         return false;
     }
@@ -120,9 +168,19 @@ const fn is_selector(name: &str) -> bool {
     true
 }
 
-/// The FMU variable of hydraulic parameter `k`.
-const fn hydraulic_param(k: usize) -> Variable {
-    let (r, p) = (vr::HYDRAULICS + k as u32, PARAMS[k].spec);
+const fn is_selector(name: &str) -> bool {
+    let mut i = 0;
+    while i < SELECTORS.len() {
+        if str_eq(name, SELECTORS[i]) {
+            return true;
+        }
+        i += 1;
+    }
+    false
+}
+
+/// The FMU variable of a physical parameter: fixed, an Integer where it counts or selects.
+const fn param(r: u32, p: ParamSpec) -> Variable {
     if is_selector(p.name) {
         Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
     } else {
@@ -130,31 +188,55 @@ const fn hydraulic_param(k: usize) -> Variable {
     }
 }
 
-/// The table: own variables, then every hydraulic and boom parameter (fixed: set them before
-/// initialisation ends).
+/// The value of parameter `p` with value reference `r`, as a number.
+fn param_value(values: &Values, r: u32, p: &ParamSpec) -> f64 {
+    if is_selector(p.name) {
+        values.integer(r) as f64
+    } else {
+        values.real(r)
+    }
+}
+
+/// The table: own variables, the section angles, then every hydraulic, boom and beam parameter
+/// (fixed: set them before initialisation ends).
 const TABLE: [Variable; N_VARS] = {
     let mut t = [OWN[0]; N_VARS];
-    let mut i = 0;
-    while i < OWN.len() {
-        t[i] = OWN[i];
-        i += 1;
+    let mut n = 0;
+    while n < OWN.len() {
+        t[n] = OWN[n];
+        n += 1;
+    }
+    let mut k = 0;
+    while k < MAX_SECTIONS {
+        t[n] = out(SECTION_NAMES[k], vr::SECTIONS + k as u32, "rad", "deg",
+            "Absolute angle of the arm section (from the joint outwards); beyond the last section, the last one's");
+        (n, k) = (n + 1, k + 1);
     }
     let mut k = 0;
     while k < PARAMS.len() {
-        t[OWN.len() + k] = hydraulic_param(k);
-        k += 1;
+        t[n] = param(vr::HYDRAULICS + k as u32, PARAMS[k].spec);
+        (n, k) = (n + 1, k + 1);
     }
     let mut k = 0;
     while k < BOOM_SPECS.len() {
-        t[OWN.len() + PARAMS.len() + k] = Variable::param(vr::BOOM + k as u32, BOOM_SPECS[k]).fixed();
-        k += 1;
+        t[n] = param(vr::BOOM + k as u32, BOOM_SPECS[k]);
+        (n, k) = (n + 1, k + 1);
+    }
+    let mut k = 0;
+    while k < BEAM_SPECS.len() {
+        t[n] = param(vr::BEAM + k as u32, BEAM_SPECS[k]);
+        (n, k) = (n + 1, k + 1);
     }
     t
 };
 
-/// Scales of the states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar, 1 mm of
-/// spool travel, full valve opening, 1 mm of stroke, 1 mm/s.
-const STATE_SCALE: [f64; N_STATES] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0, 1e-3, 1e-3];
+/// Scales of the circuit states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar,
+/// 1 mm of spool travel, full valve opening.
+const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
+/// Scales of the boom coordinates and velocities: 1 mm and 1 mm/s of stroke (rigid); 0.1 mrad
+/// and 1 mrad/s of section angle (flexible: deflection angles are ~1 mrad).
+const RIGID_SCALE: (f64, f64) = (1e-3, 1e-3);
+const FLEXIBLE_SCALE: (f64, f64) = (1e-4, 1e-3);
 
 const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
 PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48), counterbalance valve with check valve and
@@ -166,35 +248,56 @@ volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving th
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
 spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>"#;
 
-/// Circuit + rigid boom as one ODE, with the operator's reference held.
+/// The boom the circuit drives.
 #[derive(Debug, Clone)]
-pub struct RigidPlant {
+pub enum Boom {
+    Rigid(RigidBoom),
+    Flexible(FlexibleBoom),
+}
+
+impl Boom {
+    /// The boom's mechanics.
+    pub fn mechanics(&self) -> &dyn BoomMechanics {
+        match self {
+            Boom::Rigid(b) => b,
+            Boom::Flexible(b) => b,
+        }
+    }
+}
+
+/// Circuit + boom as one ODE, with the operator's reference held.
+#[derive(Debug, Clone)]
+pub struct Plant {
     pub circuit: Circuit,
-    pub boom: RigidBoom,
+    pub boom: Boom,
     pub u_ref: f64,
 }
 
-impl OdeSystem for RigidPlant {
+impl OdeSystem for Plant {
     fn dim(&self) -> usize {
-        N_STATES
+        N_CIRCUIT + 2 * self.boom.mechanics().dof()
     }
 
     fn rhs(&self, _t: f64, s: &[f64], dx: &mut [f64]) {
-        let c: &circuit::State = s[..N_CIRCUIT].try_into().expect("circuit slice");
-        let e = self.circuit.evaluate(c, self.u_ref, s[X], s[V]);
-        dx[..N_CIRCUIT].copy_from_slice(&e.dx);
-        dx[X] = s[V];
-        dx[V] = self.boom.acceleration(s[X], s[V], e.force);
+        let b = self.boom.mechanics();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(b.dof());
+        let c: &circuit::State = c.try_into().expect("circuit slice");
+        let e = self.circuit.evaluate(c, self.u_ref, b.stroke(q), b.stroke_rate(q, qd));
+        let (dc, dboom) = dx.split_at_mut(N_CIRCUIT);
+        dc.copy_from_slice(&e.dx);
+        let (dq, dqd) = dboom.split_at_mut(b.dof());
+        dq.copy_from_slice(qd);
+        b.accelerations(q, qd, e.force, dqd);
     }
 }
 
-impl RigidPlant {
+impl Plant {
     /// The plant from the FMU's parameter values; refuses inconsistent combinations.
     pub fn from_values(values: &Values) -> Result<Self, String> {
         let mut circuit = Circuit::default();
         for (k, p) in PARAMS.iter().enumerate() {
-            let r = vr::HYDRAULICS + k as u32;
-            (p.set)(&mut circuit, if is_selector(p.spec.name) { values.integer(r) as f64 } else { values.real(r) });
+            (p.set)(&mut circuit, param_value(values, vr::HYDRAULICS + k as u32, &p.spec));
         }
         let cyl = &circuit.cylinder;
         if cyl.d_rod >= cyl.d_piston {
@@ -209,46 +312,66 @@ impl RigidPlant {
                 circuit.dcv.x_db, circuit.dcv.x_max
             ));
         }
-        let boom_vr = |name: &str| {
-            let k = BOOM_SPECS.iter().position(|s| s.name == name).expect("boom parameter name");
-            values.real(vr::BOOM + k as u32)
+        let lookup = |specs: &[ParamSpec], base: u32, name: &str| {
+            let k = specs.iter().position(|s| s.name == name).expect("parameter name");
+            param_value(values, base + k as u32, &specs[k])
         };
-        let boom = RigidBoom::new(&BoomParams::from_lookup(boom_vr), cyl.stroke)
-            .map_err(|e| format!("boom geometry (boom.*, cylinder.l_retracted, cylinder.stroke): {e}"))?;
-        Ok(RigidPlant { circuit, boom, u_ref: values.real(vr::U_REF) })
+        let params = BoomParams::from_lookup(|n| lookup(BOOM_SPECS, vr::BOOM, n));
+        let boom = if values.boolean(vr::FLEXIBLE) {
+            let beam = BeamParams::from_lookup(|n| lookup(BEAM_SPECS, vr::BEAM, n));
+            FlexibleBoom::new(&params, &beam, cyl.stroke).map(Boom::Flexible)
+        } else {
+            RigidBoom::new(&params, cyl.stroke).map(Boom::Rigid)
+        };
+        let boom = boom.map_err(|e| format!("boom geometry (boom.*, cylinder.l_retracted, cylinder.stroke): {e}"))?;
+        Ok(Plant { circuit, boom, u_ref: values.real(vr::U_REF) })
     }
 
     /// Static equilibrium at stroke `x0`: the load held at rest by the closed CBV.
-    pub fn equilibrium(&self, x0: f64) -> Result<[f64; N_STATES], String> {
+    pub fn equilibrium(&self, x0: f64) -> Result<Vec<f64>, String> {
         let stroke = self.circuit.cylinder.stroke;
         if !(0.0..=stroke).contains(&x0) {
             return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
         }
-        let f_load = self.boom.static_force(x0);
-        let c = self.circuit.equilibrium(f_load).map_err(|e| {
-            format!(
-                "no static equilibrium at start.x = {x0} m with the load of {f_load:.0} N (payload.m, cbv.p_set): {e}"
-            )
+        let b = self.boom.mechanics();
+        let rest = b.equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
+        let c = self.circuit.equilibrium(rest.f_cyl).map_err(|e| {
+            format!("no static equilibrium at start.x = {x0} m with the load of {:.0} N (payload.m, cbv.p_set): {e}", rest.f_cyl)
         })?;
-        let mut s = [0.0; N_STATES];
-        s[..N_CIRCUIT].copy_from_slice(&c);
-        s[X] = x0;
+        let mut s = c.to_vec();
+        s.extend_from_slice(&rest.q);
+        s.resize(self.dim(), 0.0);
         Ok(s)
+    }
+
+    /// Absolute tolerances for relative tolerance `rtol`.
+    fn atol(&self, rtol: f64) -> Vec<f64> {
+        let dof = self.boom.mechanics().dof();
+        let (q, qd) = if let Boom::Rigid(_) = self.boom { RIGID_SCALE } else { FLEXIBLE_SCALE };
+        let scales = CIRCUIT_SCALE.iter().copied().chain(std::iter::repeat_n(q, dof)).chain(std::iter::repeat_n(qd, dof));
+        scales.map(|s| s * rtol).collect()
     }
 }
 
 /// The HydraulicBoom model: plant, state and integrator.
 #[derive(Debug, Clone)]
 pub struct HydraulicBoom {
-    plant: RigidPlant,
-    state: [f64; N_STATES],
+    plant: Plant,
+    state: Vec<f64>,
     solver: Radau5,
 }
 
 impl HydraulicBoom {
-    fn with_state(values: &Values, state: [f64; N_STATES]) -> Result<Self, String> {
-        let plant = RigidPlant::from_values(values)?;
-        Ok(HydraulicBoom { plant, state, solver: Radau5::new(N_STATES) })
+    /// The model with the plant of `values` and the given state (the equilibrium if `None`).
+    fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
+        let plant = Plant::from_values(values)?;
+        let state = match state {
+            None => plant.equilibrium(values.real(vr::X0))?,
+            Some(s) if s.len() == plant.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
+            Some(s) => return Err(format!("expected {} finite states, got {}", plant.dim(), s.len())),
+        };
+        let solver = Radau5::new(plant.dim());
+        Ok(HydraulicBoom { plant, state, solver })
     }
 }
 
@@ -269,9 +392,7 @@ impl Model for HydraulicBoom {
     const VARIABLES: &'static [Variable] = &TABLE;
 
     fn initialize(values: &Values) -> Result<Self, String> {
-        let mut m = Self::with_state(values, [0.0; N_STATES])?;
-        m.state = m.plant.equilibrium(values.real(vr::X0))?;
-        Ok(m)
+        Self::with_state(values, None)
     }
 
     fn retune(&mut self, _values: &Values) -> Result<(), String> {
@@ -280,39 +401,55 @@ impl Model for HydraulicBoom {
 
     fn outputs(&self, values: &mut Values) {
         let s = &self.state;
-        let c: &circuit::State = s[..N_CIRCUIT].try_into().expect("circuit slice");
-        let e = self.plant.circuit.evaluate(c, values.real(vr::U_REF), s[X], s[V]);
-        let b = self.plant.boom.state(s[X], s[V]);
+        let b = self.plant.boom.mechanics();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(b.dof());
+        let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
+        let e = self.plant.circuit.evaluate(c.try_into().expect("circuit slice"), values.real(vr::U_REF), x, v);
+        let (theta, omega, tip) = match &self.plant.boom {
+            Boom::Rigid(r) => {
+                let st = r.state(x, v);
+                (st.theta2, st.theta2_dot, 0.0)
+            }
+            Boom::Flexible(f) => (q[0], qd[0], f.tip_deflection(q)),
+        };
+        let payload = b.payload(q);
+        let stats = self.solver.stats();
         let outputs = [
-            (vr::P1, s[circuit::P1]),
-            (vr::P2, s[circuit::P2]),
-            (vr::P3, s[circuit::P3]),
-            (vr::P4, s[circuit::P4]),
+            (vr::P1, c[circuit::P1]),
+            (vr::P2, c[circuit::P2]),
+            (vr::P3, c[circuit::P3]),
+            (vr::P4, c[circuit::P4]),
             (vr::U, e.u),
             (vr::U_CV, e.u_cv),
-            (vr::U_CBV, s[circuit::U_CBV]),
+            (vr::U_CBV, c[circuit::U_CBV]),
             (vr::Q1, e.q[0]),
             (vr::Q2, e.q[1]),
             (vr::Q3, e.q[2]),
             (vr::Q4, e.q[3]),
-            (vr::X, s[X]),
-            (vr::V, s[V]),
+            (vr::X, x),
+            (vr::V, v),
             (vr::F, e.force),
             (vr::F_FR, e.f_friction),
-            (vr::THETA, b.theta2),
-            (vr::OMEGA, b.theta2_dot),
-            (vr::PAYLOAD_X, b.payload.x),
-            (vr::PAYLOAD_Y, b.payload.y),
-            (vr::X_V, s[circuit::X_V]),
+            (vr::THETA, theta),
+            (vr::OMEGA, omega),
+            (vr::PAYLOAD_X, payload.x),
+            (vr::PAYLOAD_Y, payload.y),
+            (vr::X_V, c[circuit::X_V]),
             (vr::U_PCV, e.u_pcv),
             (vr::P_X, e.p_x),
-            (vr::SOLVER_STEPS, self.solver.stats().accepted_steps as f64),
-            (vr::SOLVER_REJECTED, self.solver.stats().rejected_steps as f64),
-            (vr::SOLVER_RHS, self.solver.stats().rhs_evals as f64),
-            (vr::SOLVER_JACOBIANS, self.solver.stats().jacobian_evals as f64),
+            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
+            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
+            (vr::SOLVER_RHS, stats.rhs_evals as f64),
+            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
+            (vr::TIP_DEFLECTION, tip),
         ];
         for (r, x) in outputs {
             values.set_real(r, x);
+        }
+        for k in 0..MAX_SECTIONS {
+            let phi = if let Boom::Flexible(_) = self.plant.boom { q[k.min(q.len() - 1)] } else { theta };
+            values.set_real(vr::SECTIONS + k as u32, phi);
         }
     }
 
@@ -327,7 +464,7 @@ impl Model for HydraulicBoom {
     ) -> Result<(), StepError> {
         let fail = |time, message: String| StepError { time, message };
         self.plant.u_ref = values.real(vr::U_REF);
-        let atol = STATE_SCALE.map(|s| s * tolerance);
+        let atol = self.plant.atol(tolerance);
         self.solver
             .set_rtol(tolerance)
             .and_then(|_| self.solver.set_atol(&atol))
@@ -350,17 +487,15 @@ impl Model for HydraulicBoom {
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = self.state.to_vec();
+        let mut v = self.state.clone();
         v.extend_from_slice(&self.solver.save_state());
         v
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let state = saved.get(..N_STATES).filter(|s| s.iter().all(|x| x.is_finite()));
-        let state = state.ok_or_else(|| format!("expected {N_STATES} finite states, got {saved:?}"))?;
-        let mut m = Self::with_state(values, state.try_into().expect("length checked"))?;
-        let solver_state =
-            saved[N_STATES..].try_into().map_err(|_| format!("expected {} solver numbers", Radau5::STATE_LEN))?;
+        let n = saved.len().checked_sub(Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+        let mut m = Self::with_state(values, Some(&saved[..n]))?;
+        let solver_state = saved[n..].try_into().map_err(|_| "solver state length".to_string())?;
         m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
         Ok(m)
     }

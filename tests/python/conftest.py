@@ -54,6 +54,7 @@ class Fmu:
         self.md = read_model_description(self.path)
         self.dir = extract(self.path, unzipdir=str(tmp_path_factory.mktemp(identifier)))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.type = {v.name: v.type for v in self.md.modelVariables}
 
     def slave(self, name="instance", guid=None, tolerance=None, **start):
         """An instantiated slave, set up (with the relative tolerance `tolerance`, None: the
@@ -68,7 +69,8 @@ class Fmu:
             s.setupExperiment(tolerance=tolerance, startTime=0.0)
             s.enterInitializationMode()
             for k, v in start.items():
-                s.setReal([self.vr[k]], [v])
+                setter = {"Real": s.setReal, "Integer": s.setInteger, "Boolean": s.setBoolean}[self.type[k]]
+                setter([self.vr[k]], [v])
             s.exitInitializationMode()
         return s
 

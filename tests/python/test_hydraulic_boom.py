@@ -107,8 +107,9 @@ def crossings(t, y, level):
 
 def simulate(boom, u_ref, t_end, h=1e-3, tolerance=None, **start):
     """Outputs at t = 0, h, ..., t_end for the spool reference u_ref (a number or a function of t,
-    held over each step). Returns (t, {name: array})."""
-    s = boom.slave(tolerance=tolerance, **start)
+    held over each step), with the rigid boom unless `start` says otherwise (the hand computations
+    here are rigid-boom statics). Returns (t, {name: array})."""
+    s = boom.slave(tolerance=tolerance, **{"boom.flexible": False, **start})
     refs = [boom.vr[n] for n in OUTPUTS]
     n = int(round(t_end / h))
     out = [s.getReal(refs)]
