@@ -28,13 +28,14 @@ pub trait Slave {
 pub struct InProcess<M: Model>(Instance<M>);
 
 impl<M: Model> InProcess<M> {
-    /// Instantiated, set up with `rtol`, initialised with the given Real values.
-    pub fn new(rtol: f64, start: &[(u32, f64)]) -> Result<Self, String> {
+    /// Instantiated, set up with `rtol`, initialised with the given Real and Boolean values.
+    pub fn new(rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
         let mut i = Instance::<M>::new(Logger::new(None, std::ptr::null_mut(), "bench", &[], false));
         i.setup_experiment(Some(rtol), 0.0, None)?;
         i.enter_initialization_mode();
-        for &(r, x) in start {
-            i.set(&[r], vec![Value::Real(x)], "Real")?;
+        for (r, x) in start {
+            let kind = if let Value::Boolean(_) = x { "Boolean" } else { "Real" };
+            i.set(&[*r], vec![x.clone()], kind)?;
         }
         i.exit_initialization_mode()?;
         Ok(InProcess(i))
@@ -71,6 +72,7 @@ type Component = unsafe extern "C" fn(fmi2Component) -> fmi2Status;
 type Setup = unsafe extern "C" fn(fmi2Component, c_int, f64, f64, c_int, f64) -> fmi2Status;
 type RealIo = unsafe extern "C" fn(fmi2Component, *const u32, usize, *mut f64) -> fmi2Status;
 type DoStep = unsafe extern "C" fn(fmi2Component, f64, f64, c_int) -> fmi2Status;
+type SetBoolean = unsafe extern "C" fn(fmi2Component, *const u32, usize, *const c_int) -> fmi2Status;
 type Free = unsafe extern "C" fn(fmi2Component);
 
 /// A slave loaded from its shared library and called through the exported C functions.
@@ -97,7 +99,7 @@ unsafe extern "C" fn free(p: *mut c_void) {
 
 impl CAbi {
     /// Loads `library`, instantiates model `M` and initialises it like [`InProcess::new`].
-    pub fn new<M: Model>(library: &Path, rtol: f64, start: &[(u32, f64)]) -> Result<Self, String> {
+    pub fn new<M: Model>(library: &Path, rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
         let path = CString::new(library.to_string_lossy().as_bytes()).map_err(|e| e.to_string())?;
         // SAFETY: dlopen/dlsym with NUL-terminated names; each symbol is cast to the signature
         // the FMI 2.0 headers give it.
@@ -133,6 +135,7 @@ impl CAbi {
             let setup: Setup = std::mem::transmute(sym(c"fmi2SetupExperiment")?);
             let enter: Component = std::mem::transmute(sym(c"fmi2EnterInitializationMode")?);
             let exit: Component = std::mem::transmute(sym(c"fmi2ExitInitializationMode")?);
+            let set_boolean: SetBoolean = std::mem::transmute(sym(c"fmi2SetBoolean")?);
             let (name, id) = (c"bench", CString::new(guid::<M>()).map_err(|e| e.to_string())?);
             let c = instantiate(name.as_ptr(), FMI2_COSIMULATION, id.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
             if c.is_null() {
@@ -149,8 +152,12 @@ impl CAbi {
             };
             check(setup(c, 1, rtol, 0.0, 0, 0.0), "fmi2SetupExperiment")?;
             check(enter(c), "fmi2EnterInitializationMode")?;
-            for &(r, x) in start {
-                s.set(r, x)?;
+            for (r, x) in start {
+                match x {
+                    Value::Real(x) => s.set(*r, *x)?,
+                    Value::Boolean(b) => check(set_boolean(c, r, 1, &(*b as c_int)), "fmi2SetBoolean")?,
+                    v => return Err(format!("start value {v:?} is not a Real or Boolean")),
+                }
             }
             check(exit(c), "fmi2ExitInitializationMode")?;
             Ok(s)
@@ -248,8 +255,7 @@ pub fn case_b(plant: &mut dyn Slave, controller: &mut dyn Slave, duration: f64) 
 
 /// Runs `case` on `plant` and reads the solver counters afterwards.
 fn timed(
-    case: &'static str,
-    via: &'static str,
+    (case, boom, via): (&'static str, &'static str, &'static str),
     plant: &mut dyn Slave,
     run: impl FnOnce(&mut dyn Slave) -> Result<(), String>,
     duration: f64,
@@ -260,7 +266,7 @@ fn timed(
     let count = |plant: &mut dyn Slave, r| plant.get(r).map(|x| x as u64);
     Ok(BenchResult {
         case,
-        boom: "rigid",
+        boom,
         via,
         simulated_s: duration,
         wall_s,
@@ -270,26 +276,35 @@ fn timed(
     })
 }
 
-/// Every benchmark: cases U and B, in-process and through the C ABI of the libraries in
-/// `library_dir` (`lib<ModelIdentifier>.so`, as `cargo build --release` leaves them).
+/// Every benchmark: cases U and B with the rigid and the flexible (4 + 5) boom, in-process and
+/// through the C ABI of the libraries in `library_dir` (`lib<ModelIdentifier>.so`, as
+/// `cargo build --release` leaves them).
 pub fn run_all(library_dir: &Path, duration: f64) -> Result<Vec<BenchResult>, String> {
-    let plant_start = [];
     let lib = |id: &str| library_dir.join(format!("lib{id}.so"));
     let (hb_lib, pfc_lib) = (lib(HydraulicBoom::INFO.identifier), lib(PressureFeedbackController::INFO.identifier));
     let mut out = Vec::new();
-    let mut p = InProcess::<HydraulicBoom>::new(RTOL, &plant_start)?;
-    out.push(timed("U", "in-process", &mut p, |p| case_u(p, duration), duration)?);
-    let mut p = CAbi::new::<HydraulicBoom>(&hb_lib, RTOL, &plant_start)?;
-    out.push(timed("U", "c-abi", &mut p, |p| case_u(p, duration), duration)?);
-    let mut p = InProcess::<HydraulicBoom>::new(RTOL, &plant_start)?;
-    let mut c = InProcess::<PressureFeedbackController>::new(RTOL, &[(pfc::P, p.get(hb::P4)?)])?;
-    out.push(timed("B", "in-process", &mut p, |p| case_b(p, &mut c, duration), duration)?);
-    let mut p = CAbi::new::<HydraulicBoom>(&hb_lib, RTOL, &plant_start)?;
-    let mut c = CAbi::new::<PressureFeedbackController>(&pfc_lib, RTOL, &[(pfc::P, p.get(hb::P4)?)])?;
-    out.push(timed("B", "c-abi", &mut p, |p| case_b(p, &mut c, duration), duration)?);
+    for (boom, flexible) in [("rigid", false), ("flexible", true)] {
+        let start = [(hb::FLEXIBLE, Value::Boolean(flexible))];
+        for via in ["in-process", "c-abi"] {
+            let plant = || -> Result<Box<dyn Slave>, String> {
+                Ok(match via {
+                    "in-process" => Box::new(InProcess::<HydraulicBoom>::new(RTOL, &start)?),
+                    _ => Box::new(CAbi::new::<HydraulicBoom>(&hb_lib, RTOL, &start)?),
+                })
+            };
+            let mut p = plant()?;
+            out.push(timed(("U", boom, via), p.as_mut(), |p| case_u(p, duration), duration)?);
+            let mut p = plant()?;
+            let c_start = [(pfc::P, Value::Real(p.get(hb::P4)?))];
+            let mut c: Box<dyn Slave> = match via {
+                "in-process" => Box::new(InProcess::<PressureFeedbackController>::new(RTOL, &c_start)?),
+                _ => Box::new(CAbi::new::<PressureFeedbackController>(&pfc_lib, RTOL, &c_start)?),
+            };
+            out.push(timed(("B", boom, via), p.as_mut(), |p| case_b(p, c.as_mut(), duration), duration)?);
+        }
+    }
     Ok(out)
 }
-
 /// Cost of one setReal + doStep + getReal cycle of the controller, in seconds, over `n` cycles.
 pub fn controller_cycle(slave: &mut dyn Slave, n: usize) -> Result<f64, String> {
     let start = Instant::now();

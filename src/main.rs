@@ -33,6 +33,16 @@ enum Cmd {
         #[arg(long, default_value_t = 10.0)]
         duration: f64,
     },
+    /// Modes of the HydraulicBoom linearised at rest with the boom horizontal (full payload,
+    /// spool closed): the flexible boom (default n2 = 4, n3 = 5) and, for comparison, the rigid one.
+    Eigen {
+        /// Print JSON: {stroke_mm, modes: [{frequency_hz, damping_ratio}], rigid_modes: [...]}.
+        #[arg(long)]
+        json: bool,
+        /// How many of the lowest modes to print.
+        #[arg(long, default_value_t = 6)]
+        count: usize,
+    },
     /// Write modelDescription/<ModelIdentifier>.xml from the variable tables.
     Xml {
         /// Compare instead of writing; fail if a committed file differs from the generator.
@@ -132,6 +142,31 @@ fn bench(json: bool, duration: f64) -> Result<(), String> {
     Ok(())
 }
 
+fn eigen(json: bool, count: usize) -> Result<(), String> {
+    use boomsim::analysis::modes::{hydraulic_boom_modes, Mode};
+    let (x0, flexible) = hydraulic_boom_modes(true)?;
+    let (_, rigid) = hydraulic_boom_modes(false)?;
+    let list = |m: &[Mode]| -> Vec<serde_json::Value> {
+        m.iter()
+            .take(count)
+            .map(|m| serde_json::json!({"frequency_hz": m.frequency_hz, "damping_ratio": m.damping_ratio}))
+            .collect()
+    };
+    if json {
+        let out = serde_json::json!({"stroke_mm": x0 * 1e3, "modes": list(&flexible), "rigid_modes": list(&rigid)});
+        println!("{out}");
+        return Ok(());
+    }
+    println!("HydraulicBoom at rest, boom horizontal at stroke {:.1} mm, spool closed, no friction", x0 * 1e3);
+    for (name, modes) in [("flexible (4 + 5)", &flexible), ("rigid", &rigid)] {
+        println!("{name}:");
+        for m in modes.iter().take(count) {
+            println!("  {:10.3} Hz  zeta {:.4}", m.frequency_hz, m.damping_ratio);
+        }
+    }
+    Ok(())
+}
+
 fn xml(check: bool) -> Result<(), String> {
     let dir = root().join("modelDescription");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
@@ -169,6 +204,7 @@ fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Cmd::Pack { out } => pack(&out),
         Cmd::Bench { json, duration } => bench(json, duration),
+        Cmd::Eigen { json, count } => eigen(json, count),
         Cmd::Xml { check } => xml(check),
         Cmd::Deflection { json } => deflection(json),
     };

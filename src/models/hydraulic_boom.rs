@@ -17,7 +17,6 @@ use crate::mechanics::BoomMechanics;
 use crate::params::ParamSpec;
 use crate::solver::{OdeSystem, Radau5};
 
-
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
     pub const U_REF: u32 = 0;
@@ -208,8 +207,13 @@ const TABLE: [Variable; N_VARS] = {
     }
     let mut k = 0;
     while k < MAX_SECTIONS {
-        t[n] = out(SECTION_NAMES[k], vr::SECTIONS + k as u32, "rad", "deg",
-            "Absolute angle of the arm section (from the joint outwards); beyond the last section, the last one's");
+        t[n] = out(
+            SECTION_NAMES[k],
+            vr::SECTIONS + k as u32,
+            "rad",
+            "deg",
+            "Absolute angle of the arm section (from the joint outwards); beyond the last section, the last one's",
+        );
         (n, k) = (n + 1, k + 1);
     }
     let mut k = 0;
@@ -336,7 +340,10 @@ impl Plant {
         let b = self.boom.mechanics();
         let rest = b.equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
         let c = self.circuit.equilibrium(rest.f_cyl).map_err(|e| {
-            format!("no static equilibrium at start.x = {x0} m with the load of {:.0} N (payload.m, cbv.p_set): {e}", rest.f_cyl)
+            format!(
+                "no static equilibrium at start.x = {x0} m with the load of {:.0} N (payload.m, cbv.p_set): {e}",
+                rest.f_cyl
+            )
         })?;
         let mut s = c.to_vec();
         s.extend_from_slice(&rest.q);
@@ -344,11 +351,17 @@ impl Plant {
         Ok(s)
     }
 
+    /// Typical magnitude of each state (atol = rtol x scale).
+    pub fn state_scale(&self) -> Vec<f64> {
+        self.atol(1.0)
+    }
+
     /// Absolute tolerances for relative tolerance `rtol`.
     fn atol(&self, rtol: f64) -> Vec<f64> {
         let dof = self.boom.mechanics().dof();
         let (q, qd) = if let Boom::Rigid(_) = self.boom { RIGID_SCALE } else { FLEXIBLE_SCALE };
-        let scales = CIRCUIT_SCALE.iter().copied().chain(std::iter::repeat_n(q, dof)).chain(std::iter::repeat_n(qd, dof));
+        let scales =
+            CIRCUIT_SCALE.iter().copied().chain(std::iter::repeat_n(q, dof)).chain(std::iter::repeat_n(qd, dof));
         scales.map(|s| s * rtol).collect()
     }
 }
