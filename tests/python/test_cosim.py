@@ -161,13 +161,3 @@ def test_report_c_ranking(run):
     (OUT / "ranking.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     assert len(results) == 18
-
-
-def test_flexible_variant_is_skipped_with_a_reason_until_the_fmu_has_it():
-    plant = cosim.FmuFile.get("HydraulicBoom")
-    sc = cosim.load_scenario("B")
-    assert "flexible" in sc["booms"]
-    if any(n in plant.vars for n in cosim.FLEXIBLE_SWITCH):
-        pytest.skip("the FMU has the flexible boom: the variant runs")
-    with pytest.raises(cosim.Skip, match="rigid boom only"):
-        cosim.run(sc, "flexible", stop_time=0.01)
