@@ -115,8 +115,7 @@ impl Variable {
         display_unit: &'static str,
         description: &'static str,
     ) -> Self {
-        let kind = Kind::Real { start: 0.0, unit, display_unit, min: NO_MIN, max: NO_MAX };
-        Self::new(name, vr, Causality::Output, Variability::Continuous, Initial::Calculated, kind, description)
+        Self::calculated(Causality::Output, name, vr, unit, display_unit, description)
     }
 
     /// A continuous Real local (internal state or diagnostic), initial = calculated.
@@ -127,8 +126,19 @@ impl Variable {
         display_unit: &'static str,
         description: &'static str,
     ) -> Self {
+        Self::calculated(Causality::Local, name, vr, unit, display_unit, description)
+    }
+
+    const fn calculated(
+        causality: Causality,
+        name: &'static str,
+        vr: u32,
+        unit: &'static str,
+        display_unit: &'static str,
+        description: &'static str,
+    ) -> Self {
         let kind = Kind::Real { start: 0.0, unit, display_unit, min: NO_MIN, max: NO_MAX };
-        Self::new(name, vr, Causality::Local, Variability::Continuous, Initial::Calculated, kind, description)
+        Self::new(name, vr, causality, Variability::Continuous, Initial::Calculated, kind, description)
     }
 
     /// A tunable Boolean parameter.
