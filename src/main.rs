@@ -1,4 +1,5 @@
-//! The boomsim command line: build and pack the FMUs, keep modelDescription files current.
+//! The boomsim command line: build and pack the FMUs, keep modelDescription files current,
+//! analyse the linearised stability.
 
 use boomsim::models;
 use clap::{Parser, Subcommand};
@@ -30,6 +31,8 @@ enum Cmd {
         #[arg(long)]
         check: bool,
     },
+    /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
+    Analyze(boomsim::analysis::cli::AnalyzeArgs),
 }
 
 /// The workspace root (this package's manifest directory).
@@ -91,6 +94,7 @@ fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Cmd::Pack { out } => pack(&out),
         Cmd::Xml { check } => xml(check),
+        Cmd::Analyze(args) => boomsim::analysis::cli::run(&args, root()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

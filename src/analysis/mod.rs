@@ -1,1 +1,19 @@
-//! Linearised stability analysis (thesis section 2.3 and 6.1).
+//! Linearised stability analysis and filter tuning (thesis section 2.3 and 6.1): transfer
+//! functions, the Routh-Hurwitz instability criterion, margins and settling times of the
+//! pressure feedback, and the `boomsim analyze` command.
+
+pub mod cli;
+pub mod criterion;
+pub mod feedback;
+pub mod margins;
+pub mod operating_point;
+pub mod plant;
+pub mod poly;
+pub mod report;
+pub mod routh;
+pub mod step;
+pub mod sweep;
+pub mod tf;
+
+pub use operating_point::OperatingPoint;
+pub use report::Analysis;
