@@ -116,4 +116,58 @@ mod tests {
         }
         assert!((cl.dc_gain() - 1.0).abs() < 1e-12);
     }
+
+    /// The closed-form step response of G_cl (filter b of Table 6.3) against an RK4 simulation
+    /// of the same transfer function as a state-space model (controllable canonical form of
+    /// the monic denominator, time in ms so the coefficients stay moderate). RK4 with
+    /// h = 1 us has a local error ~ (h |p|)^5 < 1e-10 for the fastest pole; tolerance 1e-6 of
+    /// the final value. The settling time must match the last 2 % band exit of the simulated
+    /// samples to within one sample (h).
+    #[test]
+    fn step_response_matches_state_space_simulation() {
+        let op = OperatingPoint::default();
+        let lin = op.linearise().unwrap();
+        let hp = HParams::new(&op, &lin);
+        let h = hp.h();
+        let g = closed_loop(lin.c2, &h, &valve(4.0 / 0.12), &filter(&tuned(&op, &lin, hp.omega_n, 3.0, 2.0)));
+        // time in ms: s = 1e3 s_ms
+        let t_scale: f64 = 1e-3;
+        let scale = |c: &[f64]| c.iter().enumerate().map(|(k, a)| a / t_scale.powi(k as i32)).collect::<Vec<_>>();
+        let (num, den) = (scale(g.num.coeffs()), scale(g.den.coeffs()));
+        let n = den.len() - 1;
+        let a: Vec<f64> = den.iter().map(|d| d / den[n]).collect();
+        let b: Vec<f64> = (0..n).map(|k| num.get(k).copied().unwrap_or(0.0) / den[n]).collect();
+        // x' = A x + e_n u (companion), y = sum b_k x_k
+        let f = |x: &[f64]| -> Vec<f64> {
+            let mut dx: Vec<f64> = (0..n).map(|k| if k + 1 < n { x[k + 1] } else { 0.0 }).collect();
+            dx[n - 1] = 1.0 - (0..n).map(|k| a[k] * x[k]).sum::<f64>();
+            dx
+        };
+        let y = StepResponse::new(&g).unwrap();
+        let (hstep, steps) = (1e-3, 600_000); // 1 us in ms, 0.6 s
+        let mut x = vec![0.0; n];
+        let mut last_out = 0.0;
+        for k in 1..=steps {
+            let k1 = f(&x);
+            let x2: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * hstep * k1[i]).collect();
+            let k2 = f(&x2);
+            let x3: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * hstep * k2[i]).collect();
+            let k3 = f(&x3);
+            let x4: Vec<f64> = (0..n).map(|i| x[i] + hstep * k3[i]).collect();
+            let k4 = f(&x4);
+            for i in 0..n {
+                x[i] += hstep / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+            let t = k as f64 * hstep * t_scale;
+            let ys: f64 = (0..n).map(|i| b[i] * x[i]).sum();
+            if k % 1000 == 0 {
+                assert!((ys - y.at(t)).abs() < 1e-6, "t = {t}: simulated {ys}, closed form {}", y.at(t));
+            }
+            if (ys - 1.0).abs() > SETTLING_BAND {
+                last_out = t;
+            }
+        }
+        let ts = y.settling_time(SETTLING_BAND);
+        assert!((ts - last_out).abs() < 2.0 * hstep * t_scale, "{ts} vs simulated {last_out}");
+    }
 }

@@ -4,6 +4,8 @@
 
 pub mod cli;
 pub mod criterion;
+#[cfg(test)]
+mod dimensions;
 pub mod feedback;
 pub mod margins;
 pub mod operating_point;
