@@ -32,7 +32,7 @@ enum Cmd {
         check: bool,
     },
     /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
-    Analyze(boomsim::analysis::cli::AnalyzeArgs),
+    Analyze(Box<boomsim::analysis::cli::AnalyzeArgs>),
 }
 
 /// The workspace root (this package's manifest directory).

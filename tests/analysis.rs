@@ -9,6 +9,7 @@ use boomsim::analysis::criterion;
 use boomsim::analysis::plant::{closed_loop, HParams};
 use boomsim::analysis::OperatingPoint;
 use boomsim::hydraulics::params::PARAMS;
+use boomsim::hydraulics::solve::bisect;
 use boomsim::hydraulics::Circuit;
 use boomsim::mechanics::params::BoomParams;
 use boomsim::mechanics::rigid_boom::RigidBoom;
@@ -85,17 +86,9 @@ fn boundary(c: &Circuit, boom: &RigidBoom) -> f64 {
         let op = linear_point(c, boom, x).expect("CBV open");
         criterion::is_stable_exact(&op, &op.linearise().expect("steady state"))
     };
-    let (mut lo, mut hi) = (mm(5.0), c.cylinder.stroke - mm(5.0));
+    let (lo, hi) = (mm(5.0), c.cylinder.stroke - mm(5.0));
     assert!(stable(lo) && !stable(hi), "one boundary inside the stroke");
-    for _ in 0..50 {
-        let mid = 0.5 * (lo + hi);
-        if stable(mid) {
-            lo = mid
-        } else {
-            hi = mid
-        }
-    }
-    0.5 * (lo + hi)
+    bisect(|x| if stable(x) { -1.0 } else { 1.0 }, lo, hi, 1e-6)
 }
 
 /// One lowering run: p3 peak-to-peak amplitudes (Pa) of the early and late windows, the

@@ -118,17 +118,8 @@ mod tests {
         }
         let m = margins(&Tf::new(&[2.0], &[0.0, 2.0, 3.0, 1.0]));
         // x^3 + 5x^2 + 4x - 4 = 0 by bisection, independent of the polynomial root finder.
-        let f = |x: f64| ((x + 5.0) * x + 4.0) * x - 4.0;
-        let (mut a, mut b) = (0.0, 1.0);
-        for _ in 0..200 {
-            let c = 0.5 * (a + b);
-            if f(c) > 0.0 {
-                b = c
-            } else {
-                a = c
-            }
-        }
-        let w = a.sqrt();
+        let x = crate::hydraulics::solve::bisect(|x| ((x + 5.0) * x + 4.0) * x - 4.0, 0.0, 1.0, 1e-15);
+        let w = x.sqrt();
         let pm = 90.0 - w.atan().to_degrees() - (w / 2.0).atan().to_degrees();
         let p = m.relevant_phase.unwrap();
         assert!((p.omega - w).abs() < 1e-9 && (p.deg - pm).abs() < 1e-6, "{p:?} vs {w} {pm}");

@@ -12,6 +12,7 @@
 //! eq. 2.69 at rest (`0 = p4 mu_c A_c - p3 A_c + m g`) yields eq. 2.85: `mu_p` does not act on
 //! the piston (it is the CBV's pilot area ratio). We use eq. 2.85.
 
+use crate::hydraulics::solve::bisect;
 use crate::hydraulics::Circuit;
 use crate::mechanics::params::BoomParams;
 use crate::units::{bar, mm};
@@ -210,19 +211,12 @@ impl OperatingPoint {
         // p4 where the valve is fully open: (mu_p + mu_c) p4 = p_set + p_fo - F / A
         let p4_open = (self.p_set + self.p_fo - self.load / self.area) / (self.mu_p + self.mu_c);
         let p4_crack = ((self.p_set - self.load / self.area) / (self.mu_p + self.mu_c)).max(0.0);
-        if p4_open <= p4_crack || q(p4_open * (1.0 - 1e-12)).map_or(true, |q_max| q_max < q3) {
+        let hi = p4_open * (1.0 - 1e-12);
+        if hi <= p4_crack || q(hi).map_or(true, |q_max| q_max < q3) {
             return None;
         }
-        let (mut lo, mut hi) = (p4_crack, p4_open);
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if q(mid).map_or(true, |qm| qm < q3) {
-                lo = mid
-            } else {
-                hi = mid
-            }
-        }
-        Some(OperatingPoint { p4: 0.5 * (lo + hi), ..*self })
+        let p4 = bisect(|p4| q(p4).map_or(-q3, |q| q - q3), p4_crack, hi, 1e-13 * p4_open);
+        Some(OperatingPoint { p4, ..*self })
     }
 }
 

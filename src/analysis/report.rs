@@ -160,3 +160,59 @@ pub fn text(a: &Analysis) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn default_analysis() -> Analysis {
+        Analysis::new(OperatingPoint::default(), default_omega_v(), &DEFAULT_FILTERS, &[]).unwrap()
+    }
+
+    /// The JSON carries every key of the issue, and the filters in the default order.
+    #[test]
+    fn json_has_the_required_keys() {
+        let j = default_analysis().to_json();
+        for k in ["C1", "C2", "K_qu", "K_qp", "kappa", "tau", "omega_n", "zeta", "xc_crit_exact_mm", "xc_crit_simplified_mm"] {
+            assert!(j[k].is_number(), "{k}");
+        }
+        let filters = j["filters"].as_array().unwrap();
+        assert_eq!(filters.len(), DEFAULT_FILTERS.len());
+        for (f, (n_k, n_w)) in filters.iter().zip(DEFAULT_FILTERS) {
+            assert_eq!((f["n_K"].as_f64(), f["n_omega"].as_f64()), (Some(n_k), Some(n_w)));
+            for k in ["K_f", "omega_f", "gain_margin_db", "phase_margin_deg", "settling_time_s", "stable"] {
+                assert!(f.get(k).is_some(), "{k}");
+            }
+        }
+    }
+
+    /// The thesis' own statements about the default operating point (section 2.3, 6.1), an
+    /// independent source for the chain identification -> H(s) -> loop -> margins:
+    /// - Table 6.1: omega_f = 0.5 omega_n = 41.91 rad/s, omega_v = 33.3 rad/s (4 digits given);
+    /// - eq. 2.87: for mu_p = 3 unstable above s_c / 4 = 125 mm, so 250 mm is unstable;
+    /// - Fig. 6.3: the filter of [1] (n_K = 1, n_omega = 0.5) with valve dynamics is unstable,
+    ///   its loop gain never reaches 0 dB (no gain crossover);
+    /// - Table 6.3 / guideline: n_K = 2..5 with n_omega = 2 give a stable loop with gain
+    ///   margins in -6..-20 dB and phase margins "around 35 deg" (we accept 25-45 deg), filter a
+    ///   (n_K = 2) settles fastest and the settling time grows with n_K (filter b "small
+    ///   increase");
+    /// - the final filter: K_f = 4.08e-12, omega_f = 168 rad/s (3 digits given).
+    #[test]
+    fn thesis_statements_hold() {
+        let a = default_analysis();
+        assert!((0.5 * a.h.omega_n - 41.91).abs() < 0.005 && (a.omega_v - 33.3).abs() < 0.05);
+        assert!(!a.stable_uncompensated && a.xc_crit_simplified == 0.125);
+        let fig_6_3 = &a.filters[5];
+        assert!(!fig_6_3.stable && fig_6_3.margins.phase.is_empty());
+        let table_6_3 = &a.filters[1..5];
+        for f in table_6_3 {
+            let gm = f.margins.relevant_gain.unwrap().db;
+            let pm = f.margins.relevant_phase.unwrap().deg;
+            assert!(f.stable && (-20.0..=-6.0).contains(&gm) && (25.0..=45.0).contains(&pm), "{f:?}");
+        }
+        let ts: Vec<f64> = table_6_3.iter().map(|f| f.settling_time.unwrap()).collect();
+        assert!(ts.windows(2).all(|w| w[0] < w[1]), "{ts:?}");
+        let b = &a.filters[2].filter;
+        assert!((b.k_f / 4.08e-12 - 1.0).abs() < 0.005 && (b.omega_f - 168.0).abs() < 0.5);
+    }
+}

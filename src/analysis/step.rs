@@ -5,6 +5,7 @@
 //! (partial fractions of `G(s) / s`). Complex pairs contribute conjugate terms; the sum is real.
 
 use super::tf::Tf;
+use crate::hydraulics::solve::bisect;
 use nalgebra::Complex;
 
 /// The step response `y(t)` of `g` as a sum of modes.
@@ -48,16 +49,8 @@ impl StepResponse {
         let dt = t_end / n as f64;
         let out = |t: f64| (self.at(t) - self.final_value).abs() > tol;
         let Some(k) = (0..=n).rev().find(|&k| out(k as f64 * dt)) else { return 0.0 };
-        let (mut a, mut b) = (k as f64 * dt, (k + 1) as f64 * dt);
-        for _ in 0..60 {
-            let c = 0.5 * (a + b);
-            if out(c) {
-                a = c
-            } else {
-                b = c
-            }
-        }
-        0.5 * (a + b)
+        let (a, b) = (k as f64 * dt, (k + 1) as f64 * dt);
+        bisect(|t| (self.at(t) - self.final_value).abs() - tol, a, b, 1e-12 * b)
     }
 }
 
