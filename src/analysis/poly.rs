@@ -21,16 +21,6 @@ impl Poly {
         Poly(v)
     }
 
-    /// The constant `c`.
-    pub fn constant(c: f64) -> Self {
-        Poly::new(&[c])
-    }
-
-    /// `s`.
-    pub fn s() -> Self {
-        Poly::new(&[0.0, 1.0])
-    }
-
     /// Ascending coefficients.
     pub fn coeffs(&self) -> &[f64] {
         &self.0

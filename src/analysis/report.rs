@@ -6,6 +6,7 @@ use super::feedback::{self, FilterResult};
 use super::margins::Margins;
 use super::operating_point::{Linearised, OperatingPoint, SteadyStateError};
 use super::plant::{self, HParams};
+use super::routh;
 use crate::hydraulics::Circuit;
 use crate::units::{BAR, MM};
 use serde_json::{json, Value};
@@ -87,6 +88,8 @@ impl Analysis {
             "required_ratio_exact": criterion::required_ratio(op, lin),
             "required_ratio_simplified": criterion::required_ratio_simplified(op),
             "stable_uncompensated": self.stable_uncompensated,
+            "routh_rhp_poles_uncompensated":
+                routh::rhp_roots(&plant::closed_loop(lin.c2, &h.h()).den),
             "xc_crit_exact_mm": self.xc_crit_exact / MM,
             "xc_crit_simplified_mm": self.xc_crit_simplified / MM,
             "filters": self.filters.iter().map(filter_json).collect::<Vec<_>>(),

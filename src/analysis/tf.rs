@@ -60,11 +60,6 @@ impl Tf {
     pub fn plus(&self, o: &Tf) -> Tf {
         Tf { num: &(&self.num * &o.den) + &(&o.num * &self.den), den: &self.den * &o.den }
     }
-
-    /// Closed loop with negative unity feedback, `G / (1 + G) = N / (D + N)`.
-    pub fn feedback(&self) -> Tf {
-        Tf { num: self.num.clone(), den: &self.den + &self.num }
-    }
 }
 
 impl Mul for &Tf {
@@ -78,16 +73,18 @@ impl Mul for &Tf {
 mod tests {
     use super::*;
 
-    /// Algebra against hand-expanded results: 1/(s+1) + 1/(s+2) = (2s+3)/(s^2+3s+2), and the
-    /// unity feedback of 2/(s+1) is 2/(s+3).
+    /// Algebra against hand-expanded results: 1/(s+1) + 1/(s+2) = (2s+3)/(s^2+3s+2), and
+    /// 2/(s+1) * 1/(s+2) = 2/(s^2+3s+2) with DC gain 1, stable.
     #[test]
     fn algebra() {
-        let sum = Tf::new(&[1.0], &[1.0, 1.0]).plus(&Tf::new(&[1.0], &[2.0, 1.0]));
+        let (a, b) = (Tf::new(&[1.0], &[1.0, 1.0]), Tf::new(&[1.0], &[2.0, 1.0]));
+        let sum = a.plus(&b);
         assert_eq!((sum.num.coeffs(), sum.den.coeffs()), (&[3.0, 2.0][..], &[2.0, 3.0, 1.0][..]));
-        let cl = Tf::new(&[2.0], &[1.0, 1.0]).feedback();
-        assert_eq!(cl.den.coeffs(), &[3.0, 1.0]);
-        assert_eq!(cl.dc_gain(), 2.0 / 3.0);
-        assert!(cl.is_stable() && !Tf::new(&[1.0], &[-1.0, 1.0]).is_stable());
+        let prod = &Tf::new(&[2.0], &[1.0, 1.0]) * &b;
+        assert_eq!((prod.num.coeffs(), prod.den.coeffs()), (&[2.0][..], &[2.0, 3.0, 1.0][..]));
+        assert_eq!(prod.dc_gain(), 1.0);
+        assert_eq!(prod.inv().den.coeffs(), &[2.0]);
+        assert!(prod.is_stable() && !Tf::new(&[1.0], &[-1.0, 1.0]).is_stable());
         let g = Tf::lag(10.0).at(10.0);
         assert!((g.norm() - 0.5f64.sqrt()).abs() < 1e-15 && (g.arg() + std::f64::consts::FRAC_PI_4).abs() < 1e-15);
     }
