@@ -91,17 +91,19 @@ pub fn evaluate(op: &OperatingPoint, lin: &Linearised, h: &Tf, omega_n: f64, ome
 
 #[cfg(test)]
 mod tests {
-    use super::super::plant::HParams;
+    use super::super::report::{default_omega_v, Analysis};
     use super::*;
+
+    fn table_6_1() -> Analysis {
+        Analysis::new(OperatingPoint::default(), default_omega_v(), &[], &[]).unwrap()
+    }
 
     /// G_cl of the explicit form equals (H / (C2 s + H)) G_v / (1 + G_ol) evaluated pointwise,
     /// and its closed-loop poles are the zeros of 1 + G_ol (1e-9 relative: rounding). The
     /// filter's DC gain is zero, so G_cl(0) = 1 (steady flow passes unchanged).
     #[test]
     fn closed_loop_is_the_feedback_of_the_open_loop() {
-        let op = OperatingPoint::default();
-        let lin = op.linearise().unwrap();
-        let hp = HParams::new(&op, &lin);
+        let Analysis { op, lin, h: hp, .. } = table_6_1();
         let h = hp.h();
         let gv = valve(4.0 / 0.12);
         let gf = filter(&tuned(&op, &lin, hp.omega_n, 3.0, 2.0));
@@ -125,9 +127,7 @@ mod tests {
     /// samples to within one sample (h).
     #[test]
     fn step_response_matches_state_space_simulation() {
-        let op = OperatingPoint::default();
-        let lin = op.linearise().unwrap();
-        let hp = HParams::new(&op, &lin);
+        let Analysis { op, lin, h: hp, .. } = table_6_1();
         let h = hp.h();
         let g = closed_loop(lin.c2, &h, &valve(4.0 / 0.12), &filter(&tuned(&op, &lin, hp.omega_n, 3.0, 2.0)));
         // time in ms: s = 1e3 s_ms
