@@ -8,6 +8,7 @@ mod common;
 use boomsim::analysis::criterion;
 use boomsim::analysis::plant::{closed_loop, HParams};
 use boomsim::analysis::OperatingPoint;
+use boomsim::fmi2::types::fmi2Status;
 use boomsim::hydraulics::params::PARAMS;
 use boomsim::hydraulics::solve::bisect;
 use boomsim::hydraulics::Circuit;
@@ -16,7 +17,6 @@ use boomsim::mechanics::rigid_boom::RigidBoom;
 use boomsim::models::hydraulic_boom::vr;
 use boomsim::models::HydraulicBoom;
 use boomsim::units::mm;
-use boomsim::fmi2::types::fmi2Status;
 use common::Slave;
 
 /// Spool reference of the lowering step: 10 % (the step of section 6.2), 2.5 l/min.

@@ -54,10 +54,7 @@ pub fn open_loop(c2: f64, h: &Tf, gv: &Tf, gf: &Tf) -> Tf {
 /// common factors: `N_H D_f / (A D_f D_v + N_f D_H)` with `C2 s + H = A / D_H`.
 pub fn closed_loop(c2: f64, h: &Tf, gv: &Tf, gf: &Tf) -> Tf {
     let a = admittance(c2, h).num;
-    Tf {
-        num: &(&h.num * &gf.den) * &gv.num,
-        den: &(&(&a * &gf.den) * &gv.den) + &(&(&gf.num * &h.den) * &gv.num),
-    }
+    Tf { num: &(&h.num * &gf.den) * &gv.num, den: &(&(&a * &gf.den) * &gv.den) + &(&(&gf.num * &h.den) * &gv.num) }
 }
 
 /// Margins and step response of one filter.
@@ -74,7 +71,15 @@ pub struct FilterResult {
 }
 
 /// Evaluates the filter `(n_K, n_omega)` at an operating point with valve bandwidth `omega_v`.
-pub fn evaluate(op: &OperatingPoint, lin: &Linearised, h: &Tf, omega_n: f64, omega_v: f64, n_k: f64, n_omega: f64) -> FilterResult {
+pub fn evaluate(
+    op: &OperatingPoint,
+    lin: &Linearised,
+    h: &Tf,
+    omega_n: f64,
+    omega_v: f64,
+    n_k: f64,
+    n_omega: f64,
+) -> FilterResult {
     let f = tuned(op, lin, omega_n, n_k, n_omega);
     let (gv, gf) = (valve(omega_v), filter(&f));
     let cl = closed_loop(lin.c2, h, &gv, &gf);

@@ -61,7 +61,8 @@ pub fn margins(l: &Tf) -> Margins {
     let n = d.len() - 1;
     let lead = d.iter().position(|&c| c != 0.0).unwrap_or(0);
     let w0 = if n > lead { (d[lead] / d[n]).abs().powf(1.0 / (n - lead) as f64) } else { 1.0 };
-    let scaled = |p: &Poly| Poly::new(&p.coeffs().iter().enumerate().map(|(k, c)| c * w0.powi(k as i32)).collect::<Vec<_>>());
+    let scaled =
+        |p: &Poly| Poly::new(&p.coeffs().iter().enumerate().map(|(k, c)| c * w0.powi(k as i32)).collect::<Vec<_>>());
     let (nr, ni) = scaled(&l.num).on_imaginary_axis();
     let (dr, di) = scaled(&l.den).on_imaginary_axis();
     let im = &(&ni * &dr) - &(&nr * &di);

@@ -176,7 +176,9 @@ mod tests {
     #[test]
     fn json_has_the_required_keys() {
         let j = default_analysis().to_json();
-        for k in ["C1", "C2", "K_qu", "K_qp", "kappa", "tau", "omega_n", "zeta", "xc_crit_exact_mm", "xc_crit_simplified_mm"] {
+        for k in
+            ["C1", "C2", "K_qu", "K_qp", "kappa", "tau", "omega_n", "zeta", "xc_crit_exact_mm", "xc_crit_simplified_mm"]
+        {
             assert!(j[k].is_number(), "{k}");
         }
         let filters = j["filters"].as_array().unwrap();

@@ -25,7 +25,8 @@ fn with_valve(base: &OperatingPoint, mu_p: f64, q3: f64) -> Option<OperatingPoin
 /// Closed-loop stability (eq. 2.82) along the stroke, 5 mm steps, per valve.
 pub fn boundary_along_stroke(base: &OperatingPoint) -> Result<String, String> {
     let q3 = base.flow().map_err(|e| e.to_string())?;
-    let mut csv = String::from("mu_p,p_set_bar,p4_bar,x_c_mm,C2_over_C1,required_exact,required_simplified,max_pole_re,stable\n");
+    let mut csv =
+        String::from("mu_p,p_set_bar,p4_bar,x_c_mm,C2_over_C1,required_exact,required_simplified,max_pole_re,stable\n");
     for (mu_p, _) in CBV_TABLE_4_3 {
         let Some(op) = with_valve(base, mu_p, q3) else { continue };
         for i in 0..=100 {
