@@ -1,4 +1,5 @@
-//! The boomsim command line: build and pack the FMUs, keep modelDescription files current.
+//! The boomsim command line: build and pack the FMUs, keep modelDescription files current,
+//! analyse the linearised stability.
 
 use boomsim::models;
 use clap::{Parser, Subcommand};
@@ -55,6 +56,8 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
+    Analyze(Box<boomsim::analysis::cli::AnalyzeArgs>),
 }
 
 /// The workspace root (this package's manifest directory).
@@ -207,6 +210,7 @@ fn main() -> ExitCode {
         Cmd::Eigen { json, count } => eigen(json, count),
         Cmd::Xml { check } => xml(check),
         Cmd::Deflection { json } => deflection(json),
+        Cmd::Analyze(args) => boomsim::analysis::cli::run(&args, root()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

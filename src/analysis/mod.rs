@@ -1,2 +1,23 @@
-//! Linearised stability analysis (thesis section 2.3 and 6.1).
+//! Linearised stability analysis and filter tuning (thesis section 2.3 and 6.1): transfer
+//! functions, the Routh-Hurwitz instability criterion, margins and settling times of the
+//! pressure feedback, the `boomsim analyze` command, and the modes of the nonlinear model
+//! linearised at rest (`boomsim eigen`).
+
+pub mod cli;
+pub mod criterion;
+#[cfg(test)]
+mod dimensions;
+pub mod feedback;
+pub mod margins;
 pub mod modes;
+pub mod operating_point;
+pub mod plant;
+pub mod poly;
+pub mod report;
+pub mod routh;
+pub mod step;
+pub mod sweep;
+pub mod tf;
+
+pub use operating_point::OperatingPoint;
+pub use report::Analysis;

@@ -1,6 +1,7 @@
 //! Modes of a nonlinear model linearised at a state: eigenvalues of the Jacobian of its ODE
 //! (central differences), as natural frequencies and damping ratios.
 
+use crate::analysis::poly::eigenvalues;
 use crate::fmi2::{Model, Value, Values};
 use crate::models::hydraulic_boom::{vr, Plant};
 use crate::models::HydraulicBoom;
@@ -45,8 +46,7 @@ pub fn jacobian(sys: &dyn OdeSystem, t: f64, x: &[f64], scale: &[f64]) -> DMatri
 
 /// The oscillatory modes of `jacobian`, lowest natural frequency first (one per conjugate pair).
 pub fn modes(jacobian: DMatrix<f64>) -> Vec<Mode> {
-    let mut modes: Vec<Mode> = jacobian
-        .complex_eigenvalues()
+    let mut modes: Vec<Mode> = eigenvalues(jacobian)
         .iter()
         .filter(|l| l.im > 0.0)
         .map(|l| Mode { frequency_hz: l.norm() / std::f64::consts::TAU, damping_ratio: -l.re / l.norm() })

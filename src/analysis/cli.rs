@@ -1,0 +1,133 @@
+//! Options and entry point of `boomsim analyze` (engineering units on the command line).
+
+use super::operating_point::{p_set_for, OperatingPoint};
+use super::report::{self, Analysis, DEFAULT_FILTERS};
+use super::sweep;
+use crate::units::{bar, mm, BAR};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// `boomsim analyze`: linear stability and filter tuning at one operating point.
+#[derive(clap::Args, Debug, Clone)]
+pub struct AnalyzeArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the stroke/flow stability boundaries and the margin maps (CSV + PNG).
+    #[arg(long)]
+    pub sweep: bool,
+    /// Output directory of --sweep.
+    #[arg(long, default_value = "out/analysis")]
+    pub out: PathBuf,
+    /// Stroke x_c [mm] (Table 6.1: 250).
+    #[arg(long, default_value_t = 250.0)]
+    pub xc: f64,
+    /// Steady rod-side pressure p4 [bar] (Table 6.1: 45).
+    #[arg(long, default_value_t = 45.0)]
+    pub p4: f64,
+    /// CBV pilot ratio mu_p [-] (default: 3, identified from Table 6.1).
+    #[arg(long)]
+    pub mu_p: Option<f64>,
+    /// CBV set pressure [bar] (default: Table 4.3 setting of the valve with this mu_p).
+    #[arg(long)]
+    pub p_set: Option<f64>,
+    /// Equivalent mass at the cylinder [kg] (default: 2456, identified from Table 6.1).
+    #[arg(long)]
+    pub mass: Option<f64>,
+    /// Load force on the rod [N] (default: mass * g, eq. 2.69).
+    #[arg(long)]
+    pub load: Option<f64>,
+    /// Bulk modulus [MPa] (parameter list: 1300).
+    #[arg(long)]
+    pub beta: Option<f64>,
+    /// Extra capacitance on the piston side [cm^3/bar] (line 3, dead volume, hose).
+    #[arg(long, default_value_t = 0.0)]
+    pub c1_extra: f64,
+    /// Extra capacitance on the rod side [cm^3/bar] (line 4, dead volume, hose).
+    #[arg(long, default_value_t = 0.0)]
+    pub c2_extra: f64,
+    /// Valve bandwidth omega_v [rad/s] (default 33.3: 4 / 0.120 s, eq. 6.4).
+    #[arg(long)]
+    pub omega_v: Option<f64>,
+    /// Filter gain factors n_K (eq. 6.6), comma separated; combined with every --n-omega.
+    #[arg(long, value_delimiter = ',')]
+    pub n_k: Vec<f64>,
+    /// Filter frequency factors n_omega (eq. 6.7), comma separated.
+    #[arg(long, value_delimiter = ',')]
+    pub n_omega: Vec<f64>,
+    /// Explicit filter gain K_f [m^4 s^2/kg] (with --omega-f; replaces the default filters).
+    #[arg(long, requires = "omega_f")]
+    pub k_f: Option<f64>,
+    /// Explicit filter frequency omega_f [rad/s].
+    #[arg(long, requires = "k_f")]
+    pub omega_f: Option<f64>,
+}
+
+impl AnalyzeArgs {
+    /// The operating point: Table 6.1 defaults overridden by the options.
+    pub fn operating_point(&self) -> OperatingPoint {
+        let d = OperatingPoint::default();
+        let mu_p = self.mu_p.unwrap_or(d.mu_p);
+        let mass = self.mass.unwrap_or(d.mass);
+        OperatingPoint {
+            x_c: mm(self.xc),
+            p4: bar(self.p4),
+            mu_p,
+            p_set: self.p_set.map_or_else(|| p_set_for(mu_p), bar),
+            mass,
+            load: self.load.unwrap_or(d.load / d.mass * mass),
+            beta: self.beta.map_or(d.beta, |b| b * 1e6),
+            c1_extra: self.c1_extra * 1e-6 / BAR,
+            c2_extra: self.c2_extra * 1e-6 / BAR,
+            ..d
+        }
+    }
+
+    /// `(n_K, n_omega)` pairs: the cross product of the options, or the defaults.
+    fn tuned_filters(&self) -> Vec<(f64, f64)> {
+        if self.n_k.is_empty() && self.n_omega.is_empty() {
+            return if self.k_f.is_some() { Vec::new() } else { DEFAULT_FILTERS.to_vec() };
+        }
+        let n_k = if self.n_k.is_empty() { vec![1.0] } else { self.n_k.clone() };
+        let n_w = if self.n_omega.is_empty() { vec![2.0] } else { self.n_omega.clone() };
+        n_k.iter().flat_map(|&k| n_w.iter().map(move |&w| (k, w))).collect()
+    }
+}
+
+/// Runs `boomsim analyze`; `root` is the workspace root (for the plot script and a relative
+/// `--out`).
+pub fn run(args: &AnalyzeArgs, root: &Path) -> Result<(), String> {
+    let op = args.operating_point();
+    let omega_v = args.omega_v.unwrap_or_else(report::default_omega_v);
+    let explicit: Vec<(f64, f64)> = args.k_f.zip(args.omega_f).into_iter().collect();
+    let a = Analysis::new(op, omega_v, &args.tuned_filters(), &explicit).map_err(|e| e.to_string())?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&a.to_json()).map_err(|e| e.to_string())?);
+    } else {
+        print!("{}", report::text(&a));
+    }
+    if args.sweep {
+        let out = if args.out.is_absolute() { args.out.clone() } else { root.join(&args.out) };
+        for p in sweep::write_all(&op, omega_v, &out)? {
+            eprintln!("{}", p.display());
+        }
+        plot(root, &out)?;
+    }
+    Ok(())
+}
+
+/// Runs `scripts/plot_analysis.py` with the project's venv (or `python3`) to draw the PNGs.
+fn plot(root: &Path, dir: &Path) -> Result<(), String> {
+    let venv = root.join(".venv/bin/python");
+    let python = if venv.exists() { venv } else { PathBuf::from("python3") };
+    let status = Command::new(&python)
+        .arg(root.join("scripts/plot_analysis.py"))
+        .arg(dir)
+        .status()
+        .map_err(|e| format!("cannot run {}: {e} (the CSV files are written)", python.display()))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("plot_analysis.py failed ({status}); the CSV files are written"))
+    }
+}
