@@ -26,15 +26,20 @@
 //! (newt = Newton iterations); on accepted steps also Gustafsson's predictive controller
 //! `h_new ≤ 0.9·h·(h/h_acc)·(err_acc/err²)^(1/4)` (previous accepted step `h_acc`, `err_acc`).
 //! After a rejection the step is not increased. The Jacobian is reused while the Newton
-//! contraction `θ ≤ 0.001`; `h` and the LU are kept if `1 ≤ h_new/h ≤ 1.2`.
+//! contraction `θ ≤ THET` (0.01); `h` and the LU are kept if `1 ≤ h_new/h ≤ 1.2`. The LU factors
+//! are also reused, with the Jacobian, for any later step whose size equals theirs up to
+//! rounding (`|h - h_lu| ≤ 1e-9·h_lu`), e.g. the step cut to land on `t_end` or the first step of
+//! the next call when both are one communication step long.
 //!
 //! **Communication points.** Steps never pass `t_end`; if the wanted step reaches `t_end` it is
 //! cut to land exactly, if it covers more than half the rest, the rest is split into two equal
 //! steps. Each `integrate` call starts with the carried step-size hint and, as between steps, the
 //! Jacobian of the previous call unless the last Newton contraction asked for a new one: it is
 //! only the iteration matrix, so a stale one (inputs changed) costs iterations, never accuracy,
-//! and a Newton failure recomputes it. Hint, contraction and Jacobian are the persistent state
-//! ([`Radau5::save_state`]), so a restored integrator continues bit-identically.
+//! and a Newton failure recomputes it; its LU factors are kept too if the first step has their
+//! step size. Hint, contraction, Jacobian and the step size of the LU factors are the persistent
+//! state ([`Radau5::save_state`]); the factors are recomputed from them on loading, so a restored
+//! integrator continues bit-identically.
 
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
@@ -61,6 +66,9 @@ const QUOT2: f64 = 1.2;
 const MAX_REJECTIONS: u32 = 100;
 /// First step size when there is no hint.
 const H_INITIAL: f64 = 1e-6;
+/// The LU factors of step size `h_lu` serve a step `h` with `|h - h_lu| <= H_SAME·h_lu`: the
+/// same step up to the rounding of `t_end - t` (a few 1e-12 relative for 1 ms steps at t ~ 10 s).
+const H_SAME: f64 = 1e-9;
 
 /// Radau IIA constants: nodes, error-estimate weights, eigenvalues of `A⁻¹` and the
 /// transformation `T`, `T⁻¹` (values of `radau5.f`).
@@ -114,6 +122,8 @@ pub struct Radau5 {
     /// Newton contraction rate of the last step; with `jac_valid`, decides Jacobian reuse.
     theta: f64,
     jac_valid: bool,
+    /// Step size the LU factors `e1`, `e2` belong to; 0 if they do not match `jac`.
+    h_lu: f64,
     stats: SolverStats,
     gamma: f64,
     alpha: f64,
@@ -132,8 +142,9 @@ pub struct Radau5 {
     ftmp: Vec<f64>,
     zc: Vec<Complex<f64>>,
     jac: DMatrix<f64>,
-    e1: DMatrix<f64>,
-    e2: DMatrix<Complex<f64>>,
+    /// LU factors of `γ/h·I - J` and `(α + iβ)/h·I - J`, column-major `n × n`.
+    e1: Vec<f64>,
+    e2: Vec<Complex<f64>>,
     piv1: Vec<usize>,
     piv2: Vec<usize>,
 }
@@ -160,6 +171,7 @@ impl Radau5 {
             h_hint: 0.0,
             theta: THET,
             jac_valid: false,
+            h_lu: 0.0,
             stats: SolverStats::default(),
             gamma,
             alpha,
@@ -175,8 +187,8 @@ impl Radau5 {
             ftmp: v(),
             zc: vec![Complex::new(0.0, 0.0); n],
             jac: DMatrix::zeros(n, n),
-            e1: DMatrix::zeros(n, n),
-            e2: DMatrix::zeros(n, n),
+            e1: vec![0.0; n * n],
+            e2: vec![Complex::new(0.0, 0.0); n * n],
             piv1: vec![0; n],
             piv2: vec![0; n],
         };
@@ -245,37 +257,52 @@ impl Radau5 {
         self.stats = SolverStats::default();
     }
 
-    /// Forgets the step-size hint and the Jacobian, e.g. after a discontinuity in the model.
+    /// Forgets the step-size hint, the Jacobian and its LU factors, e.g. after a discontinuity
+    /// in the model.
     pub fn reset(&mut self) {
         self.h_hint = 0.0;
         self.jac_valid = false;
+        self.h_lu = 0.0;
     }
 
-    /// Number of `f64` in [`save_state`](Self::save_state): `3 + n²`.
+    /// Number of `f64` in [`save_state`](Self::save_state): `4 + n²`.
     pub fn state_len(&self) -> usize {
-        3 + self.n * self.n
+        4 + self.n * self.n
     }
 
     /// The persistent state carried between calls: step-size hint (0 = none), last Newton
-    /// contraction, Jacobian validity (0/1) and the Jacobian (column-major).
+    /// contraction, Jacobian validity (0/1), the step size of the LU factors (0 = none) and the
+    /// Jacobian (column-major). The LU factors themselves are not saved: they are a
+    /// deterministic function of the Jacobian and their step size, and
+    /// [`load_state`](Self::load_state) recomputes them bit-identically.
     pub fn save_state(&self) -> Vec<f64> {
-        let mut s = vec![self.h_hint, self.theta, self.jac_valid as u8 as f64];
+        let mut s = vec![self.h_hint, self.theta, self.jac_valid as u8 as f64, self.h_lu];
         s.extend_from_slice(self.jac.as_slice());
         s
     }
 
-    /// Restores a state from [`save_state`](Self::save_state).
+    /// Restores a state from [`save_state`](Self::save_state), refactorising the iteration
+    /// matrices if the saved state had LU factors.
     pub fn load_state(&mut self, s: &[f64]) -> Result<(), SolveError> {
         if s.len() != self.state_len() || s.iter().any(|v| !v.is_finite()) {
             return Err(invalid(format!("expected {} finite numbers, got {}", self.state_len(), s.len())));
         }
-        if !(s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || s[2] == 1.0)) {
-            return Err(invalid(format!("step-size hint {}, contraction {}, flag {} are invalid", s[0], s[1], s[2])));
+        let jac_valid = s[2] == 1.0;
+        if !(s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && (jac_valid || s[3] == 0.0)) {
+            return Err(invalid(format!(
+                "step-size hint {}, contraction {}, flag {}, LU step size {} are invalid",
+                s[0], s[1], s[2], s[3]
+            )));
         }
         self.h_hint = s[0];
         self.theta = s[1];
-        self.jac_valid = s[2] == 1.0;
-        self.jac.as_mut_slice().copy_from_slice(&s[3..]);
+        self.jac_valid = jac_valid;
+        self.jac.as_mut_slice().copy_from_slice(&s[4..]);
+        self.h_lu = 0.0;
+        if s[3] > 0.0 && !self.decompose(s[3]) {
+            self.jac_valid = false;
+            return Err(invalid(format!("the saved Jacobian is singular at step size {}", s[3])));
+        }
         Ok(())
     }
 
@@ -313,7 +340,6 @@ impl Radau5 {
         }
         self.update_scal();
 
-        let (gamma, alpha, beta) = (self.gamma, self.alpha, self.beta);
         let fnewt = (10.0 * UROUND / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
         let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_end.abs());
         let cfac = SAFE * (1 + 2 * NIT) as f64;
@@ -321,7 +347,8 @@ impl Radau5 {
         let mut h_nat = if self.h_hint > 0.0 { self.h_hint } else { H_INITIAL }.min(self.max_step);
         let (mut h, mut last) = plan(t, t_end, h_nat);
         let (mut first, mut reject) = (true, false);
-        let (mut need_jac, mut need_lu, mut caljac) = (!self.jac_valid || self.theta > THET, true, false);
+        let mut need_jac = !self.jac_valid || self.theta > THET;
+        let (mut need_lu, mut caljac) = (need_jac || !self.lu_matches(h), false);
         let (mut theta, mut hold) = (self.theta, h);
         let (mut hacc, mut erracc, mut n_acc) = (0.0, 0.0, 0u64);
         let (mut n_rej_row, mut n_attempts) = (0u32, 0u64);
@@ -360,12 +387,11 @@ impl Radau5 {
                     return Err(SolveError { kind: SolveErrorKind::NonFiniteJacobian, t, h });
                 }
                 caljac = true;
-                self.jac_valid = true;
                 need_jac = false;
                 need_lu = true;
             }
             if need_lu {
-                if !self.decompose(gamma / h, alpha / h, beta / h) {
+                if !self.decompose(h) {
                     h *= 0.5;
                     fail = Some(FailureCause::SingularMatrix);
                     continue;
@@ -405,8 +431,8 @@ impl Radau5 {
                 continue;
             }
             // Candidate new state and f there; a non-finite f rejects the step.
-            for i in 0..n {
-                self.tmp[i] = self.y[i] + self.z[2][i];
+            for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(&self.z[2]) {
+                *x = y + z;
             }
             sys.rhs(tph, &self.tmp, &mut self.ftmp);
             self.stats.rhs_evals += 1;
@@ -458,14 +484,14 @@ impl Radau5 {
             }
             h = hn;
             last = lastn;
-            need_lu = true;
             need_jac = theta > THET;
+            need_lu = need_jac || !self.lu_matches(h);
         }
     }
 
     fn update_scal(&mut self) {
-        for i in 0..self.n {
-            self.scal[i] = self.atol[i] + self.rtol * self.y[i].abs();
+        for ((s, &a), &y) in self.scal.iter_mut().zip(&self.atol).zip(&self.y) {
+            *s = a + self.rtol * y.abs();
         }
     }
 
@@ -473,64 +499,87 @@ impl Radau5 {
     /// `δ_j = sqrt(ε·max(1e-5, |y_j|))` (radau5.f). Returns `false` if not finite.
     fn compute_jacobian<S: OdeSystem + ?Sized>(&mut self, sys: &S, t: f64) -> bool {
         self.stats.jacobian_evals += 1;
+        self.h_lu = 0.0;
         if !sys.jacobian(t, &self.y, &mut self.jac) {
             self.tmp.copy_from_slice(&self.y);
-            for j in 0..self.n {
+            for (j, col) in self.jac.as_mut_slice().chunks_exact_mut(self.n).enumerate() {
                 let delta = (UROUND * self.y[j].abs().max(1e-5)).sqrt();
                 self.tmp[j] = self.y[j] + delta;
                 sys.rhs(t, &self.tmp, &mut self.ftmp);
                 self.tmp[j] = self.y[j];
-                for i in 0..self.n {
-                    self.jac[(i, j)] = (self.ftmp[i] - self.y0[i]) / delta;
+                for ((c, &f), &f0) in col.iter_mut().zip(&self.ftmp).zip(&self.y0) {
+                    *c = (f - f0) / delta;
                 }
             }
             self.stats.rhs_evals += self.n as u64;
         }
-        self.jac.iter().all(|v| v.is_finite())
+        self.jac_valid = self.jac.iter().all(|v| v.is_finite());
+        self.jac_valid
     }
 
-    /// Factorises `E1 = fac1·I - J` and `E2 = (alphn + i·betan)·I - J`.
-    fn decompose(&mut self, fac1: f64, alphn: f64, betan: f64) -> bool {
+    /// Whether the LU factors serve a step of size `h` (see [`H_SAME`]).
+    fn lu_matches(&self, h: f64) -> bool {
+        self.h_lu > 0.0 && (h - self.h_lu).abs() <= H_SAME * self.h_lu
+    }
+
+    /// Factorises `E1 = γ/h·I - J` and `E2 = (α + iβ)/h·I - J`; on success the factors belong to
+    /// step size `h`.
+    fn decompose(&mut self, h: f64) -> bool {
         self.stats.lu_decompositions += 1;
-        for j in 0..self.n {
-            for i in 0..self.n {
-                let d = if i == j { 1.0 } else { 0.0 };
-                let jij = self.jac[(i, j)];
-                self.e1[(i, j)] = fac1 * d - jij;
-                self.e2[(i, j)] = Complex::new(alphn * d - jij, betan * d);
+        let (fac1, alphn, betan) = (self.gamma / h, self.alpha / h, self.beta / h);
+        let n = self.n;
+        let cols =
+            self.jac.as_slice().chunks_exact(n).zip(self.e1.chunks_exact_mut(n)).zip(self.e2.chunks_exact_mut(n));
+        for (j, ((jc, e1c), e2c)) in cols.enumerate() {
+            for ((&jij, e1), e2) in jc.iter().zip(e1c.iter_mut()).zip(e2c.iter_mut()) {
+                *e1 = 0.0 - jij;
+                *e2 = Complex::new(0.0 - jij, 0.0);
             }
+            e1c[j] = fac1 - jc[j];
+            e2c[j] = Complex::new(alphn - jc[j], betan);
         }
-        lu::factor(&mut self.e1, &mut self.piv1) && lu::factor(&mut self.e2, &mut self.piv2)
+        let ok = lu::factor(&mut self.e1, &mut self.piv1) && lu::factor(&mut self.e2, &mut self.piv2);
+        self.h_lu = if ok { h } else { 0.0 };
+        ok
     }
 
     /// Starting values from the collocation polynomial of the last step; `r = h/h_old`.
     fn extrapolate(&mut self, r: f64) {
+        let n = self.n;
         let cq = [C1 * r, C2 * r, r];
-        for i in 0..self.n {
-            let (a1, a2, a3) = (self.cont[0][i], self.cont[1][i], self.cont[2][i]);
-            let mut zi = [0.0; 3];
-            for k in 0..3 {
-                zi[k] = cq[k] * (a1 + (cq[k] - C2M1) * (a2 + (cq[k] - C1M1) * a3));
-                self.z[k][i] = zi[k];
-            }
-            self.w[0][i] = TI11 * zi[0] + TI12 * zi[1] + TI13 * zi[2];
-            self.w[1][i] = TI21 * zi[0] + TI22 * zi[1] + TI23 * zi[2];
-            self.w[2][i] = TI31 * zi[0] + TI32 * zi[1] + TI33 * zi[2];
+        let [c0, c1, c2] = &self.cont;
+        let [z0, z1, z2] = &mut self.z;
+        let [w0, w1, w2] = &mut self.w;
+        let (c0, c1, c2) = (&c0[..n], &c1[..n], &c2[..n]);
+        let (z0, z1, z2) = (&mut z0[..n], &mut z1[..n], &mut z2[..n]);
+        let (w0, w1, w2) = (&mut w0[..n], &mut w1[..n], &mut w2[..n]);
+        for i in 0..n {
+            let (a1, a2, a3) = (c0[i], c1[i], c2[i]);
+            let zi = cq.map(|c| c * (a1 + (c - C2M1) * (a2 + (c - C1M1) * a3)));
+            (z0[i], z1[i], z2[i]) = (zi[0], zi[1], zi[2]);
+            w0[i] = TI11 * zi[0] + TI12 * zi[1] + TI13 * zi[2];
+            w1[i] = TI21 * zi[0] + TI22 * zi[1] + TI23 * zi[2];
+            w2[i] = TI31 * zi[0] + TI32 * zi[1] + TI33 * zi[2];
         }
     }
 
     /// Divided differences of the collocation polynomial through `y_new - y_old` at `c_i - 1`,
     /// from the increments `Z` of the accepted step.
     fn update_cont(&mut self) {
-        for i in 0..self.n {
-            let (z1, z2, z3) = (self.z[0][i], self.z[1][i], self.z[2][i]);
-            let c1 = (z2 - z3) / C2M1;
+        let n = self.n;
+        let [z0, z1, z2] = &self.z;
+        let [c0, c1, c2] = &mut self.cont;
+        let (z0, z1, z2) = (&z0[..n], &z1[..n], &z2[..n]);
+        let (c0, c1, c2) = (&mut c0[..n], &mut c1[..n], &mut c2[..n]);
+        for i in 0..n {
+            let (z1, z2, z3) = (z0[i], z1[i], z2[i]);
+            let d1 = (z2 - z3) / C2M1;
             let ak = (z1 - z2) / C1MC2;
             let acont3 = (ak - z1 / C1) / C2;
-            let c2 = (ak - c1) / C1M1;
-            self.cont[0][i] = c1;
-            self.cont[1][i] = c2;
-            self.cont[2][i] = c2 - acont3;
+            let d2 = (ak - d1) / C1M1;
+            c0[i] = d1;
+            c1[i] = d2;
+            c2[i] = d2 - acont3;
         }
     }
 
@@ -556,33 +605,43 @@ impl Radau5 {
                 return Err(diverged);
             }
             let times = [t + C1 * h, t + C2 * h, tph];
-            for (k, &tk) in times.iter().enumerate() {
-                for i in 0..n {
-                    self.tmp[i] = self.y[i] + self.z[k][i];
+            for (zk, &tk) in self.z.iter_mut().zip(&times) {
+                for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(zk.iter()) {
+                    *x = y + z;
                 }
-                sys.rhs(tk, &self.tmp, &mut self.z[k]);
+                sys.rhs(tk, &self.tmp, zk);
             }
             self.stats.rhs_evals += 3;
-            if !(all_finite(&self.z[0]) && all_finite(&self.z[1]) && all_finite(&self.z[2])) {
+            if !self.z.iter().all(|zk| all_finite(zk)) {
                 return Err(NewtonFail { cause: FailureCause::NonFiniteRhs, hfac: 0.5 });
             }
             // Right-hand sides of the transformed systems, then solve.
-            let mut dyno = 0.0;
-            for i in 0..n {
-                let (a1, a2, a3) = (self.z[0][i], self.z[1][i], self.z[2][i]);
-                let (w1, w2, w3) = (self.w[0][i], self.w[1][i], self.w[2][i]);
-                self.z[0][i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - w1 * fac1;
-                let r2 = TI21 * a1 + TI22 * a2 + TI23 * a3 - w2 * alphn + w3 * betan;
-                let r3 = TI31 * a1 + TI32 * a2 + TI33 * a3 - w3 * alphn - w2 * betan;
-                self.zc[i] = Complex::new(r2, r3);
+            {
+                let [z0, z1, z2] = &mut self.z;
+                let [w0, w1, w2] = &self.w;
+                let (z0, z1, z2, zc) = (&mut z0[..n], &z1[..n], &z2[..n], &mut self.zc[..n]);
+                let (w0, w1, w2) = (&w0[..n], &w1[..n], &w2[..n]);
+                for i in 0..n {
+                    let (a1, a2, a3) = (z0[i], z1[i], z2[i]);
+                    let (w1, w2, w3) = (w0[i], w1[i], w2[i]);
+                    z0[i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - w1 * fac1;
+                    let r2 = TI21 * a1 + TI22 * a2 + TI23 * a3 - w2 * alphn + w3 * betan;
+                    let r3 = TI31 * a1 + TI32 * a2 + TI33 * a3 - w3 * alphn - w2 * betan;
+                    zc[i] = Complex::new(r2, r3);
+                }
             }
             lu::solve(&self.e1, &self.piv1, &mut self.z[0]);
             lu::solve(&self.e2, &self.piv2, &mut self.zc);
-            for i in 0..n {
-                self.z[1][i] = self.zc[i].re;
-                self.z[2][i] = self.zc[i].im;
-                let s = self.scal[i];
-                dyno += (self.z[0][i] / s).powi(2) + (self.z[1][i] / s).powi(2) + (self.z[2][i] / s).powi(2);
+            let mut dyno = 0.0;
+            {
+                let [z0, z1, z2] = &mut self.z;
+                let (z0, z1, z2, zc, scal) = (&z0[..n], &mut z1[..n], &mut z2[..n], &self.zc[..n], &self.scal[..n]);
+                for i in 0..n {
+                    z1[i] = zc[i].re;
+                    z2[i] = zc[i].im;
+                    let s = scal[i];
+                    dyno += (z0[i] / s).powi(2) + (z1[i] / s).powi(2) + (z2[i] / s).powi(2);
+                }
             }
             self.stats.newton_iterations += 1;
             newt += 1;
@@ -604,16 +663,22 @@ impl Radau5 {
                 }
             }
             dynold = dyno.max(UROUND);
-            for i in 0..n {
-                let w1 = self.w[0][i] + self.z[0][i];
-                let w2 = self.w[1][i] + self.z[1][i];
-                let w3 = self.w[2][i] + self.z[2][i];
-                self.w[0][i] = w1;
-                self.w[1][i] = w2;
-                self.w[2][i] = w3;
-                self.z[0][i] = T11 * w1 + T12 * w2 + T13 * w3;
-                self.z[1][i] = T21 * w1 + T22 * w2 + T23 * w3;
-                self.z[2][i] = T31 * w1 + w2;
+            {
+                let [z0, z1, z2] = &mut self.z;
+                let [w0, w1, w2] = &mut self.w;
+                let (z0, z1, z2) = (&mut z0[..n], &mut z1[..n], &mut z2[..n]);
+                let (w0, w1, w2) = (&mut w0[..n], &mut w1[..n], &mut w2[..n]);
+                for i in 0..n {
+                    let a1 = w0[i] + z0[i];
+                    let a2 = w1[i] + z1[i];
+                    let a3 = w2[i] + z2[i];
+                    w0[i] = a1;
+                    w1[i] = a2;
+                    w2[i] = a3;
+                    z0[i] = T11 * a1 + T12 * a2 + T13 * a3;
+                    z1[i] = T21 * a1 + T22 * a2 + T23 * a3;
+                    z2[i] = T31 * a1 + a2;
+                }
             }
             if !dyno.is_finite() {
                 return Err(diverged);
@@ -629,23 +694,28 @@ impl Radau5 {
         let n = self.n;
         let (h1, h2, h3) = (DD1 / h, DD2 / h, DD3 / h);
         // ftmp = (e·Z)/h, tmp = E1⁻¹ (f(t, y) + ftmp).
-        for i in 0..n {
-            self.ftmp[i] = h1 * self.z[0][i] + h2 * self.z[1][i] + h3 * self.z[2][i];
-            self.tmp[i] = self.ftmp[i] + self.y0[i];
+        {
+            let [z0, z1, z2] = &self.z;
+            let (z0, z1, z2, y0) = (&z0[..n], &z1[..n], &z2[..n], &self.y0[..n]);
+            let (ftmp, tmp) = (&mut self.ftmp[..n], &mut self.tmp[..n]);
+            for i in 0..n {
+                ftmp[i] = h1 * z0[i] + h2 * z1[i] + h3 * z2[i];
+                tmp[i] = ftmp[i] + y0[i];
+            }
         }
         lu::solve(&self.e1, &self.piv1, &mut self.tmp);
         let err = self.norm(&self.tmp);
         if err < 1.0 || !refine {
             return err;
         }
-        for i in 0..n {
-            self.tmp[i] += self.y[i];
+        for (x, &y) in self.tmp.iter_mut().zip(&self.y) {
+            *x += y;
         }
         // w[0] is free here: the Newton iterate is no longer needed after Z.
         sys.rhs(t, &self.tmp, &mut self.w[0]);
         self.stats.rhs_evals += 1;
-        for i in 0..n {
-            self.tmp[i] = self.w[0][i] + self.ftmp[i];
+        for ((x, &w), &f) in self.tmp.iter_mut().zip(&self.w[0]).zip(&self.ftmp) {
+            *x = w + f;
         }
         lu::solve(&self.e1, &self.piv1, &mut self.tmp);
         let refined = self.norm(&self.tmp);
