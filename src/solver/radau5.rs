@@ -10,7 +10,8 @@
 //! Convergence is judged by the contraction rate `θ` (stop when `θ/(1-θ)·‖ΔZ‖ ≤ κ`,
 //! `κ = max(10ε/rtol, min(0.03, √rtol))`; abort and reduce `h` if `θ ≥ 0.99` or the predicted
 //! error after 7 iterations is too large). Starting values extrapolate the collocation polynomial
-//! of the previous step (zero on the first step of each `integrate` call).
+//! of the previous accepted step, also across `integrate` calls when the call continues the
+//! last one (see below); zero otherwise.
 //!
 //! **Error estimate** (Hairer–Wanner Sec. IV.8): with the embedded order-3 formula
 //! `err = (γ/h·I - J)⁻¹ (f(t, y) + (e1 z1 + e2 z2 + e3 z3)/h)`, `e = -(13+7√6, 13-7√6, 1)/3`;
@@ -25,7 +26,8 @@
 //! **Step size.** `h_new = h / clamp(err^(1/4)/fac, 1/8, 5)`, `fac = min(0.9, 0.9·15/(newt+14))`
 //! (newt = Newton iterations); on accepted steps also Gustafsson's predictive controller
 //! `h_new ≤ 0.9·h·(h/h_acc)·(err_acc/err²)^(1/4)` (previous accepted step `h_acc`, `err_acc`).
-//! After a rejection the step is not increased. The Jacobian is reused while the Newton
+//! After a rejection the step is not increased; a rejected first step of an integration (no
+//! continued call, `h` a guess) retries with `h/10`. The Jacobian is reused while the Newton
 //! contraction `θ ≤ THET` (0.01); `h` and the LU are kept if `1 ≤ h_new/h ≤ 1.2`. The LU factors
 //! are also reused, with the Jacobian, for any later step whose size equals theirs up to
 //! rounding (`|h - h_lu| ≤ 1e-9·h_lu`), e.g. the step cut to land on `t_end` or the first step of
@@ -37,9 +39,15 @@
 //! Jacobian of the previous call unless the last Newton contraction asked for a new one: it is
 //! only the iteration matrix, so a stale one (inputs changed) costs iterations, never accuracy,
 //! and a Newton failure recomputes it; its LU factors are kept too if the first step has their
-//! step size. Hint, contraction, Jacobian and the step size of the LU factors are the persistent
-//! state ([`Radau5::save_state`]); the factors are recomputed from them on loading, so a restored
-//! integrator continues bit-identically.
+//! step size. A call *continues* the previous integration if it starts at the time and (bit for
+//! bit) at the state where the last accepted step ended, as an FMU's successive doStep calls do:
+//! then its first step is an ordinary step (starting values extrapolated from the last
+//! collocation polynomial, a rejection reduces `h` by the controller). A changed input only
+//! makes that starting value less accurate, which costs Newton iterations, never accuracy.
+//! Hint, contraction, Jacobian, the step size of the LU factors and the last step (size, end
+//! time, collocation polynomial, end state) are the persistent state ([`Radau5::save_state`]);
+//! the LU factors are recomputed from them on loading, so a restored integrator continues
+//! bit-identically.
 
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
@@ -124,10 +132,15 @@ pub struct Radau5 {
     jac_valid: bool,
     /// Step size the LU factors `e1`, `e2` belong to; 0 if they do not match `jac`.
     h_lu: f64,
+    /// Size and end time of the last accepted step, whose collocation polynomial is `cont` and
+    /// whose end state is `y` (`h_cont = 0`: none).
+    h_cont: f64,
+    t_cont: f64,
     stats: SolverStats,
     gamma: f64,
     alpha: f64,
     beta: f64,
+    /// Newton convergence factor `θ/(1-θ)` carried from step to step (persistent state).
     faccon: f64,
     /// Current state, `f(t, y)`, error weights.
     y: Vec<f64>,
@@ -172,6 +185,8 @@ impl Radau5 {
             theta: THET,
             jac_valid: false,
             h_lu: 0.0,
+            h_cont: 0.0,
+            t_cont: 0.0,
             stats: SolverStats::default(),
             gamma,
             alpha,
@@ -263,21 +278,36 @@ impl Radau5 {
         self.h_hint = 0.0;
         self.jac_valid = false;
         self.h_lu = 0.0;
+        self.h_cont = 0.0;
+        self.faccon = 1.0;
     }
 
-    /// Number of `f64` in [`save_state`](Self::save_state): `4 + n²`.
+    /// Number of `f64` in [`save_state`](Self::save_state): `7 + n² + 4n`.
     pub fn state_len(&self) -> usize {
-        4 + self.n * self.n
+        7 + self.n * self.n + 4 * self.n
     }
 
     /// The persistent state carried between calls: step-size hint (0 = none), last Newton
-    /// contraction, Jacobian validity (0/1), the step size of the LU factors (0 = none) and the
-    /// Jacobian (column-major). The LU factors themselves are not saved: they are a
-    /// deterministic function of the Jacobian and their step size, and
+    /// contraction, Jacobian validity (0/1), the step size of the LU factors (0 = none), size
+    /// and end time of the last accepted step (size 0 = none), the Newton convergence factor
+    /// carried between steps (`θ/(1-θ)` of the last iteration), the Jacobian (column-major), the
+    /// collocation polynomial of the last step (3n) and its end state (n). The LU factors are
+    /// not saved: they are a deterministic function of the Jacobian and their step size, and
     /// [`load_state`](Self::load_state) recomputes them bit-identically.
     pub fn save_state(&self) -> Vec<f64> {
-        let mut s = vec![self.h_hint, self.theta, self.jac_valid as u8 as f64, self.h_lu];
+        let mut s = vec![
+            self.h_hint,
+            self.theta,
+            self.jac_valid as u8 as f64,
+            self.h_lu,
+            self.h_cont,
+            self.t_cont,
+            self.faccon,
+        ];
         s.extend_from_slice(self.jac.as_slice());
+        for v in self.cont.iter().chain([&self.y]) {
+            s.extend_from_slice(v);
+        }
         s
     }
 
@@ -288,16 +318,23 @@ impl Radau5 {
             return Err(invalid(format!("expected {} finite numbers, got {}", self.state_len(), s.len())));
         }
         let jac_valid = s[2] == 1.0;
-        if !(s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && (jac_valid || s[3] == 0.0)) {
+        let ok = s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && s[4] >= 0.0;
+        if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0) {
             return Err(invalid(format!(
-                "step-size hint {}, contraction {}, flag {}, LU step size {} are invalid",
-                s[0], s[1], s[2], s[3]
+                "step-size hint {}, contraction {}, flag {}, LU step size {}, last step {}, convergence factor {} are invalid",
+                s[0], s[1], s[2], s[3], s[4], s[6]
             )));
         }
+        let n = self.n;
         self.h_hint = s[0];
         self.theta = s[1];
         self.jac_valid = jac_valid;
-        self.jac.as_mut_slice().copy_from_slice(&s[4..]);
+        (self.h_cont, self.t_cont, self.faccon) = (s[4], s[5], s[6]);
+        let (jac, rest) = s[7..].split_at(n * n);
+        self.jac.as_mut_slice().copy_from_slice(jac);
+        for (v, saved) in self.cont.iter_mut().chain([&mut self.y]).zip(rest.chunks_exact(n)) {
+            v.copy_from_slice(saved);
+        }
         self.h_lu = 0.0;
         if s[3] > 0.0 && !self.decompose(s[3]) {
             self.jac_valid = false;
@@ -331,6 +368,12 @@ impl Radau5 {
         if t_end == t0 {
             return Ok(());
         }
+        // A call that starts where the last accepted step ended continues that integration: its
+        // first step extrapolates the last collocation polynomial like any other step.
+        let continues = self.h_cont > 0.0 && t0 == self.t_cont && bit_equal(x, &self.y);
+        if !continues {
+            self.h_cont = 0.0;
+        }
         self.y.copy_from_slice(x);
         let mut t = t0;
         sys.rhs(t, &self.y, &mut self.y0);
@@ -349,7 +392,8 @@ impl Radau5 {
         let (mut first, mut reject) = (true, false);
         let mut need_jac = !self.jac_valid || self.theta > THET;
         let (mut need_lu, mut caljac) = (need_jac || !self.lu_matches(h), false);
-        let (mut theta, mut hold) = (self.theta, h);
+        let (mut theta, mut hold) = (self.theta, if continues { self.h_cont } else { h });
+        let mut zero_start = !continues;
         let (mut hacc, mut erracc, mut n_acc) = (0.0, 0.0, 0u64);
         let (mut n_rej_row, mut n_attempts) = (0u32, 0u64);
         let mut fail: Option<FailureCause> = None;
@@ -401,7 +445,7 @@ impl Radau5 {
             let tph = if last { t_end } else { t + h };
 
             // Starting values for Z and W = T⁻¹ Z.
-            if first {
+            if zero_start {
                 for k in 0..3 {
                     self.z[k].fill(0.0);
                     self.w[k].fill(0.0);
@@ -425,7 +469,7 @@ impl Radau5 {
             let mut quot = FACR.max(FACL.min(err.powf(0.25) / fac));
             let mut hnew = h / quot;
             if err >= 1.0 {
-                h = if first { 0.1 * h } else { hnew };
+                h = if first && !continues { 0.1 * h } else { hnew };
                 last = false;
                 fail = Some(FailureCause::ErrorTest);
                 continue;
@@ -448,6 +492,7 @@ impl Radau5 {
             n_acc += 1;
             n_rej_row = 0;
             first = false;
+            zero_start = false;
             if n_acc > 1 {
                 let facgus = (hacc / h) * (err * err / erracc).powf(0.25) / SAFE;
                 quot = quot.max(FACR.max(FACL.min(facgus)));
@@ -461,6 +506,7 @@ impl Radau5 {
             self.y0.copy_from_slice(&self.ftmp);
             self.update_scal();
             self.update_cont();
+            (self.h_cont, self.t_cont) = (h, t);
 
             if last {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
@@ -748,6 +794,10 @@ fn plan(t: f64, t_end: f64, h: f64) -> (f64, bool) {
     } else {
         (h, false)
     }
+}
+
+fn bit_equal(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits())
 }
 
 fn all_finite(v: &[f64]) -> bool {
