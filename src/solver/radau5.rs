@@ -53,7 +53,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::{lu, FailureCause, OdeSystem, SolveError, SolveErrorKind, SolverStats};
-use nalgebra::{Complex, DMatrix};
+use nalgebra::DMatrix;
 
 /// Unit round-off used in RADAU5's formulas.
 const UROUND: f64 = 1e-16;
@@ -153,11 +153,11 @@ pub struct Radau5 {
     cont: [Vec<f64>; 3],
     tmp: Vec<f64>,
     ftmp: Vec<f64>,
-    zc: Vec<Complex<f64>>,
     jac: DMatrix<f64>,
     /// LU factors of `γ/h·I - J` and `(α + iβ)/h·I - J`, column-major `n × n`.
     e1: Vec<f64>,
-    e2: Vec<Complex<f64>>,
+    e2_re: Vec<f64>,
+    e2_im: Vec<f64>,
     piv1: Vec<usize>,
     piv2: Vec<usize>,
 }
@@ -200,10 +200,10 @@ impl Radau5 {
             cont: [v(), v(), v()],
             tmp: v(),
             ftmp: v(),
-            zc: vec![Complex::new(0.0, 0.0); n],
             jac: DMatrix::zeros(n, n),
             e1: vec![0.0; n * n],
-            e2: vec![Complex::new(0.0, 0.0); n * n],
+            e2_re: vec![0.0; n * n],
+            e2_im: vec![0.0; n * n],
             piv1: vec![0; n],
             piv2: vec![0; n],
         };
@@ -574,17 +574,20 @@ impl Radau5 {
         self.stats.lu_decompositions += 1;
         let (fac1, alphn, betan) = (self.gamma / h, self.alpha / h, self.beta / h);
         let n = self.n;
-        let cols =
-            self.jac.as_slice().chunks_exact(n).zip(self.e1.chunks_exact_mut(n)).zip(self.e2.chunks_exact_mut(n));
-        for (j, ((jc, e1c), e2c)) in cols.enumerate() {
-            for ((&jij, e1), e2) in jc.iter().zip(e1c.iter_mut()).zip(e2c.iter_mut()) {
+        let cols = self.jac.as_slice().chunks_exact(n).zip(self.e1.chunks_exact_mut(n));
+        let cols = cols.zip(self.e2_re.chunks_exact_mut(n).zip(self.e2_im.chunks_exact_mut(n)));
+        for (j, ((jc, e1c), (e2r, e2i))) in cols.enumerate() {
+            for (((&jij, e1), e2r), e2i) in jc.iter().zip(e1c.iter_mut()).zip(e2r.iter_mut()).zip(e2i.iter_mut()) {
                 *e1 = 0.0 - jij;
-                *e2 = Complex::new(0.0 - jij, 0.0);
+                *e2r = 0.0 - jij;
+                *e2i = 0.0;
             }
             e1c[j] = fac1 - jc[j];
-            e2c[j] = Complex::new(alphn - jc[j], betan);
+            e2r[j] = alphn - jc[j];
+            e2i[j] = betan;
         }
-        let ok = lu::factor(&mut self.e1, &mut self.piv1) && lu::factor(&mut self.e2, &mut self.piv2);
+        let ok = lu::factor(&mut self.e1, &mut self.piv1)
+            && lu::factor_complex(&mut self.e2_re, &mut self.e2_im, &mut self.piv2);
         self.h_lu = if ok { h } else { 0.0 };
         ok
     }
@@ -665,7 +668,7 @@ impl Radau5 {
             {
                 let [z0, z1, z2] = &mut self.z;
                 let [w0, w1, w2] = &self.w;
-                let (z0, z1, z2, zc) = (&mut z0[..n], &z1[..n], &z2[..n], &mut self.zc[..n]);
+                let (z0, z1, z2) = (&mut z0[..n], &mut z1[..n], &mut z2[..n]);
                 let (w0, w1, w2) = (&w0[..n], &w1[..n], &w2[..n]);
                 for i in 0..n {
                     let (a1, a2, a3) = (z0[i], z1[i], z2[i]);
@@ -673,18 +676,18 @@ impl Radau5 {
                     z0[i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - w1 * fac1;
                     let r2 = TI21 * a1 + TI22 * a2 + TI23 * a3 - w2 * alphn + w3 * betan;
                     let r3 = TI31 * a1 + TI32 * a2 + TI33 * a3 - w3 * alphn - w2 * betan;
-                    zc[i] = Complex::new(r2, r3);
+                    z1[i] = r2;
+                    z2[i] = r3;
                 }
             }
             lu::solve(&self.e1, &self.piv1, &mut self.z[0]);
-            lu::solve(&self.e2, &self.piv2, &mut self.zc);
+            let [_, z1, z2] = &mut self.z;
+            lu::solve_complex(&self.e2_re, &self.e2_im, &self.piv2, z1, z2);
             let mut dyno = 0.0;
             {
-                let [z0, z1, z2] = &mut self.z;
-                let (z0, z1, z2, zc, scal) = (&z0[..n], &mut z1[..n], &mut z2[..n], &self.zc[..n], &self.scal[..n]);
+                let [z0, z1, z2] = &self.z;
+                let (z0, z1, z2, scal) = (&z0[..n], &z1[..n], &z2[..n], &self.scal[..n]);
                 for i in 0..n {
-                    z1[i] = zc[i].re;
-                    z2[i] = zc[i].im;
                     let s = scal[i];
                     dyno += (z0[i] / s).powi(2) + (z1[i] / s).powi(2) + (z2[i] / s).powi(2);
                 }
