@@ -37,6 +37,66 @@ pub struct RigidBoom {
     payload: Vector2<f64>,
     /// Outer end of the arm on its centre line relative to B: (l_arm - b7, 0).
     tip: Vector2<f64>,
+    /// Constants of the equation of motion, see [`Geometry`].
+    geo: Geometry,
+}
+
+/// Constants that turn the closed-form angles of [`super::kinematics::Triangle`] into algebra:
+/// with `cos beta = (w1² + w2² - l²) / (2 w1 w2)` and `cos alpha = (w2² + l² - w1²) / (2 w2 l)`
+/// (law of cosines; beta, alpha in (0, pi), so their sines are the positive roots), the boom
+/// angle theta2 = beta + (phi2 - phi1) and the cylinder angle theta1 = pi - phi1 - alpha need no
+/// acos, atan or sin/cos: by the addition theorems
+///
+/// ```text
+/// lever(theta2) = e_x cos theta2 - e_y sin theta2 = cos beta · lc - sin beta · ls
+/// sin theta1    = sin(phi1 + alpha) = sin phi1 cos alpha + cos phi1 sin alpha
+/// ```
+///
+/// with `lc = e_x cos(phi2 - phi1) - e_y sin(phi2 - phi1)`, `ls = e_x sin(phi2 - phi1) +
+/// e_y cos(phi2 - phi1)` (e_cm = (e_x, e_y)). Same quantities as [`Triangle::theta2_derivatives`],
+/// [`super::kinematics::Body::lever`] and [`Triangle::theta1`], equal to rounding.
+///
+/// [`Triangle::theta2_derivatives`]: super::kinematics::Triangle::theta2_derivatives
+/// [`Triangle::theta1`]: super::kinematics::Triangle::theta1
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Geometry {
+    /// w1 w2 and w1² + w2².
+    ww: f64,
+    w_sq: f64,
+    /// w2 and w2² - w1².
+    w2: f64,
+    w21: f64,
+    /// sin phi1, cos phi1.
+    sin_phi1: f64,
+    cos_phi1: f64,
+    /// lc, ls (see above).
+    lc: f64,
+    ls: f64,
+}
+
+impl Geometry {
+    fn new(kin: &BoomKinematics) -> Self {
+        let t = kin.triangle();
+        let e = kin.body().e_cm;
+        let (sd, cd) = (t.phi2 - t.phi1).sin_cos();
+        let (sin_phi1, cos_phi1) = t.phi1.sin_cos();
+        Self {
+            ww: t.w1 * t.w2,
+            w_sq: t.w1 * t.w1 + t.w2 * t.w2,
+            w2: t.w2,
+            w21: t.w2 * t.w2 - t.w1 * t.w1,
+            sin_phi1,
+            cos_phi1,
+            lc: e.x * cd - e.y * sd,
+            ls: e.x * sd + e.y * cd,
+        }
+    }
+}
+
+/// `sin` of an angle in [0, pi] from its cosine, `sqrt((1 - c)(1 + c))` (accurate also near
+/// c = ±1, where `1 - c²` would cancel).
+fn sin_from_cos(c: f64) -> f64 {
+    ((1.0 - c) * (1.0 + c)).sqrt()
 }
 
 /// Positions and angles of the boom at one stroke position.
@@ -87,6 +147,7 @@ impl RigidBoom {
         }
         let b7 = p.b[6];
         Ok(Self {
+            geo: Geometry::new(&kin),
             kin,
             l_retracted: p.l_retracted,
             m_rod: p.m_rod,
@@ -105,15 +166,24 @@ impl RigidBoom {
         self.l_retracted + x
     }
 
+    /// The coefficients at stroke `x`: theta2' and theta2'' as in
+    /// [`Triangle::theta2_derivatives`](super::kinematics::Triangle::theta2_derivatives), the
+    /// lever and sin theta1 by the algebra of [`Geometry`] (no transcendental functions).
     fn eom(&self, x: f64) -> Eom {
         let l = self.l_cyl(x);
-        let t = self.kin.triangle();
+        let g = &self.geo;
         let body = self.kin.body();
-        let (theta2, d1, d2) = t.theta2_derivatives(l);
+        let c = (g.w_sq - l * l) / (2.0 * g.ww);
+        let s = sin_from_cos(c);
+        let d1 = l / (g.ww * s);
+        let d2 = (s - l * c * d1) / (g.ww * s * s);
+        let ca = (g.w21 + l * l) / (2.0 * g.w2 * l);
+        let sin_theta1 = g.sin_phi1 * ca + g.cos_phi1 * sin_from_cos(ca);
+        let lever = c * g.lc - s * g.ls;
         Eom {
             m_eff: body.j_b * d1 * d1 + self.m_rod,
             c_v2: body.j_b * d1 * d2,
-            f_gravity: self.g * (body.m_d * body.lever(theta2) * d1 + self.m_rod * t.theta1(l).sin()),
+            f_gravity: self.g * (body.m_d * lever * d1 + self.m_rod * sin_theta1),
         }
     }
 
@@ -383,6 +453,28 @@ mod tests {
         let a_c = std::f64::consts::PI / 4.0 * 0.065f64.powi(2);
         let m_table_6_1 = a_c * 1.3e9 / (0.25 * 83.82f64.powi(2));
         assert!((boom.static_force(mm(250.0)) / 9.807 / m_table_6_1 - 1.0).abs() < 0.01);
+    }
+
+    /// The transcendental-free coefficients of `eom` against the closed-form angles (acos of
+    /// the law of cosines, sin/cos of theta2 and theta1) over the stroke and beyond: equal to
+    /// rounding (1e-13 relative; the triangle is far from degenerate, sin beta >= 0.3).
+    #[test]
+    fn algebraic_eom_matches_closed_form_angles() {
+        let boom = boom();
+        let t = *boom.kinematics().triangle();
+        let body = *boom.kinematics().body();
+        let p = BoomParams::default();
+        for i in 0..=70 {
+            let x = -0.1 + 0.01 * i as f64;
+            let l = boom.l_cyl(x);
+            let (theta2, d1, d2) = t.theta2_derivatives(l);
+            let f_gravity = p.g * (body.m_d * body.lever(theta2) * d1 + p.m_rod * t.theta1(l).sin());
+            let e = boom.eom(x);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * b.abs();
+            assert!(close(e.m_eff, body.j_b * d1 * d1 + p.m_rod), "x = {x}: m_eff");
+            assert!(close(e.c_v2, body.j_b * d1 * d2), "x = {x}: c_v2 {} vs {}", e.c_v2, body.j_b * d1 * d2);
+            assert!(close(e.f_gravity, f_gravity), "x = {x}: f_gravity {} vs {f_gravity}", e.f_gravity);
+        }
     }
 
     #[test]

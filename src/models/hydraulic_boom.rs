@@ -506,10 +506,13 @@ impl Model for HydraulicBoom {
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let n = saved.len().checked_sub(Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+        let plant = Plant::from_values(values)?;
+        let n = plant.dim();
+        if saved.len() != n + Radau5::new(n).state_len() {
+            return Err(format!("expected {} numbers, got {}", n + Radau5::new(n).state_len(), saved.len()));
+        }
         let mut m = Self::with_state(values, Some(&saved[..n]))?;
-        let solver_state = saved[n..].try_into().map_err(|_| "solver state length".to_string())?;
-        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        m.solver.load_state(&saved[n..]).map_err(|e| e.to_string())?;
         Ok(m)
     }
 }

@@ -10,7 +10,8 @@
 //! Convergence is judged by the contraction rate `θ` (stop when `θ/(1-θ)·‖ΔZ‖ ≤ κ`,
 //! `κ = max(10ε/rtol, min(0.03, √rtol))`; abort and reduce `h` if `θ ≥ 0.99` or the predicted
 //! error after 7 iterations is too large). Starting values extrapolate the collocation polynomial
-//! of the previous step (zero on the first step of each `integrate` call).
+//! of the previous accepted step, also across `integrate` calls when the call continues the
+//! last one (see below); zero otherwise.
 //!
 //! **Error estimate** (Hairer–Wanner Sec. IV.8): with the embedded order-3 formula
 //! `err = (γ/h·I - J)⁻¹ (f(t, y) + (e1 z1 + e2 z2 + e3 z3)/h)`, `e = -(13+7√6, 13-7√6, 1)/3`;
@@ -25,19 +26,34 @@
 //! **Step size.** `h_new = h / clamp(err^(1/4)/fac, 1/8, 5)`, `fac = min(0.9, 0.9·15/(newt+14))`
 //! (newt = Newton iterations); on accepted steps also Gustafsson's predictive controller
 //! `h_new ≤ 0.9·h·(h/h_acc)·(err_acc/err²)^(1/4)` (previous accepted step `h_acc`, `err_acc`).
-//! After a rejection the step is not increased. The Jacobian is reused while the Newton
-//! contraction `θ ≤ 0.001`; `h` and the LU are kept if `1 ≤ h_new/h ≤ 1.2`.
+//! After a rejection the step is not increased; a rejected first step of an integration (no
+//! continued call, `h` a guess) retries with `h/10`. The Jacobian is reused while the Newton
+//! contraction `θ ≤ THET` (0.01); `h` and the LU are kept if `1 ≤ h_new/h ≤ 1.2`. The LU factors
+//! are also reused, with the Jacobian, for any later step whose size equals theirs up to
+//! rounding (`|h - h_lu| ≤ 1e-9·h_lu`), e.g. the step cut to land on `t_end` or the first step of
+//! the next call when both are one communication step long.
 //!
 //! **Communication points.** Steps never pass `t_end`; if the wanted step reaches `t_end` it is
 //! cut to land exactly, if it covers more than half the rest, the rest is split into two equal
-//! steps. Each `integrate` call starts with a fresh Jacobian (inputs may have changed) and the
-//! carried step-size hint, the only persistent state ([`Radau5::save_state`]).
+//! steps. Each `integrate` call starts with the carried step-size hint and, as between steps, the
+//! Jacobian of the previous call unless the last Newton contraction asked for a new one: it is
+//! only the iteration matrix, so a stale one (inputs changed) costs iterations, never accuracy,
+//! and a Newton failure recomputes it; its LU factors are kept too if the first step has their
+//! step size. A call *continues* the previous integration if it starts at the time and (bit for
+//! bit) at the state where the last accepted step ended, as an FMU's successive doStep calls do:
+//! then its first step is an ordinary step (starting values extrapolated from the last
+//! collocation polynomial, a rejection reduces `h` by the controller). A changed input only
+//! makes that starting value less accurate, which costs Newton iterations, never accuracy.
+//! Hint, contraction, Jacobian, the step size of the LU factors and the last step (size, end
+//! time, collocation polynomial, end state) are the persistent state ([`Radau5::save_state`]);
+//! the LU factors are recomputed from them on loading, so a restored integrator continues
+//! bit-identically.
 
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
 
 use super::{lu, FailureCause, OdeSystem, SolveError, SolveErrorKind, SolverStats};
-use nalgebra::{Complex, DMatrix};
+use nalgebra::DMatrix;
 
 /// Unit round-off used in RADAU5's formulas.
 const UROUND: f64 = 1e-16;
@@ -58,6 +74,9 @@ const QUOT2: f64 = 1.2;
 const MAX_REJECTIONS: u32 = 100;
 /// First step size when there is no hint.
 const H_INITIAL: f64 = 1e-6;
+/// The LU factors of step size `h_lu` serve a step `h` with `|h - h_lu| <= H_SAME·h_lu`: the
+/// same step up to the rounding of `t_end - t` (a few 1e-12 relative for 1 ms steps at t ~ 10 s).
+const H_SAME: f64 = 1e-9;
 
 /// Radau IIA constants: nodes, error-estimate weights, eigenvalues of `A⁻¹` and the
 /// transformation `T`, `T⁻¹` (values of `radau5.f`).
@@ -108,10 +127,20 @@ pub struct Radau5 {
     max_step: f64,
     max_steps: u64,
     h_hint: f64,
+    /// Newton contraction rate of the last step; with `jac_valid`, decides Jacobian reuse.
+    theta: f64,
+    jac_valid: bool,
+    /// Step size the LU factors `e1`, `e2` belong to; 0 if they do not match `jac`.
+    h_lu: f64,
+    /// Size and end time of the last accepted step, whose collocation polynomial is `cont` and
+    /// whose end state is `y` (`h_cont = 0`: none).
+    h_cont: f64,
+    t_cont: f64,
     stats: SolverStats,
     gamma: f64,
     alpha: f64,
     beta: f64,
+    /// Newton convergence factor `θ/(1-θ)` carried from step to step (persistent state).
     faccon: f64,
     /// Current state, `f(t, y)`, error weights.
     y: Vec<f64>,
@@ -124,10 +153,11 @@ pub struct Radau5 {
     cont: [Vec<f64>; 3],
     tmp: Vec<f64>,
     ftmp: Vec<f64>,
-    zc: Vec<Complex<f64>>,
     jac: DMatrix<f64>,
-    e1: DMatrix<f64>,
-    e2: DMatrix<Complex<f64>>,
+    /// LU factors of `γ/h·I - J` and `(α + iβ)/h·I - J`, column-major `n × n`.
+    e1: Vec<f64>,
+    e2_re: Vec<f64>,
+    e2_im: Vec<f64>,
     piv1: Vec<usize>,
     piv2: Vec<usize>,
 }
@@ -140,9 +170,6 @@ struct NewtonFail {
 }
 
 impl Radau5 {
-    /// Number of `f64` in [`save_state`](Self::save_state).
-    pub const STATE_LEN: usize = 1;
-
     /// An integrator for systems of dimension `n` with `rtol = 1e-6`, `atol_i = 1e-6`, no step
     /// limit and at most 100 000 steps per `integrate` call.
     pub fn new(n: usize) -> Self {
@@ -155,6 +182,11 @@ impl Radau5 {
             max_step: f64::INFINITY,
             max_steps: 100_000,
             h_hint: 0.0,
+            theta: THET,
+            jac_valid: false,
+            h_lu: 0.0,
+            h_cont: 0.0,
+            t_cont: 0.0,
             stats: SolverStats::default(),
             gamma,
             alpha,
@@ -168,10 +200,10 @@ impl Radau5 {
             cont: [v(), v(), v()],
             tmp: v(),
             ftmp: v(),
-            zc: vec![Complex::new(0.0, 0.0); n],
             jac: DMatrix::zeros(n, n),
-            e1: DMatrix::zeros(n, n),
-            e2: DMatrix::zeros(n, n),
+            e1: vec![0.0; n * n],
+            e2_re: vec![0.0; n * n],
+            e2_im: vec![0.0; n * n],
             piv1: vec![0; n],
             piv2: vec![0; n],
         };
@@ -240,22 +272,74 @@ impl Radau5 {
         self.stats = SolverStats::default();
     }
 
-    /// Forgets the step-size hint, e.g. after a discontinuity in the model.
+    /// Forgets the step-size hint, the Jacobian and its LU factors, e.g. after a discontinuity
+    /// in the model.
     pub fn reset(&mut self) {
         self.h_hint = 0.0;
+        self.jac_valid = false;
+        self.h_lu = 0.0;
+        self.h_cont = 0.0;
+        self.faccon = 1.0;
     }
 
-    /// The persistent state carried between calls: `[step-size hint]` (0 = none).
-    pub fn save_state(&self) -> [f64; Self::STATE_LEN] {
-        [self.h_hint]
+    /// Number of `f64` in [`save_state`](Self::save_state): `7 + n² + 4n`.
+    pub fn state_len(&self) -> usize {
+        7 + self.n * self.n + 4 * self.n
     }
 
-    /// Restores a state from [`save_state`](Self::save_state).
-    pub fn load_state(&mut self, s: &[f64; Self::STATE_LEN]) -> Result<(), SolveError> {
-        if !(s[0] >= 0.0 && s[0].is_finite()) {
-            return Err(invalid(format!("step-size hint {} is not finite and >= 0", s[0])));
+    /// The persistent state carried between calls: step-size hint (0 = none), last Newton
+    /// contraction, Jacobian validity (0/1), the step size of the LU factors (0 = none), size
+    /// and end time of the last accepted step (size 0 = none), the Newton convergence factor
+    /// carried between steps (`θ/(1-θ)` of the last iteration), the Jacobian (column-major), the
+    /// collocation polynomial of the last step (3n) and its end state (n). The LU factors are
+    /// not saved: they are a deterministic function of the Jacobian and their step size, and
+    /// [`load_state`](Self::load_state) recomputes them bit-identically.
+    pub fn save_state(&self) -> Vec<f64> {
+        let mut s = vec![
+            self.h_hint,
+            self.theta,
+            self.jac_valid as u8 as f64,
+            self.h_lu,
+            self.h_cont,
+            self.t_cont,
+            self.faccon,
+        ];
+        s.extend_from_slice(self.jac.as_slice());
+        for v in self.cont.iter().chain([&self.y]) {
+            s.extend_from_slice(v);
         }
+        s
+    }
+
+    /// Restores a state from [`save_state`](Self::save_state), refactorising the iteration
+    /// matrices if the saved state had LU factors.
+    pub fn load_state(&mut self, s: &[f64]) -> Result<(), SolveError> {
+        if s.len() != self.state_len() || s.iter().any(|v| !v.is_finite()) {
+            return Err(invalid(format!("expected {} finite numbers, got {}", self.state_len(), s.len())));
+        }
+        let jac_valid = s[2] == 1.0;
+        let ok = s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && s[4] >= 0.0;
+        if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0) {
+            return Err(invalid(format!(
+                "step-size hint {}, contraction {}, flag {}, LU step size {}, last step {}, convergence factor {} are invalid",
+                s[0], s[1], s[2], s[3], s[4], s[6]
+            )));
+        }
+        let n = self.n;
         self.h_hint = s[0];
+        self.theta = s[1];
+        self.jac_valid = jac_valid;
+        (self.h_cont, self.t_cont, self.faccon) = (s[4], s[5], s[6]);
+        let (jac, rest) = s[7..].split_at(n * n);
+        self.jac.as_mut_slice().copy_from_slice(jac);
+        for (v, saved) in self.cont.iter_mut().chain([&mut self.y]).zip(rest.chunks_exact(n)) {
+            v.copy_from_slice(saved);
+        }
+        self.h_lu = 0.0;
+        if s[3] > 0.0 && !self.decompose(s[3]) {
+            self.jac_valid = false;
+            return Err(invalid(format!("the saved Jacobian is singular at step size {}", s[3])));
+        }
         Ok(())
     }
 
@@ -284,6 +368,12 @@ impl Radau5 {
         if t_end == t0 {
             return Ok(());
         }
+        // A call that starts where the last accepted step ended continues that integration: its
+        // first step extrapolates the last collocation polynomial like any other step.
+        let continues = self.h_cont > 0.0 && t0 == self.t_cont && bit_equal(x, &self.y);
+        if !continues {
+            self.h_cont = 0.0;
+        }
         self.y.copy_from_slice(x);
         let mut t = t0;
         sys.rhs(t, &self.y, &mut self.y0);
@@ -293,7 +383,6 @@ impl Radau5 {
         }
         self.update_scal();
 
-        let (gamma, alpha, beta) = (self.gamma, self.alpha, self.beta);
         let fnewt = (10.0 * UROUND / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
         let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_end.abs());
         let cfac = SAFE * (1 + 2 * NIT) as f64;
@@ -301,8 +390,10 @@ impl Radau5 {
         let mut h_nat = if self.h_hint > 0.0 { self.h_hint } else { H_INITIAL }.min(self.max_step);
         let (mut h, mut last) = plan(t, t_end, h_nat);
         let (mut first, mut reject) = (true, false);
-        let (mut need_jac, mut need_lu, mut caljac) = (true, true, false);
-        let (mut theta, mut hold) = (THET, h);
+        let mut need_jac = !self.jac_valid || self.theta > THET;
+        let (mut need_lu, mut caljac) = (need_jac || !self.lu_matches(h), false);
+        let (mut theta, mut hold) = (self.theta, if continues { self.h_cont } else { h });
+        let mut zero_start = !continues;
         let (mut hacc, mut erracc, mut n_acc) = (0.0, 0.0, 0u64);
         let (mut n_rej_row, mut n_attempts) = (0u32, 0u64);
         let mut fail: Option<FailureCause> = None;
@@ -344,7 +435,7 @@ impl Radau5 {
                 need_lu = true;
             }
             if need_lu {
-                if !self.decompose(gamma / h, alpha / h, beta / h) {
+                if !self.decompose(h) {
                     h *= 0.5;
                     fail = Some(FailureCause::SingularMatrix);
                     continue;
@@ -354,7 +445,7 @@ impl Radau5 {
             let tph = if last { t_end } else { t + h };
 
             // Starting values for Z and W = T⁻¹ Z.
-            if first {
+            if zero_start {
                 for k in 0..3 {
                     self.z[k].fill(0.0);
                     self.w[k].fill(0.0);
@@ -378,14 +469,14 @@ impl Radau5 {
             let mut quot = FACR.max(FACL.min(err.powf(0.25) / fac));
             let mut hnew = h / quot;
             if err >= 1.0 {
-                h = if first { 0.1 * h } else { hnew };
+                h = if first && !continues { 0.1 * h } else { hnew };
                 last = false;
                 fail = Some(FailureCause::ErrorTest);
                 continue;
             }
             // Candidate new state and f there; a non-finite f rejects the step.
-            for i in 0..n {
-                self.tmp[i] = self.y[i] + self.z[2][i];
+            for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(&self.z[2]) {
+                *x = y + z;
             }
             sys.rhs(tph, &self.tmp, &mut self.ftmp);
             self.stats.rhs_evals += 1;
@@ -401,6 +492,7 @@ impl Radau5 {
             n_acc += 1;
             n_rej_row = 0;
             first = false;
+            zero_start = false;
             if n_acc > 1 {
                 let facgus = (hacc / h) * (err * err / erracc).powf(0.25) / SAFE;
                 quot = quot.max(FACR.max(FACL.min(facgus)));
@@ -414,11 +506,13 @@ impl Radau5 {
             self.y0.copy_from_slice(&self.ftmp);
             self.update_scal();
             self.update_cont();
+            (self.h_cont, self.t_cont) = (h, t);
 
             if last {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
                 let hint = if hnew < h { hnew } else { hnew.max(h_nat) };
                 self.h_hint = hint.min(self.max_step);
+                self.theta = theta;
                 x.copy_from_slice(&self.y);
                 return Ok(());
             }
@@ -436,14 +530,14 @@ impl Radau5 {
             }
             h = hn;
             last = lastn;
-            need_lu = true;
             need_jac = theta > THET;
+            need_lu = need_jac || !self.lu_matches(h);
         }
     }
 
     fn update_scal(&mut self) {
-        for i in 0..self.n {
-            self.scal[i] = self.atol[i] + self.rtol * self.y[i].abs();
+        for ((s, &a), &y) in self.scal.iter_mut().zip(&self.atol).zip(&self.y) {
+            *s = a + self.rtol * y.abs();
         }
     }
 
@@ -451,64 +545,90 @@ impl Radau5 {
     /// `δ_j = sqrt(ε·max(1e-5, |y_j|))` (radau5.f). Returns `false` if not finite.
     fn compute_jacobian<S: OdeSystem + ?Sized>(&mut self, sys: &S, t: f64) -> bool {
         self.stats.jacobian_evals += 1;
+        self.h_lu = 0.0;
         if !sys.jacobian(t, &self.y, &mut self.jac) {
             self.tmp.copy_from_slice(&self.y);
-            for j in 0..self.n {
+            for (j, col) in self.jac.as_mut_slice().chunks_exact_mut(self.n).enumerate() {
                 let delta = (UROUND * self.y[j].abs().max(1e-5)).sqrt();
                 self.tmp[j] = self.y[j] + delta;
                 sys.rhs(t, &self.tmp, &mut self.ftmp);
                 self.tmp[j] = self.y[j];
-                for i in 0..self.n {
-                    self.jac[(i, j)] = (self.ftmp[i] - self.y0[i]) / delta;
+                for ((c, &f), &f0) in col.iter_mut().zip(&self.ftmp).zip(&self.y0) {
+                    *c = (f - f0) / delta;
                 }
             }
             self.stats.rhs_evals += self.n as u64;
         }
-        self.jac.iter().all(|v| v.is_finite())
+        self.jac_valid = self.jac.iter().all(|v| v.is_finite());
+        self.jac_valid
     }
 
-    /// Factorises `E1 = fac1·I - J` and `E2 = (alphn + i·betan)·I - J`.
-    fn decompose(&mut self, fac1: f64, alphn: f64, betan: f64) -> bool {
+    /// Whether the LU factors serve a step of size `h` (see [`H_SAME`]).
+    fn lu_matches(&self, h: f64) -> bool {
+        self.h_lu > 0.0 && (h - self.h_lu).abs() <= H_SAME * self.h_lu
+    }
+
+    /// Factorises `E1 = γ/h·I - J` and `E2 = (α + iβ)/h·I - J`; on success the factors belong to
+    /// step size `h`.
+    fn decompose(&mut self, h: f64) -> bool {
         self.stats.lu_decompositions += 1;
-        for j in 0..self.n {
-            for i in 0..self.n {
-                let d = if i == j { 1.0 } else { 0.0 };
-                let jij = self.jac[(i, j)];
-                self.e1[(i, j)] = fac1 * d - jij;
-                self.e2[(i, j)] = Complex::new(alphn * d - jij, betan * d);
+        let (fac1, alphn, betan) = (self.gamma / h, self.alpha / h, self.beta / h);
+        let n = self.n;
+        let cols = self.jac.as_slice().chunks_exact(n).zip(self.e1.chunks_exact_mut(n));
+        let cols = cols.zip(self.e2_re.chunks_exact_mut(n).zip(self.e2_im.chunks_exact_mut(n)));
+        for (j, ((jc, e1c), (e2r, e2i))) in cols.enumerate() {
+            for (((&jij, e1), e2r), e2i) in jc.iter().zip(e1c.iter_mut()).zip(e2r.iter_mut()).zip(e2i.iter_mut()) {
+                *e1 = 0.0 - jij;
+                *e2r = 0.0 - jij;
+                *e2i = 0.0;
             }
+            e1c[j] = fac1 - jc[j];
+            e2r[j] = alphn - jc[j];
+            e2i[j] = betan;
         }
-        lu::factor(&mut self.e1, &mut self.piv1) && lu::factor(&mut self.e2, &mut self.piv2)
+        let ok = lu::factor(&mut self.e1, &mut self.piv1)
+            && lu::factor_complex(&mut self.e2_re, &mut self.e2_im, &mut self.piv2);
+        self.h_lu = if ok { h } else { 0.0 };
+        ok
     }
 
     /// Starting values from the collocation polynomial of the last step; `r = h/h_old`.
     fn extrapolate(&mut self, r: f64) {
+        let n = self.n;
         let cq = [C1 * r, C2 * r, r];
-        for i in 0..self.n {
-            let (a1, a2, a3) = (self.cont[0][i], self.cont[1][i], self.cont[2][i]);
-            let mut zi = [0.0; 3];
-            for k in 0..3 {
-                zi[k] = cq[k] * (a1 + (cq[k] - C2M1) * (a2 + (cq[k] - C1M1) * a3));
-                self.z[k][i] = zi[k];
-            }
-            self.w[0][i] = TI11 * zi[0] + TI12 * zi[1] + TI13 * zi[2];
-            self.w[1][i] = TI21 * zi[0] + TI22 * zi[1] + TI23 * zi[2];
-            self.w[2][i] = TI31 * zi[0] + TI32 * zi[1] + TI33 * zi[2];
+        let [c0, c1, c2] = &self.cont;
+        let [z0, z1, z2] = &mut self.z;
+        let [w0, w1, w2] = &mut self.w;
+        let (c0, c1, c2) = (&c0[..n], &c1[..n], &c2[..n]);
+        let (z0, z1, z2) = (&mut z0[..n], &mut z1[..n], &mut z2[..n]);
+        let (w0, w1, w2) = (&mut w0[..n], &mut w1[..n], &mut w2[..n]);
+        for i in 0..n {
+            let (a1, a2, a3) = (c0[i], c1[i], c2[i]);
+            let zi = cq.map(|c| c * (a1 + (c - C2M1) * (a2 + (c - C1M1) * a3)));
+            (z0[i], z1[i], z2[i]) = (zi[0], zi[1], zi[2]);
+            w0[i] = TI11 * zi[0] + TI12 * zi[1] + TI13 * zi[2];
+            w1[i] = TI21 * zi[0] + TI22 * zi[1] + TI23 * zi[2];
+            w2[i] = TI31 * zi[0] + TI32 * zi[1] + TI33 * zi[2];
         }
     }
 
     /// Divided differences of the collocation polynomial through `y_new - y_old` at `c_i - 1`,
     /// from the increments `Z` of the accepted step.
     fn update_cont(&mut self) {
-        for i in 0..self.n {
-            let (z1, z2, z3) = (self.z[0][i], self.z[1][i], self.z[2][i]);
-            let c1 = (z2 - z3) / C2M1;
+        let n = self.n;
+        let [z0, z1, z2] = &self.z;
+        let [c0, c1, c2] = &mut self.cont;
+        let (z0, z1, z2) = (&z0[..n], &z1[..n], &z2[..n]);
+        let (c0, c1, c2) = (&mut c0[..n], &mut c1[..n], &mut c2[..n]);
+        for i in 0..n {
+            let (z1, z2, z3) = (z0[i], z1[i], z2[i]);
+            let d1 = (z2 - z3) / C2M1;
             let ak = (z1 - z2) / C1MC2;
             let acont3 = (ak - z1 / C1) / C2;
-            let c2 = (ak - c1) / C1M1;
-            self.cont[0][i] = c1;
-            self.cont[1][i] = c2;
-            self.cont[2][i] = c2 - acont3;
+            let d2 = (ak - d1) / C1M1;
+            c0[i] = d1;
+            c1[i] = d2;
+            c2[i] = d2 - acont3;
         }
     }
 
@@ -534,33 +654,43 @@ impl Radau5 {
                 return Err(diverged);
             }
             let times = [t + C1 * h, t + C2 * h, tph];
-            for (k, &tk) in times.iter().enumerate() {
-                for i in 0..n {
-                    self.tmp[i] = self.y[i] + self.z[k][i];
+            for (zk, &tk) in self.z.iter_mut().zip(&times) {
+                for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(zk.iter()) {
+                    *x = y + z;
                 }
-                sys.rhs(tk, &self.tmp, &mut self.z[k]);
+                sys.rhs(tk, &self.tmp, zk);
             }
             self.stats.rhs_evals += 3;
-            if !(all_finite(&self.z[0]) && all_finite(&self.z[1]) && all_finite(&self.z[2])) {
+            if !self.z.iter().all(|zk| all_finite(zk)) {
                 return Err(NewtonFail { cause: FailureCause::NonFiniteRhs, hfac: 0.5 });
             }
             // Right-hand sides of the transformed systems, then solve.
-            let mut dyno = 0.0;
-            for i in 0..n {
-                let (a1, a2, a3) = (self.z[0][i], self.z[1][i], self.z[2][i]);
-                let (w1, w2, w3) = (self.w[0][i], self.w[1][i], self.w[2][i]);
-                self.z[0][i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - w1 * fac1;
-                let r2 = TI21 * a1 + TI22 * a2 + TI23 * a3 - w2 * alphn + w3 * betan;
-                let r3 = TI31 * a1 + TI32 * a2 + TI33 * a3 - w3 * alphn - w2 * betan;
-                self.zc[i] = Complex::new(r2, r3);
+            {
+                let [z0, z1, z2] = &mut self.z;
+                let [w0, w1, w2] = &self.w;
+                let (z0, z1, z2) = (&mut z0[..n], &mut z1[..n], &mut z2[..n]);
+                let (w0, w1, w2) = (&w0[..n], &w1[..n], &w2[..n]);
+                for i in 0..n {
+                    let (a1, a2, a3) = (z0[i], z1[i], z2[i]);
+                    let (w1, w2, w3) = (w0[i], w1[i], w2[i]);
+                    z0[i] = TI11 * a1 + TI12 * a2 + TI13 * a3 - w1 * fac1;
+                    let r2 = TI21 * a1 + TI22 * a2 + TI23 * a3 - w2 * alphn + w3 * betan;
+                    let r3 = TI31 * a1 + TI32 * a2 + TI33 * a3 - w3 * alphn - w2 * betan;
+                    z1[i] = r2;
+                    z2[i] = r3;
+                }
             }
             lu::solve(&self.e1, &self.piv1, &mut self.z[0]);
-            lu::solve(&self.e2, &self.piv2, &mut self.zc);
-            for i in 0..n {
-                self.z[1][i] = self.zc[i].re;
-                self.z[2][i] = self.zc[i].im;
-                let s = self.scal[i];
-                dyno += (self.z[0][i] / s).powi(2) + (self.z[1][i] / s).powi(2) + (self.z[2][i] / s).powi(2);
+            let [_, z1, z2] = &mut self.z;
+            lu::solve_complex(&self.e2_re, &self.e2_im, &self.piv2, z1, z2);
+            let mut dyno = 0.0;
+            {
+                let [z0, z1, z2] = &self.z;
+                let (z0, z1, z2, scal) = (&z0[..n], &z1[..n], &z2[..n], &self.scal[..n]);
+                for i in 0..n {
+                    let s = scal[i];
+                    dyno += (z0[i] / s).powi(2) + (z1[i] / s).powi(2) + (z2[i] / s).powi(2);
+                }
             }
             self.stats.newton_iterations += 1;
             newt += 1;
@@ -582,16 +712,22 @@ impl Radau5 {
                 }
             }
             dynold = dyno.max(UROUND);
-            for i in 0..n {
-                let w1 = self.w[0][i] + self.z[0][i];
-                let w2 = self.w[1][i] + self.z[1][i];
-                let w3 = self.w[2][i] + self.z[2][i];
-                self.w[0][i] = w1;
-                self.w[1][i] = w2;
-                self.w[2][i] = w3;
-                self.z[0][i] = T11 * w1 + T12 * w2 + T13 * w3;
-                self.z[1][i] = T21 * w1 + T22 * w2 + T23 * w3;
-                self.z[2][i] = T31 * w1 + w2;
+            {
+                let [z0, z1, z2] = &mut self.z;
+                let [w0, w1, w2] = &mut self.w;
+                let (z0, z1, z2) = (&mut z0[..n], &mut z1[..n], &mut z2[..n]);
+                let (w0, w1, w2) = (&mut w0[..n], &mut w1[..n], &mut w2[..n]);
+                for i in 0..n {
+                    let a1 = w0[i] + z0[i];
+                    let a2 = w1[i] + z1[i];
+                    let a3 = w2[i] + z2[i];
+                    w0[i] = a1;
+                    w1[i] = a2;
+                    w2[i] = a3;
+                    z0[i] = T11 * a1 + T12 * a2 + T13 * a3;
+                    z1[i] = T21 * a1 + T22 * a2 + T23 * a3;
+                    z2[i] = T31 * a1 + a2;
+                }
             }
             if !dyno.is_finite() {
                 return Err(diverged);
@@ -607,23 +743,28 @@ impl Radau5 {
         let n = self.n;
         let (h1, h2, h3) = (DD1 / h, DD2 / h, DD3 / h);
         // ftmp = (e·Z)/h, tmp = E1⁻¹ (f(t, y) + ftmp).
-        for i in 0..n {
-            self.ftmp[i] = h1 * self.z[0][i] + h2 * self.z[1][i] + h3 * self.z[2][i];
-            self.tmp[i] = self.ftmp[i] + self.y0[i];
+        {
+            let [z0, z1, z2] = &self.z;
+            let (z0, z1, z2, y0) = (&z0[..n], &z1[..n], &z2[..n], &self.y0[..n]);
+            let (ftmp, tmp) = (&mut self.ftmp[..n], &mut self.tmp[..n]);
+            for i in 0..n {
+                ftmp[i] = h1 * z0[i] + h2 * z1[i] + h3 * z2[i];
+                tmp[i] = ftmp[i] + y0[i];
+            }
         }
         lu::solve(&self.e1, &self.piv1, &mut self.tmp);
         let err = self.norm(&self.tmp);
         if err < 1.0 || !refine {
             return err;
         }
-        for i in 0..n {
-            self.tmp[i] += self.y[i];
+        for (x, &y) in self.tmp.iter_mut().zip(&self.y) {
+            *x += y;
         }
         // w[0] is free here: the Newton iterate is no longer needed after Z.
         sys.rhs(t, &self.tmp, &mut self.w[0]);
         self.stats.rhs_evals += 1;
-        for i in 0..n {
-            self.tmp[i] = self.w[0][i] + self.ftmp[i];
+        for ((x, &w), &f) in self.tmp.iter_mut().zip(&self.w[0]).zip(&self.ftmp) {
+            *x = w + f;
         }
         lu::solve(&self.e1, &self.piv1, &mut self.tmp);
         let refined = self.norm(&self.tmp);
@@ -656,6 +797,10 @@ fn plan(t: f64, t_end: f64, h: f64) -> (f64, bool) {
     } else {
         (h, false)
     }
+}
+
+fn bit_equal(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits())
 }
 
 fn all_finite(v: &[f64]) -> bool {

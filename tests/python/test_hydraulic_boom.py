@@ -363,14 +363,21 @@ def test_oil_mass_is_conserved(boom):
     Q3 into the piston side, -Q4 - Q_LB into the rod side (Q_LB = dQ_L p4, eq. 2.47). The inflow is
     integrated by the trapezoid rule over the 0.1 ms communication points.
 
-    Tolerance = solver + quadrature. Solver: the states carry a local error of rtol |state| (rtol
-    = 1e-6), which moves M by rtol (area x + C |p|), C = dV/dp ~ 2.3e-12 m^3/Pa (oil + hose): 1.6e-9
-    m^3. Quadrature: the trapezoid error of each interval is h^3 |f''| / 12, summed without
+    Run at rtol = 1e-9: near vacuum the oil-air mass is hypersensitive to the pressure,
+    dM/dp ~ V / (x0 P_atm) ~ 2.6e-6 m^3/Pa at the -0.99 bar gauge reached in line 4 (vs V/beta ~
+    2e-13 at working pressures), so at the default rtol = 1e-6 a 0.01 Pa error in p4 already moves
+    2.6e-8 m^3; the balance then measures the solver, not the model. At 1e-9 the solver's share is
+    negligible and the check is on the model's equations.
+
+    Tolerance = solver + quadrature. Solver: the states carry a local error of rtol |state|, which
+    moves M by rtol (area x + C |p|), C = dV/dp ~ 2.3e-12 m^3/Pa (oil + hose) away from vacuum.
+    Quadrature: the trapezoid error of each interval is h^3 |f''| / 12, summed without
     cancellation with f'' from second differences: sum h |d2 f| / 12 (2.5e-9 m^3 here; the
     sharp CBV events dominate it). The masses moved are ~1.5e-4 m^3: conservation to ~3e-5. (At
     2e-5 s sampling the balance closes to 1e-13 m^3: the model conserves mass exactly.)"""
+    rtol = 1e-9
     h = 1e-4
-    t, r = simulate(boom, -0.1, 3.0, h=h)
+    t, r = simulate(boom, -0.1, 3.0, h=h, tolerance=rtol)
     x = r["cylinder.x"]
     c_w3, c_w4 = T["line.c_hose"] * T["line.v_l3"], T["line.c_hose"] * T["line.v_l4"]
     sides = {
@@ -384,7 +391,7 @@ def test_oil_mass_is_conserved(boom):
         integral = np.trapezoid(rate, t)
         moved = mass[-1] - mass[0]
         cap = (vol / T["fluid.beta"]).max() + c_w4  # dV/dp at high pressure (oil + hose)
-        solver = 1e-6 * (cap * np.abs(p).max() + area * x.max())
+        solver = rtol * (cap * np.abs(p).max() + area * x.max())
         quadrature = h * np.abs(np.diff(rate, 2)).sum() / 12
         assert abs(moved) > 1e-4, name  # the test moves real oil
         assert abs(moved - integral) <= solver + quadrature, (name, moved - integral, solver, quadrature)
