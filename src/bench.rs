@@ -8,6 +8,7 @@
 use crate::fmi2::instance::Instance;
 use crate::fmi2::log::Logger;
 use crate::fmi2::types::*;
+use crate::fmi2::variables::BaseType;
 use crate::fmi2::{guid::guid, Model, Value};
 use crate::models::hydraulic_boom::vr as hb;
 use crate::models::pressure_feedback_controller::vr as pfc;
@@ -34,8 +35,7 @@ impl<M: Model> InProcess<M> {
         i.setup_experiment(Some(rtol), 0.0, None)?;
         i.enter_initialization_mode();
         for (r, x) in start {
-            let kind = if let Value::Boolean(_) = x { "Boolean" } else { "Real" };
-            i.set(&[*r], vec![x.clone()], kind)?;
+            i.set(&[*r], vec![x.clone()])?;
         }
         i.exit_initialization_mode()?;
         Ok(InProcess(i))
@@ -44,11 +44,11 @@ impl<M: Model> InProcess<M> {
 
 impl<M: Model> Slave for InProcess<M> {
     fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
-        self.0.set(&[vr], vec![Value::Real(x)], "Real")
+        self.0.set(&[vr], vec![Value::Real(x)])
     }
     fn get(&mut self, vr: u32) -> Result<f64, String> {
         let mut x = [0.0];
-        self.0.get(&[vr], &mut x, "Real", |v| if let Value::Real(x) = v { *x } else { f64::NAN })?;
+        self.0.get(&[vr], &mut x, BaseType::Real, |v| if let Value::Real(x) = v { *x } else { f64::NAN })?;
         Ok(x[0])
     }
     fn step(&mut self, t: f64, h: f64) -> Result<(), String> {

@@ -12,7 +12,7 @@ use super::log::{Logger, LOG_FMI_CALLS};
 use super::model::Model;
 use super::state::{allowed, describe, Mask, State};
 use super::types::*;
-use super::variables::Value;
+use super::variables::{BaseType, Value};
 use std::ffi::{CStr, CString};
 use std::os::raw::{c_char, c_int};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -222,7 +222,7 @@ unsafe fn get<M: Model, T>(
     vr: *const fmi2ValueReference,
     n: usize,
     out: *mut T,
-    wanted: &str,
+    wanted: BaseType,
     read: impl Fn(&Value) -> T,
 ) -> fmi2Status {
     call::<M>(c, function, allowed::GET, |inst| {
@@ -234,15 +234,31 @@ unsafe fn get<M: Model, T>(
 }
 
 pub unsafe fn get_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut f64) -> fmi2Status {
-    get::<M, f64>(c, "fmi2GetReal", vr, n, value, "Real", |v| if let Value::Real(x) = v { *x } else { f64::NAN })
+    get::<M, f64>(
+        c,
+        "fmi2GetReal",
+        vr,
+        n,
+        value,
+        BaseType::Real,
+        |v| if let Value::Real(x) = v { *x } else { f64::NAN },
+    )
 }
 
 pub unsafe fn get_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> fmi2Status {
-    get::<M, c_int>(c, "fmi2GetInteger", vr, n, value, "Integer", |v| if let Value::Integer(x) = v { *x } else { 0 })
+    get::<M, c_int>(c, "fmi2GetInteger", vr, n, value, BaseType::Integer, |v| {
+        if let Value::Integer(x) = v {
+            *x
+        } else {
+            0
+        }
+    })
 }
 
 pub unsafe fn get_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> fmi2Status {
-    get::<M, c_int>(c, "fmi2GetBoolean", vr, n, value, "Boolean", |v| matches!(v, Value::Boolean(true)) as c_int)
+    get::<M, c_int>(c, "fmi2GetBoolean", vr, n, value, BaseType::Boolean, |v| {
+        matches!(v, Value::Boolean(true)) as c_int
+    })
 }
 
 pub unsafe fn get_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut fmi2String) -> fmi2Status {
@@ -250,7 +266,7 @@ pub unsafe fn get_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, v
         let vrs = slice(vr, n, "vr")?;
         let out = slice_mut(value, n, "value")?;
         let mut texts = vec![CString::default(); n];
-        inst.get(vrs, &mut texts, "String", |v| match v {
+        inst.get(vrs, &mut texts, BaseType::String, |v| match v {
             Value::String(s) => CString::new(s.replace('\0', " ")).unwrap_or_default(),
             _ => CString::default(),
         })?;
@@ -268,27 +284,26 @@ unsafe fn set<M: Model, T: Copy>(
     vr: *const fmi2ValueReference,
     n: usize,
     value: *const T,
-    wanted: &str,
     convert: impl Fn(T) -> Result<Value, String>,
 ) -> fmi2Status {
     call::<M>(c, function, allowed::SET, |inst| {
         let vrs = slice(vr, n, "vr")?;
         let values = slice(value, n, "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
-        inst.set(vrs, values, wanted)?;
+        inst.set(vrs, values)?;
         Ok(fmi2Status::OK)
     })
 }
 
 pub unsafe fn set_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const f64) -> fmi2Status {
-    set::<M, f64>(c, "fmi2SetReal", vr, n, value, "Real", |x| Ok(Value::Real(x)))
+    set::<M, f64>(c, "fmi2SetReal", vr, n, value, |x| Ok(Value::Real(x)))
 }
 
 pub unsafe fn set_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
-    set::<M, c_int>(c, "fmi2SetInteger", vr, n, value, "Integer", |x| Ok(Value::Integer(x)))
+    set::<M, c_int>(c, "fmi2SetInteger", vr, n, value, |x| Ok(Value::Integer(x)))
 }
 
 pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
-    set::<M, c_int>(c, "fmi2SetBoolean", vr, n, value, "Boolean", |x| match x {
+    set::<M, c_int>(c, "fmi2SetBoolean", vr, n, value, |x| match x {
         FMI2_FALSE => Ok(Value::Boolean(false)),
         FMI2_TRUE => Ok(Value::Boolean(true)),
         _ => Err(format!("{x} is not an fmi2Boolean; valid values are fmi2False (0) and fmi2True (1)")),
@@ -296,7 +311,7 @@ pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, 
 }
 
 pub unsafe fn set_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const fmi2String) -> fmi2Status {
-    set::<M, fmi2String>(c, "fmi2SetString", vr, n, value, "String", |p| {
+    set::<M, fmi2String>(c, "fmi2SetString", vr, n, value, |p| {
         text(p).map(|s| Value::String(s.to_owned())).ok_or_else(|| "a string value is NULL or not UTF-8".into())
     })
 }

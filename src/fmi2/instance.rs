@@ -5,7 +5,7 @@ use super::log::Logger;
 use super::model::{Log, Model};
 use super::state::State;
 use super::types::fmi2Status;
-use super::variables::{fmi_name, Causality, Initial, Kind, Value, Values, Variability, Variable};
+use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 
 /// Relative tolerance for matching the master's communication point with the instance time.
 pub const TIME_MATCH_RTOL: f64 = 1e-9;
@@ -67,6 +67,9 @@ impl<M: Model> Default for Core<M> {
 struct ModelLog<'a>(&'a Logger);
 
 impl Log for ModelLog<'_> {
+    fn enabled(&self, category: &str) -> bool {
+        self.0.category_enabled(category)
+    }
     fn info(&mut self, category: &str, message: &str) {
         self.0.info(category, message);
     }
@@ -157,16 +160,15 @@ impl<M: Model> Instance<M> {
     }
 
     /// Looks up a value reference and checks its type.
-    fn lookup(&self, vr: u32, wanted: &str) -> Result<(usize, &'static Variable), String> {
+    fn lookup(&self, vr: u32, wanted: BaseType) -> Result<(usize, &'static Variable), String> {
         let i = self
             .core
             .values
             .position(vr)
             .ok_or_else(|| format!("unknown value reference {vr}: {} has no such variable", M::INFO.identifier))?;
         let v = &M::VARIABLES[i];
-        let actual = format!("{:?}", v.base_type());
-        if actual != wanted {
-            return Err(format!("variable \"{}\" (vr {vr}) is a {actual}, not a {wanted}", v.name));
+        if v.base_type() != wanted {
+            return Err(format!("variable \"{}\" (vr {vr}) is a {:?}, not a {wanted:?}", v.name, v.base_type()));
         }
         Ok((i, v))
     }
@@ -176,7 +178,7 @@ impl<M: Model> Instance<M> {
         &mut self,
         vrs: &[u32],
         out: &mut [T],
-        wanted: &str,
+        wanted: BaseType,
         read: impl Fn(&Value) -> T,
     ) -> Result<(), String> {
         self.refresh_outputs()?;
@@ -187,21 +189,23 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// Writes values of one type, all or nothing: every value is checked before any is stored.
-    pub fn set(&mut self, vrs: &[u32], new: Vec<Value>, wanted: &str) -> Result<(), String> {
+    /// Writes values, all or nothing: every value is checked (type, settability, range) before
+    /// any is stored.
+    pub fn set(&mut self, vrs: &[u32], new: Vec<Value>) -> Result<(), String> {
         let mut checked = Vec::with_capacity(vrs.len());
         for (&vr, value) in vrs.iter().zip(new) {
-            let (i, v) = self.lookup(vr, wanted)?;
+            let (i, v) = self.lookup(vr, value.base_type())?;
             settable(v, self.core.state)?;
             in_range(v, &value)?;
             checked.push((i, value));
         }
-        let before = self.core.values.clone();
-        let tunes = checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
+        let tunes = self.core.state == State::StepComplete
+            && checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
+        let before = tunes.then(|| self.core.values.clone());
         for (i, value) in checked {
             self.core.values.put(i, value);
         }
-        if tunes && self.core.state == State::StepComplete {
+        if let Some(before) = before {
             let c = &mut self.core;
             if let Err(e) = c.model.as_mut().map_or(Ok(()), |m| m.retune(&c.values)) {
                 c.values = before;
@@ -219,7 +223,7 @@ impl<M: Model> Instance<M> {
         }
         let mut checked = Vec::with_capacity(vrs.len());
         for ((&vr, &order), &d) in vrs.iter().zip(orders).zip(values) {
-            let (i, v) = self.lookup(vr, "Real")?;
+            let (i, v) = self.lookup(vr, BaseType::Real)?;
             if v.causality != Causality::Input {
                 return Err(format!("variable \"{}\" is not an input; derivatives can only be set for inputs", v.name));
             }

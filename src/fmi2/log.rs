@@ -89,12 +89,15 @@ impl Logger {
         }
     }
 
+    /// Whether a category, given by name, is delivered.
+    pub fn category_enabled(&self, category: &str) -> bool {
+        self.categories.iter().position(|(c, _)| *c == category).is_some_and(|i| self.is_enabled(i))
+    }
+
     /// Logs an fmi2OK message in a category given by name (the model's own or `logFmiCalls`).
     pub fn info(&self, category: &str, message: &str) {
-        if let Some(i) = self.categories.iter().position(|(c, _)| *c == category) {
-            if self.is_enabled(i) {
-                self.emit(fmi2Status::OK, category, message);
-            }
+        if self.category_enabled(category) {
+            self.emit(fmi2Status::OK, category, message);
         }
     }
 

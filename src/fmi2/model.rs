@@ -34,6 +34,8 @@ pub struct StepError {
 
 /// What a model says while it steps, routed to a log category by the FMI layer.
 pub trait Log {
+    /// Whether messages of a category are delivered (skip formatting them when not).
+    fn enabled(&self, category: &str) -> bool;
     /// Logs an info message in one of the model's own categories.
     fn info(&mut self, category: &str, message: &str);
     /// Logs a warning.

@@ -206,6 +206,18 @@ pub enum Value {
     String(String),
 }
 
+impl Value {
+    /// The value's base type.
+    pub fn base_type(&self) -> BaseType {
+        match self {
+            Value::Real(_) => BaseType::Real,
+            Value::Integer(_) => BaseType::Integer,
+            Value::Boolean(_) => BaseType::Boolean,
+            Value::String(_) => BaseType::String,
+        }
+    }
+}
+
 /// The current values of all variables of one instance, in table order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Values {
