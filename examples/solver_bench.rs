@@ -267,16 +267,7 @@ impl Rodas4 {
 
     fn integrate(&mut self, sys: &dyn OdeSystem, t0: f64, x: &mut [f64], t_end: f64) -> Result<(), String> {
         let n = self.n;
-        let plan = |t: f64, h: f64| {
-            let rest = t_end - t;
-            if h * 1.0001 >= rest {
-                (rest, true)
-            } else if 2.0 * h > rest {
-                (0.5 * rest, false)
-            } else {
-                (h, false)
-            }
-        };
+        let plan = |t: f64, h: f64| boomsim::solver::plan(t, t_end, h);
         self.y.copy_from_slice(x);
         let mut t = t0;
         sys.rhs(t, &self.y, &mut self.dy);

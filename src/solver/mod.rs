@@ -13,7 +13,7 @@ pub mod radau5;
 #[cfg(test)]
 mod tests;
 
-pub use radau5::Radau5;
+pub use radau5::{plan, Radau5};
 
 /// An ODE `dx/dt = f(t, x)` of fixed dimension.
 pub trait OdeSystem {

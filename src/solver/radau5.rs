@@ -788,7 +788,7 @@ impl Radau5 {
 
 /// Step towards `t_end`: land exactly if `h` reaches it (with 1e-4 relative slack), split the
 /// rest into two equal steps if `h` covers more than half of it. Returns `(h, last)`.
-fn plan(t: f64, t_end: f64, h: f64) -> (f64, bool) {
+pub fn plan(t: f64, t_end: f64, h: f64) -> (f64, bool) {
     let rest = t_end - t;
     if h * 1.0001 >= rest {
         (rest, true)
