@@ -40,7 +40,7 @@
 //! kappa = d^2 l_cyl/dt^2 - g . q_ddot. The mass matrix is dense (n^2 / 2 entries, O(n) sines and
 //! cosines) and solved by Cholesky on the stack; nothing is allocated.
 
-use nalgebra::{DMatrix, DVector, Matrix2, SMatrix, Vector2};
+use nalgebra::{DMatrix, DVector, SMatrix, Vector2};
 
 use super::kinematics::{law_of_cosines, Triangle};
 use super::params::{BeamParams, BoomParams};
@@ -83,13 +83,12 @@ pub struct FlexibleBoom {
     g: f64,
 }
 
-/// The cylinder pin C: position, unit vector and length of A -> C, and the lever vectors of the
-/// chain up to C (C = B + sum_j r_j, each r_j turning with q_j).
+/// The cylinder pin C: position, unit vector and length of A -> C (C = B + sum_j r_j over the
+/// sections up to the mount, each lever r_j turning with q_j; see [`FlexibleBoom::lever`]).
 struct Pin {
     c: Vector2<f64>,
     u: Vector2<f64>,
     l: f64,
-    r: [Vector2<f64>; MAX_SECTIONS],
 }
 
 /// Backward-pass quantities of one section kept for the forward pass.
@@ -97,14 +96,29 @@ struct Pin {
 struct Sweep {
     h: Vector2<f64>,
     e: f64,
-    inv_d: f64,
 }
 
-/// Sine and cosine of every section angle.
+/// Sine and cosine of the section angles (the first n, or the first n_ii for the pin alone).
 struct Trig {
     s: Column,
     c: Column,
 }
+
+/// sin and cos of |d| <= [`SMALL_ANGLE`] by their Taylor series to d^9 and d^10 (Horner in
+/// d^2): the first omitted terms, d^11 / 11! and d^12 / 12!, are below 3e-18 of the result there,
+/// under a fortieth of an ulp.
+fn sin_cos_small(d: f64) -> (f64, f64) {
+    const SIN: [f64; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362880.0];
+    const COS: [f64; 5] = [-1.0 / 2.0, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0, -1.0 / 3628800.0];
+    let z = d * d;
+    let s = SIN.iter().rev().fold(0.0, |acc, k| z * (k + acc));
+    let c = COS.iter().rev().fold(0.0, |acc, k| z * (k + acc));
+    (d + d * s, 1.0 + c)
+}
+
+/// Largest angle difference evaluated by [`sin_cos_small`] (the beam's sections differ by
+/// ~0.01 rad; beyond it the library `sin_cos`).
+const SMALL_ANGLE: f64 = 0.1;
 
 /// `v` turned by +90 deg: the derivative of a rotating vector with respect to its angle.
 fn perp(v: Vector2<f64>) -> Vector2<f64> {
@@ -211,27 +225,52 @@ impl FlexibleBoom {
     }
 
     fn trig(&self, q: &[f64]) -> Trig {
-        let mut t = Trig { s: [0.0; MAX_SECTIONS], c: [0.0; MAX_SECTIONS] };
-        for (i, a) in q[..self.n].iter().enumerate() {
-            (t.s[i], t.c[i]) = a.sin_cos();
+        self.trig_to(q, self.n)
+    }
+
+    /// sin and cos of the first `m` angles. The sections differ from q[0] by the beam's
+    /// deflection, so one library `sin_cos` of q[0] and the rotation by the small difference
+    /// d = q[i] - q[0] ([`sin_cos_small`]) give them to an ulp or two; a difference beyond
+    /// [`SMALL_ANGLE`] takes the library call.
+    fn trig_to(&self, q: &[f64], m: usize) -> Trig {
+        let mut t = self.relative_trig(q, m);
+        let (s0, c0) = q[0].sin_cos();
+        for (s, c) in t.s[..m].iter_mut().zip(&mut t.c[..m]) {
+            (*s, *c) = (s0 * *c + c0 * *s, c0 * *c - s0 * *s);
         }
         t
     }
 
-    fn pin_of(&self, t: &Trig) -> Pin {
-        let mut r = [Vector2::zeros(); MAX_SECTIONS];
-        let p = self.n_ii - 1;
-        let mut c = self.b;
-        for (j, rj) in r.iter_mut().enumerate().take(p + 1) {
-            *rj = if j < p {
-                self.len[j] * Vector2::new(t.c[j], t.s[j])
-            } else {
-                Vector2::new(t.c[p] * self.pin.x - t.s[p] * self.pin.y, t.s[p] * self.pin.x + t.c[p] * self.pin.y)
-            };
-            c += *rj;
+    /// sin and cos of the first `m` angles relative to the first, q[i] - q[0].
+    fn relative_trig(&self, q: &[f64], m: usize) -> Trig {
+        let mut t = Trig { s: [0.0; MAX_SECTIONS], c: [0.0; MAX_SECTIONS] };
+        for (i, a) in q[..m].iter().enumerate() {
+            let d = a - q[0];
+            (t.s[i], t.c[i]) = if d.abs() <= SMALL_ANGLE { sin_cos_small(d) } else { d.sin_cos() };
         }
+        t
+    }
+
+    /// The lever r_j of section j <= n_ii - 1 towards the pin C: the section itself, or for the
+    /// last section of part II its inner node -> C.
+    fn lever(&self, t: &Trig, j: usize) -> Vector2<f64> {
+        let (s, c) = (t.s[j], t.c[j]);
+        if j + 1 < self.n_ii {
+            self.len[j] * Vector2::new(c, s)
+        } else {
+            Vector2::new(c * self.pin.x - s * self.pin.y, s * self.pin.x + c * self.pin.y)
+        }
+    }
+
+    fn pin_of(&self, t: &Trig) -> Pin {
+        let c = (0..self.n_ii).fold(self.b, |c, j| c + self.lever(t, j));
         let l = c.norm();
-        Pin { c, u: c / l, l, r }
+        Pin { c, u: c / l, l }
+    }
+
+    /// Velocity of the pin C.
+    fn pin_velocity(&self, t: &Trig, qd: &[f64]) -> Vector2<f64> {
+        (0..self.n_ii).fold(Vector2::zeros(), |v, j| v + perp(self.lever(t, j)) * qd[j])
     }
 
     /// Generalised forces of gravity, springs and dampers.
@@ -266,7 +305,7 @@ impl FlexibleBoom {
 
     /// Cylinder length |A C| for the section angles `q`.
     pub fn l_cyl(&self, q: &[f64]) -> f64 {
-        self.pin_of(&self.trig(q)).l
+        self.pin_of(&self.trig_to(q, self.n_ii)).l
     }
 
     /// Global position (origin A) of the centre-line point at arm coordinate `x_a` from B
@@ -312,7 +351,7 @@ impl FlexibleBoom {
         let pin = self.pin_of(&t);
         let mut f = [0.0; MAX_SECTIONS];
         self.forces(q, &[0.0; MAX_SECTIONS], &t, &mut f);
-        let g: Column = std::array::from_fn(|j| pin.u.dot(&perp(pin.r[j])));
+        let g: Column = std::array::from_fn(|j| if j < self.n_ii { pin.u.dot(&perp(self.lever(&t, j))) } else { 0.0 });
         let f_cyl = -f[..self.n].iter().sum::<f64>() / g.iter().sum::<f64>();
         let mut tail = 0.0;
         for i in (1..self.n).rev() {
@@ -363,10 +402,11 @@ impl FlexibleBoom {
         let mut centripetal = Vector2::zeros();
         let mut g = [0.0; MAX_SECTIONS];
         for j in 0..self.n_ii {
-            let dc = perp(pin.r[j]);
+            let r = self.lever(&t, j);
+            let dc = perp(r);
             g[j] = pin.u.dot(&dc);
             c_dot += dc * qd[j];
-            centripetal -= pin.r[j] * (qd[j] * qd[j]);
+            centripetal -= r * (qd[j] * qd[j]);
         }
         let l_dot = pin.u.dot(&c_dot);
         let kappa = pin.u.dot(&centripetal) + (c_dot.norm_squared() - l_dot * l_dot) / pin.l;
@@ -390,55 +430,68 @@ impl FlexibleBoom {
     fn articulated(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]) {
         let n = self.n;
         let p = self.n_ii - 1;
-        let t = self.trig(q);
-        let pin = self.pin_of(&t);
-        let mut c_dot = Vector2::zeros();
-        for j in 0..=p {
-            c_dot += perp(pin.r[j]) * qd[j];
-        }
-        let u = pin.u;
+        let t = self.relative_trig(q, n);
+        let (s0, c0) = q[0].sin_cos();
+        let (gx, gy) = (-self.g * s0, -self.g * c0);
+        let b0 = Vector2::new(c0 * self.b.x + s0 * self.b.y, c0 * self.b.y - s0 * self.b.x);
+        let pin = (0..self.n_ii).fold(b0, |c, j| c + self.lever(&t, j));
+        let l = pin.norm();
+        let u = pin / l;
+        let c_dot = self.pin_velocity(&t, qd);
         let l_dot = u.dot(&c_dot);
-        let f_rod = f_cyl - self.m_rod * (self.g * u.y + (c_dot.norm_squared() - l_dot * l_dot) / pin.l);
+        let f_rod = f_cyl - self.m_rod * ((c_dot.norm_squared() - l_dot * l_dot) / l - (u.x * gx + u.y * gy));
         let mut sweep = [Sweep::default(); MAX_SECTIONS];
-        let (mut k, mut b) = (Matrix2::zeros(), Vector2::zeros());
+        let (mut kxx, mut kxy, mut kyy, mut bx, mut by) = (0.0, 0.0, 0.0, 0.0, 0.0);
         let mut tau_out = 0.0;
         for j in (0..n).rev() {
-            let (s, c) = (t.s[j], t.c[j]);
-            let x = self.len[j] * Vector2::new(c, s);
+            let (s, c, l) = (t.s[j], t.c[j], self.len[j]);
+            let (x, y) = (l * c, l * s);
             let f = self.first[j];
-            let sg = Vector2::new(c * f.x - s * f.y, s * f.x + c * f.y);
+            let (sx, sy) = (c * f.x - s * f.y, s * f.x + c * f.y);
             let w2 = qd[j] * qd[j];
             let tau_in = if j > 0 { self.k[j - 1] * (q[j] - q[j - 1]) + self.c[j - 1] * (qd[j] - qd[j - 1]) } else { 0.0 };
-            let kpx = k * perp(x);
-            let mut d = self.second[j] + perp(x).dot(&kpx);
-            let mut h = perp(sg) + kpx;
-            let beta = b - w2 * (k * x);
-            let mut e = tau_out - tau_in - self.g * sg.x - perp(x).dot(&beta);
-            let mut force = beta - w2 * sg + Vector2::new(0.0, self.mass[j] * self.g);
-            let mut inertia = k + Matrix2::identity() * self.mass[j];
+            let (kpx, kpy) = (kxy * x - kxx * y, kyy * x - kxy * y);
+            let mut d = self.second[j] + (y * y) * kxx + ((x * x) * kyy - (2.0 * x * y) * kxy);
+            let (mut hx, mut hy) = (kpx - sy, kpy + sx);
+            let (betax, betay) = (bx - w2 * (kxx * x + kxy * y), by - w2 * (kxy * x + kyy * y));
+            let m = self.mass[j];
+            let mut e0 = tau_out - tau_in + (sx * gy - sy * gx);
+            let (mut fx, mut fy) = (-w2 * sx - m * gx, -w2 * sy - m * gy);
+            let (mut ixx, mut ixy, mut iyy) = (kxx + m, kxy, kyy + m);
             if j == p {
-                let rho = pin.r[p];
+                let rho = self.lever(&t, p);
                 let lever = u.dot(&perp(rho));
                 let load = f_rod + w2 * self.m_rod * u.dot(&rho);
+                let mu = self.m_rod * u;
                 d += self.m_rod * lever * lever;
-                h += self.m_rod * lever * u;
-                e += lever * load;
-                force -= u * load;
-                inertia += self.m_rod * u * u.transpose();
+                hx += lever * mu.x;
+                hy += lever * mu.y;
+                e0 += lever * load;
+                fx -= u.x * load;
+                fy -= u.y * load;
+                ixx += mu.x * u.x;
+                ixy += mu.x * u.y;
+                iyy += mu.y * u.y;
             }
+            (kxx, kxy, kyy) = (ixx - hx * hx / d, ixy - hx * hy / d, iyy - hy * hy / d);
             let inv_d = 1.0 / d;
-            k = inertia - h * h.transpose() * inv_d;
-            b = force + h * (e * inv_d);
-            sweep[j] = Sweep { h, e, inv_d };
+            let (hdx, hdy) = (hx * inv_d, hy * inv_d);
+            let ed = (e0 - (x * betay - y * betax)) * inv_d;
+            (bx, by) = (
+                (betax * (1.0 + hdx * y) - betay * (hdx * x)) + (fx + hdx * e0),
+                (betay * (1.0 - hdy * x) + betax * (hdy * y)) + (fy + hdy * e0),
+            );
+            sweep[j] = Sweep { h: Vector2::new(hdx, hdy), e: ed };
             tau_out = tau_in;
         }
-        let mut a = Vector2::zeros();
-        for j in 0..n {
-            let sw = sweep[j];
-            let qdd = (sw.e - sw.h.dot(&a)) * sw.inv_d;
-            out[j] = qdd;
-            let x = self.len[j] * Vector2::new(t.c[j], t.s[j]);
-            a += qdd * perp(x) - qd[j] * qd[j] * x;
+        let (mut ax, mut ay) = (0.0, 0.0);
+        for (j, (o, sw)) in out[..n].iter_mut().zip(&sweep).enumerate() {
+            *o = sw.e - (sw.h.x * ax + sw.h.y * ay);
+            let (s, c, l) = (t.s[j], t.c[j], self.len[j]);
+            let (x, y, w2) = (l * c, l * s, qd[j] * qd[j]);
+            let (gx, gy) = (-y * sw.e - w2 * x, x * sw.e - w2 * y);
+            let (txx, txy, tyx, tyy) = (1.0 + y * sw.h.x, y * sw.h.y, -x * sw.h.x, 1.0 - x * sw.h.y);
+            (ax, ay) = (txx * ax + (txy * ay + gx), tyx * ax + (tyy * ay + gy));
         }
     }
 }
@@ -471,8 +524,8 @@ impl BoomMechanics for FlexibleBoom {
     }
 
     fn stroke_rate(&self, q: &[f64], qd: &[f64]) -> f64 {
-        let pin = self.pin_of(&self.trig(q));
-        (0..self.n_ii).map(|j| pin.u.dot(&perp(pin.r[j])) * qd[j]).sum()
+        let t = self.trig_to(q, self.n_ii);
+        self.pin_of(&t).u.dot(&self.pin_velocity(&t, qd))
     }
 
     fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]) {
