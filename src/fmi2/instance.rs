@@ -268,8 +268,10 @@ impl<M: Model> Instance<M> {
         c.outputs_current = false;
         match result {
             Ok(()) => {
-                // Inputs with a derivative follow their ramp to the new communication point.
-                for (i, &d) in c.input_derivatives.iter().enumerate() {
+                // Inputs with a derivative follow their ramp to the new communication point
+                // (only models that interpolate inputs accept derivatives).
+                let ramps = if M::INFO.can_interpolate_inputs { c.input_derivatives.as_slice() } else { &[] };
+                for (i, &d) in ramps.iter().enumerate() {
                     if let (Value::Real(x), true) = (c.values.at(i), d != 0.0) {
                         c.values.put(i, Value::Real(x + d * h));
                     }

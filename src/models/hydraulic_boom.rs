@@ -372,6 +372,8 @@ pub struct HydraulicBoom {
     plant: Plant,
     state: Vec<f64>,
     solver: Radau5,
+    /// The relative tolerance the solver is set to (NaN: not yet).
+    rtol: f64,
 }
 
 impl HydraulicBoom {
@@ -384,7 +386,7 @@ impl HydraulicBoom {
             Some(s) => return Err(format!("expected {} finite states, got {}", plant.dim(), s.len())),
         };
         let solver = Radau5::new(plant.dim());
-        Ok(HydraulicBoom { plant, state, solver })
+        Ok(HydraulicBoom { plant, state, solver, rtol: f64::NAN })
     }
 }
 
@@ -477,11 +479,14 @@ impl Model for HydraulicBoom {
     ) -> Result<(), StepError> {
         let fail = |time, message: String| StepError { time, message };
         self.plant.u_ref = values.real(vr::U_REF);
-        let atol = self.plant.atol(tolerance);
-        self.solver
-            .set_rtol(tolerance)
-            .and_then(|_| self.solver.set_atol(&atol))
-            .map_err(|e| fail(t, e.to_string()))?;
+        if tolerance != self.rtol {
+            let atol = self.plant.atol(tolerance);
+            self.solver
+                .set_rtol(tolerance)
+                .and_then(|_| self.solver.set_atol(&atol))
+                .map_err(|e| fail(t, e.to_string()))?;
+            self.rtol = tolerance;
+        }
         let before = *self.solver.stats();
         self.solver.integrate(&self.plant, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
         if log.enabled("logSolver") {
