@@ -7,14 +7,11 @@
 //! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
 //! angle of each section). The operator's reference `valve.u_ref` is held over each step.
 
+use super::parts::{self, out, TableBuilder, CIRCUIT_SCALE, FLEXIBLE_SWITCH, N_BOOM_ROWS, START_STROKE, TIP_DEFLECTION};
+pub use super::parts::Boom;
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
-use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
-use crate::mechanics::rigid_boom::RigidBoom;
-use crate::mechanics::BoomMechanics;
-use crate::params::ParamSpec;
 use crate::solver::{OdeSystem, Radau5};
 
 /// Value references (stable across releases: append, never renumber).
@@ -46,32 +43,7 @@ pub mod vr {
     pub const SOLVER_REJECTED: u32 = 24;
     pub const SOLVER_RHS: u32 = 25;
     pub const SOLVER_JACOBIANS: u32 = 26;
-    pub const X0: u32 = 30;
-    pub const FLEXIBLE: u32 = 31;
-    pub const TIP_DEFLECTION: u32 = 40;
-    /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
-    pub const SECTIONS: u32 = 41;
-    /// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
-    pub const HYDRAULICS: u32 = 100;
-    /// Boom parameters: `BOOM + index` in [`crate::mechanics::params::SPECS`].
-    pub const BOOM: u32 = 200;
-    /// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_SPECS`].
-    pub const BEAM: u32 = 250;
-}
-
-const START_STROKE: ParamSpec = ParamSpec {
-    name: "start.x",
-    default: 0.480,
-    unit: "m",
-    display_unit: "mm",
-    min: 0.0,
-    max: 10.0,
-    description: "Initial stroke; the load starts at rest, held by the closed CBV, pressures in equilibrium",
-    source: "Start stroke of the experiments, 480 mm (sections 6.2, chapter 7)",
-};
-
-const fn out(name: &'static str, r: u32, unit: &'static str, display: &'static str, d: &'static str) -> Variable {
-    Variable::real_output(name, r, unit, display, d)
+    pub use crate::models::parts::vr::*;
 }
 
 #[rustfmt::skip]
@@ -105,142 +77,16 @@ const OWN: [Variable; 30] = [
     Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
     Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
     Variable::param(vr::X0, START_STROKE).fixed(),
-    Variable::bool_param("boom.flexible", vr::FLEXIBLE, true,
-        "Lumped flexible arm (boom.n2 + boom.n3 sections, eq. 2.34-2.39); false: rigid boom").fixed(),
-    out("boom.tip_deflection", vr::TIP_DEFLECTION, "m", "mm",
-        "Deflection of the arm's end normal to the rigid boom line at the same cylinder length, > 0 up (0 when rigid)"),
+    FLEXIBLE_SWITCH,
+    TIP_DEFLECTION,
 ];
 
-/// Names of the section-angle outputs (structured names, 1-based as in the thesis).
-const SECTION_NAMES: [&str; MAX_SECTIONS] = [
-    "boom.section[1].phi",
-    "boom.section[2].phi",
-    "boom.section[3].phi",
-    "boom.section[4].phi",
-    "boom.section[5].phi",
-    "boom.section[6].phi",
-    "boom.section[7].phi",
-    "boom.section[8].phi",
-    "boom.section[9].phi",
-    "boom.section[10].phi",
-    "boom.section[11].phi",
-    "boom.section[12].phi",
-    "boom.section[13].phi",
-    "boom.section[14].phi",
-    "boom.section[15].phi",
-    "boom.section[16].phi",
-    "boom.section[17].phi",
-    "boom.section[18].phi",
-    "boom.section[19].phi",
-    "boom.section[20].phi",
-    "boom.section[21].phi",
-    "boom.section[22].phi",
-    "boom.section[23].phi",
-    "boom.section[24].phi",
-    "boom.section[25].phi",
-    "boom.section[26].phi",
-    "boom.section[27].phi",
-    "boom.section[28].phi",
-    "boom.section[29].phi",
-    "boom.section[30].phi",
-    "boom.section[31].phi",
-    "boom.section[32].phi",
-];
-
-const N_VARS: usize = OWN.len() + MAX_SECTIONS + PARAMS.len() + BOOM_SPECS.len() + BEAM_SPECS.len();
-
-/// Parameters that count or select (a model index, section counts): exposed as Integers.
-const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
-
-const fn str_eq(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
-
-const fn is_selector(name: &str) -> bool {
-    let mut i = 0;
-    while i < SELECTORS.len() {
-        if str_eq(name, SELECTORS[i]) {
-            return true;
-        }
-        i += 1;
-    }
-    false
-}
-
-/// The FMU variable of a physical parameter: fixed, an Integer where it counts or selects.
-const fn param(r: u32, p: ParamSpec) -> Variable {
-    if is_selector(p.name) {
-        Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
-    } else {
-        Variable::param(r, p).fixed()
-    }
-}
-
-/// The value of parameter `p` with value reference `r`, as a number.
-fn param_value(values: &Values, r: u32, p: &ParamSpec) -> f64 {
-    if is_selector(p.name) {
-        values.integer(r) as f64
-    } else {
-        values.real(r)
-    }
-}
+const N_VARS: usize = OWN.len() + PARAMS.len() + N_BOOM_ROWS;
 
 /// The table: own variables, the section angles, then every hydraulic, boom and beam parameter
 /// (fixed: set them before initialisation ends).
-const TABLE: [Variable; N_VARS] = {
-    let mut t = [OWN[0]; N_VARS];
-    let mut n = 0;
-    while n < OWN.len() {
-        t[n] = OWN[n];
-        n += 1;
-    }
-    let mut k = 0;
-    while k < MAX_SECTIONS {
-        t[n] = out(
-            SECTION_NAMES[k],
-            vr::SECTIONS + k as u32,
-            "rad",
-            "deg",
-            "Absolute angle of the arm section (from the joint outwards); beyond the last section, the last one's",
-        );
-        (n, k) = (n + 1, k + 1);
-    }
-    let mut k = 0;
-    while k < PARAMS.len() {
-        t[n] = param(vr::HYDRAULICS + k as u32, PARAMS[k].spec);
-        (n, k) = (n + 1, k + 1);
-    }
-    let mut k = 0;
-    while k < BOOM_SPECS.len() {
-        t[n] = param(vr::BOOM + k as u32, BOOM_SPECS[k]);
-        (n, k) = (n + 1, k + 1);
-    }
-    let mut k = 0;
-    while k < BEAM_SPECS.len() {
-        t[n] = param(vr::BEAM + k as u32, BEAM_SPECS[k]);
-        (n, k) = (n + 1, k + 1);
-    }
-    t
-};
-
-/// Scales of the circuit states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar,
-/// 1 mm of spool travel, full valve opening.
-const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
-/// Scales of the boom coordinates and velocities: 1 mm and 1 mm/s of stroke (rigid); 0.1 mrad
-/// and 1 mrad/s of section angle (flexible: deflection angles are ~1 mrad).
-const RIGID_SCALE: (f64, f64) = (1e-3, 1e-3);
-const FLEXIBLE_SCALE: (f64, f64) = (1e-4, 1e-3);
+const TABLE: [Variable; N_VARS] =
+    TableBuilder::new(&OWN).sections().hydraulics(PARAMS, 0, PARAMS.len()).boom_params().build();
 
 const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
 PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48), counterbalance valve with check valve and
@@ -251,23 +97,6 @@ volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving th
 <p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
 spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>"#;
-
-/// The boom the circuit drives.
-#[derive(Debug, Clone)]
-pub enum Boom {
-    Rigid(RigidBoom),
-    Flexible(FlexibleBoom),
-}
-
-impl Boom {
-    /// The boom's mechanics.
-    pub fn mechanics(&self) -> &dyn BoomMechanics {
-        match self {
-            Boom::Rigid(b) => b,
-            Boom::Flexible(b) => b,
-        }
-    }
-}
 
 /// Circuit + boom as one ODE, with the operator's reference held.
 #[derive(Debug, Clone)]
@@ -299,35 +128,8 @@ impl OdeSystem for Plant {
 impl Plant {
     /// The plant from the FMU's parameter values; refuses inconsistent combinations.
     pub fn from_values(values: &Values) -> Result<Self, String> {
-        let mut circuit = Circuit::default();
-        for (k, p) in PARAMS.iter().enumerate() {
-            (p.set)(&mut circuit, param_value(values, vr::HYDRAULICS + k as u32, &p.spec));
-        }
-        let cyl = &circuit.cylinder;
-        if cyl.d_rod >= cyl.d_piston {
-            return Err(format!(
-                "cylinder.d_rod = {} must be less than cylinder.d_piston = {}",
-                cyl.d_rod, cyl.d_piston
-            ));
-        }
-        if circuit.dcv.x_db >= circuit.dcv.x_max {
-            return Err(format!(
-                "valve.x_db = {} must be less than valve.x_max = {}",
-                circuit.dcv.x_db, circuit.dcv.x_max
-            ));
-        }
-        let lookup = |specs: &[ParamSpec], base: u32, name: &str| {
-            let k = specs.iter().position(|s| s.name == name).expect("parameter name");
-            param_value(values, base + k as u32, &specs[k])
-        };
-        let params = BoomParams::from_lookup(|n| lookup(BOOM_SPECS, vr::BOOM, n));
-        let boom = if values.boolean(vr::FLEXIBLE) {
-            let beam = BeamParams::from_lookup(|n| lookup(BEAM_SPECS, vr::BEAM, n));
-            FlexibleBoom::new(&params, &beam, cyl.stroke).map(Boom::Flexible)
-        } else {
-            RigidBoom::new(&params, cyl.stroke).map(Boom::Rigid)
-        };
-        let boom = boom.map_err(|e| format!("boom geometry (boom.*, cylinder.l_retracted, cylinder.stroke): {e}"))?;
+        let circuit = parts::circuit_from_values(values)?;
+        let boom = Boom::from_values(values, circuit.cylinder.stroke)?;
         Ok(Plant { circuit, boom, u_ref: values.real(vr::U_REF) })
     }
 
@@ -358,11 +160,7 @@ impl Plant {
 
     /// Absolute tolerances for relative tolerance `rtol`.
     fn atol(&self, rtol: f64) -> Vec<f64> {
-        let dof = self.boom.mechanics().dof();
-        let (q, qd) = if let Boom::Rigid(_) = self.boom { RIGID_SCALE } else { FLEXIBLE_SCALE };
-        let scales =
-            CIRCUIT_SCALE.iter().copied().chain(std::iter::repeat_n(q, dof)).chain(std::iter::repeat_n(qd, dof));
-        scales.map(|s| s * rtol).collect()
+        CIRCUIT_SCALE.iter().map(|s| s * rtol).chain(self.boom.atol(rtol)).collect()
     }
 }
 
@@ -419,14 +217,6 @@ impl Model for HydraulicBoom {
         let (q, qd) = boom.split_at(b.dof());
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
         let e = self.plant.circuit.evaluate(c.try_into().expect("circuit slice"), values.real(vr::U_REF), x, v);
-        let (theta, omega, tip) = match &self.plant.boom {
-            Boom::Rigid(r) => {
-                let st = r.state(x, v);
-                (st.theta2, st.theta2_dot, 0.0)
-            }
-            Boom::Flexible(f) => (q[0], qd[0], f.tip_deflection(q)),
-        };
-        let payload = b.payload(q);
         let stats = self.solver.stats();
         let outputs = [
             (vr::P1, c[circuit::P1]),
@@ -444,10 +234,6 @@ impl Model for HydraulicBoom {
             (vr::V, v),
             (vr::F, e.force),
             (vr::F_FR, e.f_friction),
-            (vr::THETA, theta),
-            (vr::OMEGA, omega),
-            (vr::PAYLOAD_X, payload.x),
-            (vr::PAYLOAD_Y, payload.y),
             (vr::X_V, c[circuit::X_V]),
             (vr::U_PCV, e.u_pcv),
             (vr::P_X, e.p_x),
@@ -455,15 +241,11 @@ impl Model for HydraulicBoom {
             (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
             (vr::SOLVER_RHS, stats.rhs_evals as f64),
             (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
-            (vr::TIP_DEFLECTION, tip),
         ];
         for (r, x) in outputs {
             values.set_real(r, x);
         }
-        for k in 0..MAX_SECTIONS {
-            let phi = if let Boom::Flexible(_) = self.plant.boom { q[k.min(q.len() - 1)] } else { theta };
-            values.set_real(vr::SECTIONS + k as u32, phi);
-        }
+        self.plant.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
 
     fn do_step(

@@ -1,6 +1,7 @@
 //! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].
 
 pub mod hydraulic_boom;
+pub mod parts;
 pub mod pressure_feedback_controller;
 
 pub use hydraulic_boom::HydraulicBoom;
