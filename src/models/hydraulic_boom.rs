@@ -266,18 +266,7 @@ impl Model for HydraulicBoom {
             .map_err(|e| fail(t, e.to_string()))?;
         let before = *self.solver.stats();
         self.solver.integrate(&self.plant, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
-        let s = self.solver.stats();
-        log.info(
-            "logSolver",
-            &format!(
-                "t = {}: {} steps ({} rejected), {} RHS, {} Jacobians",
-                t + h,
-                s.accepted_steps - before.accepted_steps,
-                s.rejected_steps - before.rejected_steps,
-                s.rhs_evals - before.rhs_evals,
-                s.jacobian_evals - before.jacobian_evals
-            ),
-        );
+        parts::log_step(log, t + h, &before, self.solver.stats());
         Ok(())
     }
 

@@ -2,7 +2,7 @@
 //! tables (the physical parameters with the same names and value references in every model), the
 //! circuit and boom built from parameter values, the boom's outputs and the tolerance scales.
 
-use crate::fmi2::{Values, Variable};
+use crate::fmi2::{Log, Values, Variable};
 use crate::hydraulics::circuit::{Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::Param;
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
@@ -10,6 +10,7 @@ use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM
 use crate::mechanics::rigid_boom::RigidBoom;
 use crate::mechanics::BoomMechanics;
 use crate::params::ParamSpec;
+use crate::solver::SolverStats;
 
 /// Value references shared by every model that has the variable (stable: append, never renumber).
 pub mod vr {
@@ -97,7 +98,7 @@ const SECTION_NAMES: [&str; MAX_SECTIONS] = [
 /// Parameters that count or select (a model index, section counts): exposed as Integers.
 const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
 
-const fn str_eq(a: &str, b: &str) -> bool {
+pub(crate) const fn str_eq(a: &str, b: &str) -> bool {
     let (a, b) = (a.as_bytes(), b.as_bytes());
     if a.len() != b.len() {
         return false;
@@ -301,3 +302,17 @@ impl Boom {
 /// Scales of the circuit states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar,
 /// 1 mm of spool travel, full valve opening.
 pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
+
+/// Logs the integrator statistics of the step that ended at `t` (category `logSolver`).
+pub(crate) fn log_step(log: &mut dyn Log, t: f64, before: &SolverStats, after: &SolverStats) {
+    log.info(
+        "logSolver",
+        &format!(
+            "t = {t}: {} steps ({} rejected), {} RHS, {} Jacobians",
+            after.accepted_steps - before.accepted_steps,
+            after.rejected_steps - before.rejected_steps,
+            after.rhs_evals - before.rhs_evals,
+            after.jacobian_evals - before.jacobian_evals
+        ),
+    );
+}

@@ -1,0 +1,243 @@
+//! The BoomMechanics FMU model: the rigid or lumped flexible boom of HydraulicBoom alone, driven
+//! through the mechanical port ([`super::port`]) by the cylinder force (plain) or the TLM wave of
+//! [`super::HydraulicCircuit`], advanced by the Radau IIA integrator.
+//!
+//! States: the boom's generalised coordinates and velocities (rigid: the stroke; flexible: the
+//! section angles). The boom carries the rod and piston (mass and weight), as in HydraulicBoom.
+
+use super::parts::{out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, START_STROKE, TIP_DEFLECTION};
+use super::port::{self, Coupling, Ramp, FORCE_RANGE};
+use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::hydraulics::params::PARAMS;
+use crate::solver::{OdeSystem, Radau5};
+
+/// Value references: those of HydraulicBoom for the same names, the port's from [`port::vr`].
+pub mod vr {
+    pub use crate::models::hydraulic_boom::vr::{
+        BEAM, BOOM, F, FLEXIBLE, HYDRAULICS, OMEGA, PAYLOAD_X, PAYLOAD_Y, SECTIONS, SOLVER_JACOBIANS,
+        SOLVER_REJECTED, SOLVER_RHS, SOLVER_STEPS, THETA, TIP_DEFLECTION, V, X, X0,
+    };
+    pub use crate::models::port::vr::*;
+}
+
+/// Index of `cylinder.stroke` in the circuit parameters: the boom's range of motion.
+const STROKE_INDEX: usize = {
+    let mut k = 0;
+    while !crate::models::parts::str_eq(PARAMS[k].spec.name, "cylinder.stroke") {
+        k += 1;
+    }
+    k
+};
+
+#[rustfmt::skip]
+const OWN: [Variable; 20] = [
+    Variable::real_input("cylinder.F", vr::F, 0.0, "N", "kN", FORCE_RANGE,
+        "Plain port: force on the rod from the circuit, pushing it out (linear over a step with its derivative)"),
+    out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
+    out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
+    out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
+    out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
+    out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
+    out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
+    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
+    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
+    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
+    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
+    Variable::param(vr::X0, START_STROKE).fixed(),
+    FLEXIBLE_SWITCH,
+    TIP_DEFLECTION,
+    port::COUPLING,
+    Variable::param(vr::Z_C, port::Z_C).fixed(),
+    out("start.F", vr::START_F, "N", "kN",
+        "Cylinder force that holds the boom at rest at start.x (set HydraulicCircuit's start.F to it)"),
+    Variable::real_input("port.c_h", vr::C_H, 0.0, "N", "kN", FORCE_RANGE,
+        "TLM port: wave from the circuit, c_h = F_H + Z_c v_H (linear over a step with its derivative)"),
+    out("port.c_m", vr::C_M, "N", "kN", "TLM port: wave to the circuit, c_m = F_M - Z_c v_M at the step end"),
+    port::PORT_F,
+];
+
+const N_VARS: usize = OWN.len() + 1 + N_BOOM_ROWS;
+const TABLE: [Variable; N_VARS] =
+    TableBuilder::new(&OWN).sections().hydraulics(PARAMS, STROKE_INDEX, STROKE_INDEX + 1).boom_params().build();
+
+const DOCUMENTATION: &str = r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
+flexible (2.1.4, 3.1.2), with the same parameters, names and value references, the rod and piston included. It
+starts at rest at <code>start.x</code>; <code>start.F</code> is the cylinder force that holds it there.
+<code>port.coupling</code> selects the port, as in HydraulicCircuit: <b>0, plain</b>: input <code>cylinder.F</code>
+(linear over a step with fmi2SetRealInputDerivatives); <b>1, TLM</b>: input wave c<sub>h</sub>, the boom is pushed by
+F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub> and emits c<sub>m</sub> = F<sub>M</sub> &minus;
+Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). Outputs: stroke, velocity, boom angle, payload
+position, tip deflection and section angles.</p>"#;
+
+/// The boom driven through the port, as one ODE over a step.
+#[derive(Debug, Clone)]
+pub struct PortedBoom {
+    pub boom: Boom,
+    pub coupling: Coupling,
+    /// Plain: the cylinder force; TLM: the wave c_h.
+    pub input: Ramp,
+}
+
+impl PortedBoom {
+    /// Force pushing the rod out at `t`, coordinates `q`, velocities `qd`.
+    pub fn force(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+        match self.coupling {
+            Coupling::Plain => self.input.at(t),
+            Coupling::Tlm { z_c } => self.input.at(t) - z_c * self.boom.mechanics().stroke_rate(q, qd),
+        }
+    }
+}
+
+impl OdeSystem for PortedBoom {
+    fn dim(&self) -> usize {
+        2 * self.boom.mechanics().dof()
+    }
+
+    fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
+        let b = self.boom.mechanics();
+        let (q, qd) = s.split_at(b.dof());
+        let (dq, dqd) = dx.split_at_mut(b.dof());
+        dq.copy_from_slice(qd);
+        b.accelerations(q, qd, self.force(t, q, qd), dqd);
+    }
+}
+
+/// The BoomMechanics model: ported boom, state, integrator.
+#[derive(Debug, Clone)]
+pub struct BoomMechanics {
+    sys: PortedBoom,
+    /// Holding force at the start.
+    f_start: f64,
+    t: f64,
+    state: Vec<f64>,
+    solver: Radau5,
+}
+
+impl BoomMechanics {
+    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, input: f64) -> Result<Self, String> {
+        let stroke = values.real(vr::HYDRAULICS + STROKE_INDEX as u32);
+        let boom = Boom::from_values(values, stroke)?;
+        let x0 = values.real(vr::X0);
+        if !(0.0..=stroke).contains(&x0) {
+            return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
+        }
+        let rest =
+            boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
+        let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input: Ramp { t0: t, y0: input, slope: 0.0 } };
+        let state = match state {
+            None => {
+                let mut s = rest.q.clone();
+                s.resize(sys.dim(), 0.0);
+                s
+            }
+            Some(s) if s.len() == sys.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
+            Some(s) => return Err(format!("expected {} finite states, got {}", sys.dim(), s.len())),
+        };
+        let solver = Radau5::new(sys.dim());
+        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, state, solver })
+    }
+
+    /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
+    fn input_vr(&self) -> u32 {
+        match self.sys.coupling {
+            Coupling::Plain => vr::F,
+            Coupling::Tlm { .. } => vr::C_H,
+        }
+    }
+}
+
+impl Model for BoomMechanics {
+    const INFO: ModelInfo = ModelInfo {
+        identifier: "BoomMechanics",
+        description: "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
+        version: "0.1.0",
+        start_time: 0.0,
+        stop_time: 15.0,
+        step_size: 1e-3,
+        default_tolerance: 1e-6,
+        log_categories: &[("logSolver", "Integrator statistics per communication step")],
+        can_interpolate_inputs: true,
+        documentation: DOCUMENTATION,
+    };
+    const VARIABLES: &'static [Variable] = &TABLE;
+
+    /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).
+    fn initialize(values: &Values) -> Result<Self, String> {
+        let mut m = Self::with_state(values, None, 0.0, 0.0)?;
+        m.sys.input.y0 = if m.sys.coupling == Coupling::Plain { values.real(vr::F) } else { m.f_start };
+        Ok(m)
+    }
+
+    fn retune(&mut self, _values: &Values) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn outputs(&self, values: &mut Values) {
+        let mut sys = self.sys.clone();
+        if sys.coupling == Coupling::Plain {
+            sys.input = Ramp { t0: self.t, y0: values.real(vr::F), slope: 0.0 };
+        }
+        let b = sys.boom.mechanics();
+        let (q, qd) = self.state.split_at(b.dof());
+        let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
+        let f = sys.force(self.t, q, qd);
+        let c_m = match sys.coupling {
+            Coupling::Plain => f,
+            Coupling::Tlm { z_c } => f - z_c * v,
+        };
+        let stats = self.solver.stats();
+        let outputs = [
+            (vr::X, x),
+            (vr::V, v),
+            (vr::START_F, self.f_start),
+            (vr::C_M, c_m),
+            (port::vr::F, f),
+            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
+            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
+            (vr::SOLVER_RHS, stats.rhs_evals as f64),
+            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
+        ];
+        for (r, x) in outputs {
+            values.set_real(r, x);
+        }
+        sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
+    }
+
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        let fail = |time, message: String| StepError { time, message };
+        self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
+        let atol: Vec<f64> = self.sys.boom.atol(tolerance).collect();
+        self.solver
+            .set_rtol(tolerance)
+            .and_then(|_| self.solver.set_atol(&atol))
+            .map_err(|e| fail(t, e.to_string()))?;
+        let before = *self.solver.stats();
+        self.solver.integrate(&self.sys, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
+        self.t = t + h;
+        crate::models::parts::log_step(log, t + h, &before, self.solver.stats());
+        Ok(())
+    }
+
+    fn save(&self) -> Vec<f64> {
+        let mut v = vec![self.t, self.sys.input.at(self.t)];
+        v.extend_from_slice(&self.state);
+        v.extend_from_slice(&self.solver.save_state());
+        v
+    }
+
+    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
+        let n = saved.len().checked_sub(2 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+        let mut m = Self::with_state(values, Some(&saved[2..2 + n]), saved[0], saved[1])?;
+        let solver_state = saved[2 + n..].try_into().map_err(|_| "solver state length".to_string())?;
+        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        Ok(m)
+    }
+}

@@ -1,0 +1,331 @@
+//! The HydraulicCircuit FMU model: the circuit of thesis Fig. 2.8 ([`crate::hydraulics::circuit`])
+//! with a mechanical port instead of the boom ([`super::port`]), for coupling to external
+//! mechanics such as [`super::BoomMechanics`].
+//!
+//! States: the circuit's six (p1..p4, spool position, load-holding opening); with the TLM port
+//! also the rod's stroke and velocity. Plain port: the stroke follows the velocity input within a
+//! step, x(t) = x_k + integral of v, v(t) = v_k + v' (t - t_k) (v' from
+//! fmi2SetRealInputDerivatives, 0 holds v), so chamber volumes and piston flows agree.
+
+use super::parts::{self, out, TableBuilder, CIRCUIT_SCALE, START_STROKE};
+use super::port::{self, Coupling, Ramp, FORCE_RANGE};
+use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
+use crate::hydraulics::params::PARAMS;
+use crate::params::ParamSpec;
+use crate::solver::{OdeSystem, Radau5};
+
+/// Value references: those of HydraulicBoom for the same names, the port's from [`port::vr`].
+pub mod vr {
+    pub use crate::models::hydraulic_boom::vr::{
+        P1, P2, P3, P4, P_X, Q1, Q2, Q3, Q4, SOLVER_JACOBIANS, SOLVER_REJECTED, SOLVER_RHS, SOLVER_STEPS, U, U_CBV,
+        U_CV, U_PCV, U_REF, X, X0, X_V, HYDRAULICS, F, F_FR, V,
+    };
+    pub use crate::models::port::vr::*;
+    /// Stroke and velocity the circuit uses (the plain inputs, or the TLM rod's states).
+    pub const PORT_X: u32 = 87;
+    pub const PORT_V: u32 = 88;
+}
+
+const PORT_MASS: ParamSpec = ParamSpec {
+    name: "port.m",
+    default: 5.0,
+    unit: "kg",
+    display_unit: "",
+    min: 1e-3,
+    max: 1e5,
+    description: "TLM port: mass the circuit integrates at the rod (rod + piston); the mechanics keeps its own",
+    source: "cylinder.m_rod, 5 kg (thesis nomenclature); 0.04 % of the boom's 14 t effective mass",
+};
+
+/// Default: the rigid boom's holding force at the 480 mm start stroke (test in
+/// tests/coupling.rs against BoomMechanics' `start.F`).
+const START_FORCE: ParamSpec = ParamSpec {
+    name: "start.F",
+    default: 23_100.0,
+    unit: "N",
+    display_unit: "kN",
+    min: 0.0,
+    max: 1e7,
+    description: "Load on the rod at the start, held by the closed CBV (the mechanics' static force at start.x: BoomMechanics' start.F)",
+    source: "rigid boom of the thesis at start.x = 480 mm",
+};
+
+#[rustfmt::skip]
+const OWN: [Variable; 33] = [
+    Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
+        "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
+    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
+    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV"),
+    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3)"),
+    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot)"),
+    out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
+    out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
+    out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
+    out("Q1", vr::Q1, "m3/s", "l/min", "PCV flow, supply to line 1 (eq. 2.50)"),
+    out("Q2", vr::Q2, "m3/s", "l/min", "DCV flow into line 2, P->A / A->T (eq. 2.40, 2.42)"),
+    out("Q3", vr::Q3, "m3/s", "l/min", "CBV flow, line 2 to line 3 (eq. 2.58, 2.59)"),
+    out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
+    Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),
+        "Plain port: cylinder stroke from the mechanics (at the step start)"),
+    Variable::real_input("cylinder.v", vr::V, 0.0, "m/s", "mm/s", (-10.0, 10.0),
+        "Plain port: cylinder velocity from the mechanics, > 0 extending (linear over a step with its derivative)"),
+    out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops (at port.x, port.v)")
+        .depends(&[vr::X, vr::V]),
+    out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity").depends(&[vr::X, vr::V]),
+    Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
+    Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
+    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
+    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
+    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
+    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
+    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
+    Variable::param(vr::X0, START_STROKE).fixed(),
+    port::COUPLING,
+    Variable::param(vr::Z_C, port::Z_C).fixed(),
+    Variable::param(vr::M, PORT_MASS).fixed(),
+    Variable::param(vr::START_F, START_FORCE).fixed(),
+    Variable::real_input("port.c_m", vr::C_M, START_FORCE.default, "N", "kN", FORCE_RANGE,
+        "TLM port: wave from the mechanics, c_m = F_M - Z_c v_M (linear over a step with its derivative)"),
+    out("port.c_h", vr::C_H, "N", "kN", "TLM port: wave to the mechanics, c_h = F_H + Z_c v_H at the step end"),
+    port::PORT_F,
+    out("port.x", vr::PORT_X, "m", "mm", "Stroke the circuit uses: cylinder.x ramped with cylinder.v (plain), the rod's (TLM)"),
+    out("port.v", vr::PORT_V, "m/s", "mm/s", "Velocity the circuit uses: cylinder.v (plain), the rod's (TLM)"),
+];
+
+const N_VARS: usize = OWN.len() + PARAMS.len();
+const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN).hydraulics(PARAMS, 0, PARAMS.len()).build();
+
+const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8 (valves, cylinder, lines; the same parameters, names and value
+references as HydraulicBoom) with a mechanical port instead of the boom, advanced inside fmi2DoStep by the Radau IIA
+integrator. <code>port.coupling</code> selects the port:</p>
+<ul><li><b>0, plain</b>: inputs <code>cylinder.x</code>, <code>cylinder.v</code> (set the slope of v with
+fmi2SetRealInputDerivatives for a velocity linear over the step; x follows its integral), output
+<code>cylinder.F</code>. Exact, but the mechanics sees a force one step old: stable while &omega;h &lt; 2 for every
+mode the oil column couples to the mechanics.</li>
+<li><b>1, TLM</b>: a transmission line with impedance Z<sub>c</sub> (<code>port.Z_c</code>) and a delay of one
+communication step. The circuit integrates the rod mass <code>port.m</code> pushed by the cylinder and held back by
+the line force F<sub>H</sub> = c<sub>m</sub> + Z<sub>c</sub>v<sub>H</sub>, and emits c<sub>h</sub> = F<sub>H</sub> +
+Z<sub>c</sub>v<sub>H</sub>; the mechanics is pushed by F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub>
+and emits c<sub>m</sub> = F<sub>M</sub> &minus; Z<sub>c</sub>v<sub>M</sub>. Passive at any step; it adds a spring
+Z<sub>c</sub>/h and a mass Z<sub>c</sub>h at the pin.</li></ul>
+<p>The circuit starts in the static equilibrium that holds <code>start.F</code> with the CBV closed (set it to the
+mechanics' static cylinder force at the start).</p>"#;
+
+/// The circuit with its port, as one ODE over a step.
+#[derive(Debug, Clone)]
+pub struct PortedCircuit {
+    pub circuit: Circuit,
+    pub coupling: Coupling,
+    /// TLM rod mass (kg).
+    pub m: f64,
+    pub u_ref: f64,
+    /// Plain: stroke at the step start and the velocity over the step.
+    pub x0: f64,
+    pub v: Ramp,
+    /// TLM: the wave from the mechanics over the step.
+    pub c_m: Ramp,
+}
+
+impl PortedCircuit {
+    /// Stroke and velocity at `t` for state `s`.
+    pub fn motion(&self, t: f64, s: &[f64]) -> (f64, f64) {
+        match self.coupling {
+            Coupling::Plain => (self.x0 + self.v.integral(t), self.v.at(t)),
+            Coupling::Tlm { .. } => (s[N_CIRCUIT], s[N_CIRCUIT + 1]),
+        }
+    }
+
+    /// The circuit's evaluation and the line force at `t`, state `s`.
+    fn evaluate(&self, t: f64, s: &[f64]) -> (circuit::Eval, f64) {
+        let (x, v) = self.motion(t, s);
+        let e = self.circuit.evaluate(s[..N_CIRCUIT].try_into().expect("circuit slice"), self.u_ref, x, v);
+        let f_line = match self.coupling {
+            Coupling::Plain => e.force,
+            Coupling::Tlm { z_c } => self.c_m.at(t) + z_c * v,
+        };
+        (e, f_line)
+    }
+}
+
+impl OdeSystem for PortedCircuit {
+    fn dim(&self) -> usize {
+        match self.coupling {
+            Coupling::Plain => N_CIRCUIT,
+            Coupling::Tlm { .. } => N_CIRCUIT + 2,
+        }
+    }
+
+    fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
+        let (e, f_line) = self.evaluate(t, s);
+        dx[..N_CIRCUIT].copy_from_slice(&e.dx);
+        if let Coupling::Tlm { .. } = self.coupling {
+            dx[N_CIRCUIT] = s[N_CIRCUIT + 1];
+            dx[N_CIRCUIT + 1] = (e.force - f_line) / self.m;
+        }
+    }
+}
+
+/// The HydraulicCircuit model: ported circuit, state, integrator.
+#[derive(Debug, Clone)]
+pub struct HydraulicCircuit {
+    sys: PortedCircuit,
+    /// Time of the state (the start of the next step).
+    t: f64,
+    state: Vec<f64>,
+    solver: Radau5,
+}
+
+impl HydraulicCircuit {
+    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, c_m: f64) -> Result<Self, String> {
+        let circuit = parts::circuit_from_values(values)?;
+        let x0 = values.real(vr::X0);
+        let stroke = circuit.cylinder.stroke;
+        let sys = PortedCircuit {
+            circuit,
+            coupling: Coupling::from_values(values),
+            m: values.real(vr::M),
+            u_ref: values.real(vr::U_REF),
+            x0: values.real(vr::X),
+            v: Ramp { t0: t, y0: values.real(vr::V), slope: 0.0 },
+            c_m: Ramp { t0: t, y0: c_m, slope: 0.0 },
+        };
+        let state = match state {
+            None => {
+                if !(0.0..=stroke).contains(&x0) {
+                    return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
+                }
+                let f = values.real(vr::START_F);
+                let c = sys.circuit.equilibrium(f).map_err(|e| {
+                    format!("no static equilibrium with start.F = {f:.0} N (payload on the CBV, cbv.p_set): {e}")
+                })?;
+                let mut s = c.to_vec();
+                if sys.dim() > N_CIRCUIT {
+                    s.extend([x0, 0.0]);
+                }
+                s
+            }
+            Some(s) if s.len() == sys.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
+            Some(s) => return Err(format!("expected {} finite states, got {}", sys.dim(), s.len())),
+        };
+        let solver = Radau5::new(sys.dim());
+        Ok(HydraulicCircuit { sys, t, state, solver })
+    }
+
+    /// Absolute tolerances for `rtol`: the circuit's scales, 1 mm and 1 mm/s for the rod.
+    fn atol(&self, rtol: f64) -> Vec<f64> {
+        CIRCUIT_SCALE.iter().chain(&[1e-3, 1e-3]).take(self.sys.dim()).map(|s| s * rtol).collect()
+    }
+}
+
+impl Model for HydraulicCircuit {
+    const INFO: ModelInfo = ModelInfo {
+        identifier: "HydraulicCircuit",
+        description: "Pressure-compensated valve, counterbalance valve and cylinder with a mechanical port (plain or TLM) for external mechanics (thesis Fig. 2.8)",
+        version: "0.1.0",
+        start_time: 0.0,
+        stop_time: 15.0,
+        step_size: 1e-3,
+        default_tolerance: 1e-6,
+        log_categories: &[("logSolver", "Integrator statistics per communication step")],
+        can_interpolate_inputs: true,
+        documentation: DOCUMENTATION,
+    };
+    const VARIABLES: &'static [Variable] = &TABLE;
+
+    fn initialize(values: &Values) -> Result<Self, String> {
+        Self::with_state(values, None, 0.0, values.real(vr::START_F))
+    }
+
+    fn retune(&mut self, _values: &Values) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn outputs(&self, values: &mut Values) {
+        let mut sys = self.sys.clone();
+        sys.u_ref = values.real(vr::U_REF);
+        if sys.coupling == Coupling::Plain {
+            (sys.x0, sys.v) = (values.real(vr::X), Ramp { t0: self.t, y0: values.real(vr::V), slope: 0.0 });
+        }
+        let s = &self.state;
+        let (x, v) = sys.motion(self.t, s);
+        let (e, f_line) = sys.evaluate(self.t, s);
+        let c_h = match sys.coupling {
+            Coupling::Plain => f_line,
+            Coupling::Tlm { z_c } => f_line + z_c * v,
+        };
+        let stats = self.solver.stats();
+        let outputs = [
+            (vr::P1, s[circuit::P1]),
+            (vr::P2, s[circuit::P2]),
+            (vr::P3, s[circuit::P3]),
+            (vr::P4, s[circuit::P4]),
+            (vr::U, e.u),
+            (vr::U_CV, e.u_cv),
+            (vr::U_CBV, s[circuit::U_CBV]),
+            (vr::Q1, e.q[0]),
+            (vr::Q2, e.q[1]),
+            (vr::Q3, e.q[2]),
+            (vr::Q4, e.q[3]),
+            (vr::F, e.force),
+            (vr::F_FR, e.f_friction),
+            (vr::X_V, s[circuit::X_V]),
+            (vr::U_PCV, e.u_pcv),
+            (vr::P_X, e.p_x),
+            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
+            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
+            (vr::SOLVER_RHS, stats.rhs_evals as f64),
+            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
+            (vr::C_H, c_h),
+            (port::vr::F, f_line),
+            (vr::PORT_X, x),
+            (vr::PORT_V, v),
+        ];
+        for (r, x) in outputs {
+            values.set_real(r, x);
+        }
+    }
+
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        let fail = |time, message: String| StepError { time, message };
+        let sys = &mut self.sys;
+        sys.u_ref = values.real(vr::U_REF);
+        sys.x0 = values.real(vr::X);
+        sys.v = Ramp::read(values, input_derivatives, vr::V, t);
+        sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);
+        let atol = self.atol(tolerance);
+        self.solver
+            .set_rtol(tolerance)
+            .and_then(|_| self.solver.set_atol(&atol))
+            .map_err(|e| fail(t, e.to_string()))?;
+        let before = *self.solver.stats();
+        let result = self.solver.integrate(&self.sys, t, &mut self.state, t + h);
+        result.map_err(|e| fail(e.t, e.to_string()))?;
+        self.t = t + h;
+        parts::log_step(log, t + h, &before, self.solver.stats());
+        Ok(())
+    }
+
+    fn save(&self) -> Vec<f64> {
+        let mut v = vec![self.t, self.sys.c_m.at(self.t)];
+        v.extend_from_slice(&self.state);
+        v.extend_from_slice(&self.solver.save_state());
+        v
+    }
+
+    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
+        let n = saved.len().checked_sub(2 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+        let mut m = Self::with_state(values, Some(&saved[2..2 + n]), saved[0], saved[1])?;
+        let solver_state = saved[2 + n..].try_into().map_err(|_| "solver state length".to_string())?;
+        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        Ok(m)
+    }
+}
