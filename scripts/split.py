@@ -181,23 +181,24 @@ def rings_down(r: cosim.Result) -> tuple[bool, str]:
     return late < REST_PTP or late < 0.8 * mid, f"p3 swing {mid / 1e5:.3g} -> {late / 1e5:.3g} bar over the last 2 x 0.5 s"
 
 
-def stable(boom: str, coupling: str, step: float) -> tuple[bool, str]:
-    """(stable, why) for the LIFT scenario with `step`: the run completes within the stroke and
-    p3 rings down (`rings_down`)."""
+def stable(boom: str, coupling: str, step: float, alpha: float = 0.0) -> tuple[bool, str]:
+    """(stable, why) for the LIFT scenario with `step` and TLM wave damping `alpha`: the run
+    completes within the stroke and p3 rings down (`rings_down`)."""
+    sc = dict(LIFT, plant={"port.alpha": alpha})
     try:
-        return rings_down(run(LIFT, boom, coupling, step))
+        return rings_down(run(sc, boom, coupling, step))
     except Unstable as e:
         return False, str(e)
 
 
-def sweep(boom: str, couplings=COUPLINGS, steps=SWEEP_STEPS) -> dict:
+def sweep(boom: str, couplings=COUPLINGS, steps=SWEEP_STEPS, alpha: float = 0.0) -> dict:
     """{coupling: (largest stable step, {step: (stable, why)})}; the sweep of a coupling stops at
     its first unstable step."""
     out = {}
     for c in couplings:
         rows, largest = {}, None
         for h in steps:
-            rows[h] = stable(boom, c, h)
+            rows[h] = stable(boom, c, h, alpha)
             if not rows[h][0]:
                 break
             largest = h
@@ -236,11 +237,13 @@ def main(argv=None):
     ap.add_argument("--coupling", default="tlm", choices=COUPLINGS)
     ap.add_argument("--step", type=float, default=None)
     ap.add_argument("--sweep", action="store_true", help="largest stable step of each coupling")
+    ap.add_argument("--alpha", type=float, default=0.0, help="TLM wave damping port.alpha of the sweep")
     args = ap.parse_args(argv)
     sc = cosim.load_scenario(args.scenario)
     if args.sweep:
-        for c, (largest, rows) in sweep(args.boom).items():
-            print(f"{args.boom} {c:10s} largest stable step {largest}:",
+        couplings = COUPLINGS if args.alpha == 0 else ("tlm", "tlm-jacobi")
+        for c, (largest, rows) in sweep(args.boom, couplings, alpha=args.alpha).items():
+            print(f"{args.boom} alpha {args.alpha:g} {c:10s} largest stable step {largest}:",
                   "; ".join(f"{h * 1e3:g} ms {'stable' if ok else 'UNSTABLE'} ({why})" for h, (ok, why) in rows.items()),
                   flush=True)
         return

@@ -30,7 +30,7 @@ const STROKE_INDEX: usize = {
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 20] = [
+const OWN: [Variable; 21] = [
     Variable::real_input("cylinder.F", vr::F, 0.0, "N", "kN", FORCE_RANGE,
         "Plain port: force on the rod from the circuit, pushing it out (linear over a step with its derivative)"),
     out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
@@ -48,6 +48,7 @@ const OWN: [Variable; 20] = [
     TIP_DEFLECTION,
     port::COUPLING,
     Variable::param(vr::Z_C, port::Z_C).fixed(),
+    Variable::param(vr::ALPHA, port::ALPHA).fixed(),
     out("start.F", vr::START_F, "N", "kN",
         "Cylinder force that holds the boom at rest at start.x (set HydraulicCircuit's start.F to it)"),
     Variable::real_input("port.c_h", vr::C_H, 0.0, "N", "kN", FORCE_RANGE,
@@ -83,7 +84,7 @@ impl PortedBoom {
     pub fn force(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
         match self.coupling {
             Coupling::Plain => self.input.at(t),
-            Coupling::Tlm { z_c } => self.input.at(t) - z_c * self.boom.mechanics().stroke_rate(q, qd),
+            Coupling::Tlm { z_c, .. } => self.input.at(t) - z_c * self.boom.mechanics().stroke_rate(q, qd),
         }
     }
 }
@@ -109,12 +110,16 @@ pub struct BoomMechanics {
     /// Holding force at the start.
     f_start: f64,
     t: f64,
+    /// The wave emitted at `t` (TLM).
+    c_m: f64,
     state: Vec<f64>,
     solver: Radau5,
 }
 
 impl BoomMechanics {
-    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, input: f64) -> Result<Self, String> {
+    /// The model at time `t` with the port input `input`, the emitted wave `c_m` and the given
+    /// state (at rest at start.x if `None`).
+    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [input, c_m]: [f64; 2]) -> Result<Self, String> {
         let stroke = values.real(vr::HYDRAULICS + STROKE_INDEX as u32);
         let boom = Boom::from_values(values, stroke)?;
         let x0 = values.real(vr::X0);
@@ -134,7 +139,7 @@ impl BoomMechanics {
             Some(s) => return Err(format!("expected {} finite states, got {}", sys.dim(), s.len())),
         };
         let solver = Radau5::new(sys.dim());
-        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, state, solver })
+        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
     }
 
     /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
@@ -163,8 +168,9 @@ impl Model for BoomMechanics {
 
     /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).
     fn initialize(values: &Values) -> Result<Self, String> {
-        let mut m = Self::with_state(values, None, 0.0, 0.0)?;
+        let mut m = Self::with_state(values, None, 0.0, [0.0, 0.0])?;
         m.sys.input.y0 = if m.sys.coupling == Coupling::Plain { values.real(vr::F) } else { m.f_start };
+        m.c_m = m.f_start;
         Ok(m)
     }
 
@@ -181,10 +187,7 @@ impl Model for BoomMechanics {
         let (q, qd) = self.state.split_at(b.dof());
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
         let f = sys.force(self.t, q, qd);
-        let c_m = match sys.coupling {
-            Coupling::Plain => f,
-            Coupling::Tlm { z_c } => f - z_c * v,
-        };
+        let c_m = if sys.coupling == Coupling::Plain { f } else { self.c_m };
         let stats = self.solver.stats();
         let outputs = [
             (vr::X, x),
@@ -222,21 +225,24 @@ impl Model for BoomMechanics {
         let before = *self.solver.stats();
         self.solver.integrate(&self.sys, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
         self.t = t + h;
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        let v = self.sys.boom.mechanics().stroke_rate(q, qd);
+        self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, q, qd), -v);
         crate::models::parts::log_step(log, t + h, &before, self.solver.stats());
         Ok(())
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = vec![self.t, self.sys.input.at(self.t)];
+        let mut v = vec![self.t, self.sys.input.at(self.t), self.c_m];
         v.extend_from_slice(&self.state);
         v.extend_from_slice(&self.solver.save_state());
         v
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let n = saved.len().checked_sub(2 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
-        let mut m = Self::with_state(values, Some(&saved[2..2 + n]), saved[0], saved[1])?;
-        let solver_state = saved[2 + n..].try_into().map_err(|_| "solver state length".to_string())?;
+        let n = saved.len().checked_sub(3 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+        let mut m = Self::with_state(values, Some(&saved[3..3 + n]), saved[0], [saved[1], saved[2]])?;
+        let solver_state = saved[3 + n..].try_into().map_err(|_| "solver state length".to_string())?;
         m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
         Ok(m)
     }

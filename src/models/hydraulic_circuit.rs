@@ -38,21 +38,21 @@ const PORT_MASS: ParamSpec = ParamSpec {
     source: "cylinder.m_rod, 5 kg (thesis nomenclature); 0.04 % of the boom's 14 t effective mass",
 };
 
-/// Default: the rigid boom's holding force at the 480 mm start stroke (test in
-/// tests/coupling.rs against BoomMechanics' `start.F`).
+/// Default: the rigid boom's holding force at the 480 mm start stroke (23 751 N; test
+/// `start_force_default_holds_the_rigid_boom`).
 const START_FORCE: ParamSpec = ParamSpec {
     name: "start.F",
-    default: 23_100.0,
+    default: 23_750.0,
     unit: "N",
     display_unit: "kN",
     min: 0.0,
     max: 1e7,
     description: "Load on the rod at the start, held by the closed CBV (the mechanics' static force at start.x: BoomMechanics' start.F)",
-    source: "rigid boom of the thesis at start.x = 480 mm",
+    source: "rigid boom of the thesis at start.x = 480 mm (flexible: 23 819 N)",
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 33] = [
+const OWN: [Variable; 34] = [
     Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
         "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
     out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
@@ -83,6 +83,7 @@ const OWN: [Variable; 33] = [
     Variable::param(vr::X0, START_STROKE).fixed(),
     port::COUPLING,
     Variable::param(vr::Z_C, port::Z_C).fixed(),
+    Variable::param(vr::ALPHA, port::ALPHA).fixed(),
     Variable::param(vr::M, PORT_MASS).fixed(),
     Variable::param(vr::START_F, START_FORCE).fixed(),
     Variable::real_input("port.c_m", vr::C_M, START_FORCE.default, "N", "kN", FORCE_RANGE,
@@ -142,7 +143,7 @@ impl PortedCircuit {
         let e = self.circuit.evaluate(s[..N_CIRCUIT].try_into().expect("circuit slice"), self.u_ref, x, v);
         let f_line = match self.coupling {
             Coupling::Plain => e.force,
-            Coupling::Tlm { z_c } => self.c_m.at(t) + z_c * v,
+            Coupling::Tlm { z_c, .. } => self.c_m.at(t) + z_c * v,
         };
         (e, f_line)
     }
@@ -172,12 +173,16 @@ pub struct HydraulicCircuit {
     sys: PortedCircuit,
     /// Time of the state (the start of the next step).
     t: f64,
+    /// The wave emitted at `t` (TLM).
+    c_h: f64,
     state: Vec<f64>,
     solver: Radau5,
 }
 
 impl HydraulicCircuit {
-    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, c_m: f64) -> Result<Self, String> {
+    /// The model at time `t` with the received wave `c_m`, the emitted `c_h` and the given state
+    /// (the equilibrium holding start.F if `None`).
+    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [c_m, c_h]: [f64; 2]) -> Result<Self, String> {
         let circuit = parts::circuit_from_values(values)?;
         let x0 = values.real(vr::X0);
         let stroke = circuit.cylinder.stroke;
@@ -209,7 +214,7 @@ impl HydraulicCircuit {
             Some(s) => return Err(format!("expected {} finite states, got {}", sys.dim(), s.len())),
         };
         let solver = Radau5::new(sys.dim());
-        Ok(HydraulicCircuit { sys, t, state, solver })
+        Ok(HydraulicCircuit { sys, t, c_h, state, solver })
     }
 
     /// Absolute tolerances for `rtol`: the circuit's scales, 1 mm and 1 mm/s for the rod.
@@ -234,7 +239,8 @@ impl Model for HydraulicCircuit {
     const VARIABLES: &'static [Variable] = &TABLE;
 
     fn initialize(values: &Values) -> Result<Self, String> {
-        Self::with_state(values, None, 0.0, values.real(vr::START_F))
+        let f = values.real(vr::START_F);
+        Self::with_state(values, None, 0.0, [f, f])
     }
 
     fn retune(&mut self, _values: &Values) -> Result<(), String> {
@@ -250,10 +256,7 @@ impl Model for HydraulicCircuit {
         let s = &self.state;
         let (x, v) = sys.motion(self.t, s);
         let (e, f_line) = sys.evaluate(self.t, s);
-        let c_h = match sys.coupling {
-            Coupling::Plain => f_line,
-            Coupling::Tlm { z_c } => f_line + z_c * v,
-        };
+        let c_h = if sys.coupling == Coupling::Plain { f_line } else { self.c_h };
         let stats = self.solver.stats();
         let outputs = [
             (vr::P1, s[circuit::P1]),
@@ -310,22 +313,40 @@ impl Model for HydraulicCircuit {
         let result = self.solver.integrate(&self.sys, t, &mut self.state, t + h);
         result.map_err(|e| fail(e.t, e.to_string()))?;
         self.t = t + h;
+        let (_, v) = self.sys.motion(self.t, &self.state);
+        self.c_h = self.sys.coupling.emit(self.c_h, self.sys.evaluate(self.t, &self.state).1, v);
         parts::log_step(log, t + h, &before, self.solver.stats());
         Ok(())
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = vec![self.t, self.sys.c_m.at(self.t)];
+        let mut v = vec![self.t, self.sys.c_m.at(self.t), self.c_h];
         v.extend_from_slice(&self.state);
         v.extend_from_slice(&self.solver.save_state());
         v
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let n = saved.len().checked_sub(2 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
-        let mut m = Self::with_state(values, Some(&saved[2..2 + n]), saved[0], saved[1])?;
-        let solver_state = saved[2 + n..].try_into().map_err(|_| "solver state length".to_string())?;
+        let n = saved.len().checked_sub(3 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+        let mut m = Self::with_state(values, Some(&saved[3..3 + n]), saved[0], [saved[1], saved[2]])?;
+        let solver_state = saved[3 + n..].try_into().map_err(|_| "solver state length".to_string())?;
         m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
         Ok(m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::params::BoomParams;
+    use crate::mechanics::rigid_boom::RigidBoom;
+
+    /// start.F's default against the rigid boom's static cylinder force at the default start
+    /// stroke; 1 N: the default is rounded to 10 N.
+    #[test]
+    fn start_force_default_holds_the_rigid_boom() {
+        let stroke = Circuit::default().cylinder.stroke;
+        let f = RigidBoom::new(&BoomParams::default(), stroke).unwrap().static_force(START_STROKE.default);
+        assert!((f - START_FORCE.default).abs() < 10.0, "{f} N");
     }
 }
