@@ -5,7 +5,7 @@
 //! States: the boom's generalised coordinates and velocities (rigid: the stroke; flexible: the
 //! section angles). The boom carries the rod and piston (mass and weight), as in HydraulicBoom.
 
-use super::parts::{out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, START_STROKE, TIP_DEFLECTION};
+use super::parts::{self, out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION};
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::params::PARAMS;
@@ -23,14 +23,14 @@ pub mod vr {
 /// Index of `cylinder.stroke` in the circuit parameters: the boom's range of motion.
 const STROKE_INDEX: usize = {
     let mut k = 0;
-    while !crate::models::parts::str_eq(PARAMS[k].spec.name, "cylinder.stroke") {
+    while !parts::str_eq(PARAMS[k].spec.name, "cylinder.stroke") {
         k += 1;
     }
     k
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 21] = [
+const OWN: [Variable; 17] = [
     Variable::real_input("cylinder.F", vr::F, 0.0, "N", "kN", FORCE_RANGE,
         "Plain port: force on the rod from the circuit, pushing it out (linear over a step with its derivative)"),
     out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
@@ -39,10 +39,6 @@ const OWN: [Variable; 21] = [
     out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
     out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
     out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
-    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
-    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
-    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
-    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
     Variable::param(vr::X0, START_STROKE).fixed(),
     FLEXIBLE_SWITCH,
     TIP_DEFLECTION,
@@ -57,9 +53,9 @@ const OWN: [Variable; 21] = [
     port::PORT_F,
 ];
 
-const N_VARS: usize = OWN.len() + 1 + N_BOOM_ROWS;
+const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 1 + N_BOOM_ROWS;
 const TABLE: [Variable; N_VARS] =
-    TableBuilder::new(&OWN).sections().hydraulics(PARAMS, STROKE_INDEX, STROKE_INDEX + 1).boom_params().build();
+    TableBuilder::new(&OWN).vars(&SOLVER_LOCALS).sections().hydraulics(PARAMS, STROKE_INDEX, STROKE_INDEX + 1).boom_params().build();
 
 const DOCUMENTATION: &str = r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
 flexible (2.1.4, 3.1.2), with the same parameters, names and value references, the rod and piston included. It
@@ -129,15 +125,7 @@ impl BoomMechanics {
         let rest =
             boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
         let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input: Ramp { t0: t, y0: input, slope: 0.0 } };
-        let state = match state {
-            None => {
-                let mut s = rest.q.clone();
-                s.resize(sys.dim(), 0.0);
-                s
-            }
-            Some(s) if s.len() == sys.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
-            Some(s) => return Err(format!("expected {} finite states, got {}", sys.dim(), s.len())),
-        };
+        let state = parts::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
         let solver = Radau5::new(sys.dim());
         Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
     }
@@ -188,21 +176,10 @@ impl Model for BoomMechanics {
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
         let f = sys.force(self.t, q, qd);
         let c_m = if sys.coupling == Coupling::Plain { f } else { self.c_m };
-        let stats = self.solver.stats();
-        let outputs = [
-            (vr::X, x),
-            (vr::V, v),
-            (vr::START_F, self.f_start),
-            (vr::C_M, c_m),
-            (port::vr::F, f),
-            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
-            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
-            (vr::SOLVER_RHS, stats.rhs_evals as f64),
-            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
-        ];
-        for (r, x) in outputs {
-            values.set_real(r, x);
+        for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
+            values.set_real(r, y);
         }
+        parts::solver_outputs(self.solver.stats(), values);
         sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
 
@@ -215,35 +192,24 @@ impl Model for BoomMechanics {
         tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        let fail = |time, message: String| StepError { time, message };
         self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
         let atol: Vec<f64> = self.sys.boom.atol(tolerance).collect();
-        self.solver
-            .set_rtol(tolerance)
-            .and_then(|_| self.solver.set_atol(&atol))
-            .map_err(|e| fail(t, e.to_string()))?;
-        let before = *self.solver.stats();
-        self.solver.integrate(&self.sys, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
+        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, &atol, log)?;
         self.t = t + h;
         let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
         let v = self.sys.boom.mechanics().stroke_rate(q, qd);
         self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, q, qd), -v);
-        crate::models::parts::log_step(log, t + h, &before, self.solver.stats());
         Ok(())
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = vec![self.t, self.sys.input.at(self.t), self.c_m];
-        v.extend_from_slice(&self.state);
-        v.extend_from_slice(&self.solver.save_state());
-        v
+        parts::save(&[self.t, self.sys.input.at(self.t), self.c_m], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let n = saved.len().checked_sub(3 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
-        let mut m = Self::with_state(values, Some(&saved[3..3 + n]), saved[0], [saved[1], saved[2]])?;
-        let solver_state = saved[3 + n..].try_into().map_err(|_| "solver state length".to_string())?;
-        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        let (head, state, solver) = parts::split_saved(saved, 3)?;
+        let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)
     }
 }

@@ -7,7 +7,10 @@
 //! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
 //! angle of each section). The operator's reference `valve.u_ref` is held over each step.
 
-use super::parts::{self, out, TableBuilder, CIRCUIT_SCALE, FLEXIBLE_SWITCH, N_BOOM_ROWS, START_STROKE, TIP_DEFLECTION};
+use super::parts::{
+    self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS,
+    START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
+};
 pub use super::parts::Boom;
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
@@ -16,70 +19,30 @@ use crate::solver::{OdeSystem, Radau5};
 
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
-    pub const U_REF: u32 = 0;
-    pub const P1: u32 = 1;
-    pub const P2: u32 = 2;
-    pub const P3: u32 = 3;
-    pub const P4: u32 = 4;
-    pub const U: u32 = 5;
-    pub const U_CV: u32 = 6;
-    pub const U_CBV: u32 = 7;
-    pub const Q1: u32 = 8;
-    pub const Q2: u32 = 9;
-    pub const Q3: u32 = 10;
-    pub const Q4: u32 = 11;
-    pub const X: u32 = 12;
-    pub const V: u32 = 13;
-    pub const F: u32 = 14;
-    pub const F_FR: u32 = 15;
-    pub const THETA: u32 = 16;
-    pub const OMEGA: u32 = 17;
-    pub const PAYLOAD_X: u32 = 18;
-    pub const PAYLOAD_Y: u32 = 19;
-    pub const X_V: u32 = 20;
-    pub const U_PCV: u32 = 21;
-    pub const P_X: u32 = 22;
-    pub const SOLVER_STEPS: u32 = 23;
-    pub const SOLVER_REJECTED: u32 = 24;
-    pub const SOLVER_RHS: u32 = 25;
-    pub const SOLVER_JACOBIANS: u32 = 26;
     pub use crate::models::parts::vr::*;
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 30] = [
-    Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
-        "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
-    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
-    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV"),
-    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3)"),
-    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot)"),
-    out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
-    out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
-    out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
-    out("Q1", vr::Q1, "m3/s", "l/min", "PCV flow, supply to line 1 (eq. 2.50)"),
-    out("Q2", vr::Q2, "m3/s", "l/min", "DCV flow into line 2, P->A / A->T (eq. 2.40, 2.42)"),
-    out("Q3", vr::Q3, "m3/s", "l/min", "CBV flow, line 2 to line 3 (eq. 2.58, 2.59)"),
-    out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
-    out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
-    out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
-    out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops"),
-    out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity"),
-    out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
-    out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
-    out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
-    out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
-    Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
-    Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
-    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
-    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
-    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
-    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
-    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
-    Variable::param(vr::X0, START_STROKE).fixed(),
-    FLEXIBLE_SWITCH,
-    TIP_DEFLECTION,
-];
+const OWN: [Variable; 30] = TableBuilder::new(&[U_REF_INPUT])
+    .vars(&CIRCUIT_OUTPUTS)
+    .vars(&[
+        out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
+        out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
+        out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops"),
+        out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity"),
+        out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
+        out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
+        out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
+        out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
+    ])
+    .vars(&CIRCUIT_LOCALS)
+    .vars(&SOLVER_LOCALS)
+    .vars(&[
+        Variable::param(vr::X0, START_STROKE).fixed(),
+        FLEXIBLE_SWITCH,
+        TIP_DEFLECTION,
+    ])
+    .build();
 
 const N_VARS: usize = OWN.len() + PARAMS.len() + N_BOOM_ROWS;
 
@@ -176,11 +139,7 @@ impl HydraulicBoom {
     /// The model with the plant of `values` and the given state (the equilibrium if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
         let plant = Plant::from_values(values)?;
-        let state = match state {
-            None => plant.equilibrium(values.real(vr::X0))?,
-            Some(s) if s.len() == plant.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
-            Some(s) => return Err(format!("expected {} finite states, got {}", plant.dim(), s.len())),
-        };
+        let state = parts::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0)))?;
         let solver = Radau5::new(plant.dim());
         Ok(HydraulicBoom { plant, state, solver })
     }
@@ -217,33 +176,10 @@ impl Model for HydraulicBoom {
         let (q, qd) = boom.split_at(b.dof());
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
         let e = self.plant.circuit.evaluate(c.try_into().expect("circuit slice"), values.real(vr::U_REF), x, v);
-        let stats = self.solver.stats();
-        let outputs = [
-            (vr::P1, c[circuit::P1]),
-            (vr::P2, c[circuit::P2]),
-            (vr::P3, c[circuit::P3]),
-            (vr::P4, c[circuit::P4]),
-            (vr::U, e.u),
-            (vr::U_CV, e.u_cv),
-            (vr::U_CBV, c[circuit::U_CBV]),
-            (vr::Q1, e.q[0]),
-            (vr::Q2, e.q[1]),
-            (vr::Q3, e.q[2]),
-            (vr::Q4, e.q[3]),
-            (vr::X, x),
-            (vr::V, v),
-            (vr::F, e.force),
-            (vr::F_FR, e.f_friction),
-            (vr::X_V, c[circuit::X_V]),
-            (vr::U_PCV, e.u_pcv),
-            (vr::P_X, e.p_x),
-            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
-            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
-            (vr::SOLVER_RHS, stats.rhs_evals as f64),
-            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
-        ];
-        for (r, x) in outputs {
-            values.set_real(r, x);
+        parts::circuit_outputs(c.try_into().expect("circuit slice"), &e, values);
+        parts::solver_outputs(self.solver.stats(), values);
+        for (r, y) in [(vr::X, x), (vr::V, v)] {
+            values.set_real(r, y);
         }
         self.plant.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
@@ -257,30 +193,19 @@ impl Model for HydraulicBoom {
         tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        let fail = |time, message: String| StepError { time, message };
         self.plant.u_ref = values.real(vr::U_REF);
         let atol = self.plant.atol(tolerance);
-        self.solver
-            .set_rtol(tolerance)
-            .and_then(|_| self.solver.set_atol(&atol))
-            .map_err(|e| fail(t, e.to_string()))?;
-        let before = *self.solver.stats();
-        self.solver.integrate(&self.plant, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
-        parts::log_step(log, t + h, &before, self.solver.stats());
-        Ok(())
+        parts::advance(&mut self.solver, &self.plant, &mut self.state, t, h, tolerance, &atol, log)
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = self.state.clone();
-        v.extend_from_slice(&self.solver.save_state());
-        v
+        parts::save(&[], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let n = saved.len().checked_sub(Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
-        let mut m = Self::with_state(values, Some(&saved[..n]))?;
-        let solver_state = saved[n..].try_into().map_err(|_| "solver state length".to_string())?;
-        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        let (_, state, solver) = parts::split_saved(saved, 0)?;
+        let mut m = Self::with_state(values, Some(state))?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)
     }
 }

@@ -7,7 +7,9 @@
 //! step, x(t) = x_k + integral of v, v(t) = v_k + v' (t - t_k) (v' from
 //! fmi2SetRealInputDerivatives, 0 holds v), so chamber volumes and piston flows agree.
 
-use super::parts::{self, out, TableBuilder, CIRCUIT_SCALE, START_STROKE};
+use super::parts::{
+    self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, SOLVER_LOCALS, START_STROKE, U_REF_INPUT,
+};
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
@@ -52,47 +54,34 @@ const START_FORCE: ParamSpec = ParamSpec {
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 34] = [
-    Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
-        "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
-    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
-    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV"),
-    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3)"),
-    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot)"),
-    out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
-    out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
-    out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
-    out("Q1", vr::Q1, "m3/s", "l/min", "PCV flow, supply to line 1 (eq. 2.50)"),
-    out("Q2", vr::Q2, "m3/s", "l/min", "DCV flow into line 2, P->A / A->T (eq. 2.40, 2.42)"),
-    out("Q3", vr::Q3, "m3/s", "l/min", "CBV flow, line 2 to line 3 (eq. 2.58, 2.59)"),
-    out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
-    Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),
-        "Plain port: cylinder stroke from the mechanics (at the step start)"),
-    Variable::real_input("cylinder.v", vr::V, 0.0, "m/s", "mm/s", (-10.0, 10.0),
-        "Plain port: cylinder velocity from the mechanics, > 0 extending (linear over a step with its derivative)"),
-    out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops (at port.x, port.v)")
-        .depends(&[vr::X, vr::V]),
-    out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity").depends(&[vr::X, vr::V]),
-    Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
-    Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
-    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
-    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
-    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
-    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
-    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
-    Variable::param(vr::X0, START_STROKE).fixed(),
-    port::COUPLING,
-    Variable::param(vr::Z_C, port::Z_C).fixed(),
-    Variable::param(vr::ALPHA, port::ALPHA).fixed(),
-    Variable::param(vr::M, PORT_MASS).fixed(),
-    Variable::param(vr::START_F, START_FORCE).fixed(),
-    Variable::real_input("port.c_m", vr::C_M, START_FORCE.default, "N", "kN", FORCE_RANGE,
-        "TLM port: wave from the mechanics, c_m = F_M - Z_c v_M (linear over a step with its derivative)"),
-    out("port.c_h", vr::C_H, "N", "kN", "TLM port: wave to the mechanics, c_h = F_H + Z_c v_H at the step end"),
-    port::PORT_F,
-    out("port.x", vr::PORT_X, "m", "mm", "Stroke the circuit uses: cylinder.x ramped with cylinder.v (plain), the rod's (TLM)"),
-    out("port.v", vr::PORT_V, "m/s", "mm/s", "Velocity the circuit uses: cylinder.v (plain), the rod's (TLM)"),
-];
+const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
+    .vars(&CIRCUIT_OUTPUTS)
+    .vars(&[
+        Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),
+            "Plain port: cylinder stroke from the mechanics (at the step start)"),
+        Variable::real_input("cylinder.v", vr::V, 0.0, "m/s", "mm/s", (-10.0, 10.0),
+            "Plain port: cylinder velocity from the mechanics, > 0 extending (linear over a step with its derivative)"),
+        out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops (at port.x, port.v)")
+            .depends(&[vr::X, vr::V]),
+        out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity").depends(&[vr::X, vr::V]),
+    ])
+    .vars(&CIRCUIT_LOCALS)
+    .vars(&SOLVER_LOCALS)
+    .vars(&[
+        Variable::param(vr::X0, START_STROKE).fixed(),
+        port::COUPLING,
+        Variable::param(vr::Z_C, port::Z_C).fixed(),
+        Variable::param(vr::ALPHA, port::ALPHA).fixed(),
+        Variable::param(vr::M, PORT_MASS).fixed(),
+        Variable::param(vr::START_F, START_FORCE).fixed(),
+        Variable::real_input("port.c_m", vr::C_M, START_FORCE.default, "N", "kN", FORCE_RANGE,
+            "TLM port: wave from the mechanics, c_m = F_M - Z_c v_M (linear over a step with its derivative)"),
+        out("port.c_h", vr::C_H, "N", "kN", "TLM port: wave to the mechanics, c_h = F_H + Z_c v_H at the step end"),
+        port::PORT_F,
+        out("port.x", vr::PORT_X, "m", "mm", "Stroke the circuit uses: cylinder.x ramped with cylinder.v (plain), the rod's (TLM)"),
+        out("port.v", vr::PORT_V, "m/s", "mm/s", "Velocity the circuit uses: cylinder.v (plain), the rod's (TLM)"),
+    ])
+    .build();
 
 const N_VARS: usize = OWN.len() + PARAMS.len();
 const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN).hydraulics(PARAMS, 0, PARAMS.len()).build();
@@ -195,24 +184,17 @@ impl HydraulicCircuit {
             v: Ramp { t0: t, y0: values.real(vr::V), slope: 0.0 },
             c_m: Ramp { t0: t, y0: c_m, slope: 0.0 },
         };
-        let state = match state {
-            None => {
-                if !(0.0..=stroke).contains(&x0) {
-                    return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
-                }
-                let f = values.real(vr::START_F);
-                let c = sys.circuit.equilibrium(f).map_err(|e| {
-                    format!("no static equilibrium with start.F = {f:.0} N (payload on the CBV, cbv.p_set): {e}")
-                })?;
-                let mut s = c.to_vec();
-                if sys.dim() > N_CIRCUIT {
-                    s.extend([x0, 0.0]);
-                }
-                s
+        let state = parts::checked_state(sys.dim(), state, || {
+            if !(0.0..=stroke).contains(&x0) {
+                return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
             }
-            Some(s) if s.len() == sys.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
-            Some(s) => return Err(format!("expected {} finite states, got {}", sys.dim(), s.len())),
-        };
+            let f = values.real(vr::START_F);
+            let c = sys.circuit.equilibrium(f).map_err(|e| {
+                format!("no static equilibrium with start.F = {f:.0} N (payload on the CBV, cbv.p_set): {e}")
+            })?;
+            let rod = if sys.dim() > N_CIRCUIT { vec![x0, 0.0] } else { vec![] };
+            Ok([&c[..], &rod].concat())
+        })?;
         let solver = Radau5::new(sys.dim());
         Ok(HydraulicCircuit { sys, t, c_h, state, solver })
     }
@@ -257,35 +239,10 @@ impl Model for HydraulicCircuit {
         let (x, v) = sys.motion(self.t, s);
         let (e, f_line) = sys.evaluate(self.t, s);
         let c_h = if sys.coupling == Coupling::Plain { f_line } else { self.c_h };
-        let stats = self.solver.stats();
-        let outputs = [
-            (vr::P1, s[circuit::P1]),
-            (vr::P2, s[circuit::P2]),
-            (vr::P3, s[circuit::P3]),
-            (vr::P4, s[circuit::P4]),
-            (vr::U, e.u),
-            (vr::U_CV, e.u_cv),
-            (vr::U_CBV, s[circuit::U_CBV]),
-            (vr::Q1, e.q[0]),
-            (vr::Q2, e.q[1]),
-            (vr::Q3, e.q[2]),
-            (vr::Q4, e.q[3]),
-            (vr::F, e.force),
-            (vr::F_FR, e.f_friction),
-            (vr::X_V, s[circuit::X_V]),
-            (vr::U_PCV, e.u_pcv),
-            (vr::P_X, e.p_x),
-            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
-            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
-            (vr::SOLVER_RHS, stats.rhs_evals as f64),
-            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
-            (vr::C_H, c_h),
-            (port::vr::F, f_line),
-            (vr::PORT_X, x),
-            (vr::PORT_V, v),
-        ];
-        for (r, x) in outputs {
-            values.set_real(r, x);
+        parts::circuit_outputs(s[..N_CIRCUIT].try_into().expect("circuit slice"), &e, values);
+        parts::solver_outputs(self.solver.stats(), values);
+        for (r, y) in [(vr::C_H, c_h), (port::vr::F, f_line), (vr::PORT_X, x), (vr::PORT_V, v)] {
+            values.set_real(r, y);
         }
     }
 
@@ -298,39 +255,27 @@ impl Model for HydraulicCircuit {
         tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        let fail = |time, message: String| StepError { time, message };
         let sys = &mut self.sys;
         sys.u_ref = values.real(vr::U_REF);
         sys.x0 = values.real(vr::X);
         sys.v = Ramp::read(values, input_derivatives, vr::V, t);
         sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);
         let atol = self.atol(tolerance);
-        self.solver
-            .set_rtol(tolerance)
-            .and_then(|_| self.solver.set_atol(&atol))
-            .map_err(|e| fail(t, e.to_string()))?;
-        let before = *self.solver.stats();
-        let result = self.solver.integrate(&self.sys, t, &mut self.state, t + h);
-        result.map_err(|e| fail(e.t, e.to_string()))?;
+        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, &atol, log)?;
         self.t = t + h;
         let (_, v) = self.sys.motion(self.t, &self.state);
         self.c_h = self.sys.coupling.emit(self.c_h, self.sys.evaluate(self.t, &self.state).1, v);
-        parts::log_step(log, t + h, &before, self.solver.stats());
         Ok(())
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = vec![self.t, self.sys.c_m.at(self.t), self.c_h];
-        v.extend_from_slice(&self.state);
-        v.extend_from_slice(&self.solver.save_state());
-        v
+        parts::save(&[self.t, self.sys.c_m.at(self.t), self.c_h], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let n = saved.len().checked_sub(3 + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
-        let mut m = Self::with_state(values, Some(&saved[3..3 + n]), saved[0], [saved[1], saved[2]])?;
-        let solver_state = saved[3 + n..].try_into().map_err(|_| "solver state length".to_string())?;
-        m.solver.load_state(solver_state).map_err(|e| e.to_string())?;
+        let (head, state, solver) = parts::split_saved(saved, 3)?;
+        let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)
     }
 }

@@ -2,18 +2,45 @@
 //! tables (the physical parameters with the same names and value references in every model), the
 //! circuit and boom built from parameter values, the boom's outputs and the tolerance scales.
 
-use crate::fmi2::{Log, Values, Variable};
-use crate::hydraulics::circuit::{Circuit, N_STATES as N_CIRCUIT};
+use crate::fmi2::{Log, StepError, Values, Variable};
+use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::Param;
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
 use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
 use crate::mechanics::rigid_boom::RigidBoom;
 use crate::mechanics::BoomMechanics;
 use crate::params::ParamSpec;
-use crate::solver::SolverStats;
+use crate::solver::{OdeSystem, Radau5, SolverStats};
 
 /// Value references shared by every model that has the variable (stable: append, never renumber).
 pub mod vr {
+    pub const U_REF: u32 = 0;
+    pub const P1: u32 = 1;
+    pub const P2: u32 = 2;
+    pub const P3: u32 = 3;
+    pub const P4: u32 = 4;
+    pub const U: u32 = 5;
+    pub const U_CV: u32 = 6;
+    pub const U_CBV: u32 = 7;
+    pub const Q1: u32 = 8;
+    pub const Q2: u32 = 9;
+    pub const Q3: u32 = 10;
+    pub const Q4: u32 = 11;
+    pub const X: u32 = 12;
+    pub const V: u32 = 13;
+    pub const F: u32 = 14;
+    pub const F_FR: u32 = 15;
+    pub const THETA: u32 = 16;
+    pub const OMEGA: u32 = 17;
+    pub const PAYLOAD_X: u32 = 18;
+    pub const PAYLOAD_Y: u32 = 19;
+    pub const X_V: u32 = 20;
+    pub const U_PCV: u32 = 21;
+    pub const P_X: u32 = 22;
+    pub const SOLVER_STEPS: u32 = 23;
+    pub const SOLVER_REJECTED: u32 = 24;
+    pub const SOLVER_RHS: u32 = 25;
+    pub const SOLVER_JACOBIANS: u32 = 26;
     pub const X0: u32 = 30;
     pub const FLEXIBLE: u32 = 31;
     pub const TIP_DEFLECTION: u32 = 40;
@@ -31,6 +58,43 @@ pub mod vr {
 pub(crate) const fn out(name: &'static str, r: u32, unit: &'static str, display: &'static str, d: &'static str) -> Variable {
     Variable::real_output(name, r, unit, display, d)
 }
+
+/// `valve.u_ref`, the operator's spool reference.
+pub(crate) const U_REF_INPUT: Variable = Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
+        "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV");
+
+/// The circuit's outputs p1..Q4 (value references 1-11).
+#[rustfmt::skip]
+pub(crate) const CIRCUIT_OUTPUTS: [Variable; 11] = [
+    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
+    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV"),
+    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3)"),
+    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot)"),
+    out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
+    out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
+    out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
+    out("Q1", vr::Q1, "m3/s", "l/min", "PCV flow, supply to line 1 (eq. 2.50)"),
+    out("Q2", vr::Q2, "m3/s", "l/min", "DCV flow into line 2, P->A / A->T (eq. 2.40, 2.42)"),
+    out("Q3", vr::Q3, "m3/s", "l/min", "CBV flow, line 2 to line 3 (eq. 2.58, 2.59)"),
+    out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
+];
+
+/// The circuit's locals: spool position, compensator opening, load-sensing pressure.
+#[rustfmt::skip]
+pub(crate) const CIRCUIT_LOCALS: [Variable; 3] = [
+    Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
+    Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
+    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
+];
+
+/// The integrator's counters.
+#[rustfmt::skip]
+pub(crate) const SOLVER_LOCALS: [Variable; 4] = [
+    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
+    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
+    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
+    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
+];
 
 pub(crate) const START_STROKE: ParamSpec = ParamSpec {
     name: "start.x",
@@ -303,8 +367,92 @@ impl Boom {
 /// 1 mm of spool travel, full valve opening.
 pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
 
+/// Writes the circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
+/// load-sensing pressure) for state `c` and its evaluation `e`.
+pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values) {
+    let outputs = [
+        (vr::P1, c[circuit::P1]),
+        (vr::P2, c[circuit::P2]),
+        (vr::P3, c[circuit::P3]),
+        (vr::P4, c[circuit::P4]),
+        (vr::U, e.u),
+        (vr::U_CV, e.u_cv),
+        (vr::U_CBV, c[circuit::U_CBV]),
+        (vr::Q1, e.q[0]),
+        (vr::Q2, e.q[1]),
+        (vr::Q3, e.q[2]),
+        (vr::Q4, e.q[3]),
+        (vr::F, e.force),
+        (vr::F_FR, e.f_friction),
+        (vr::X_V, c[circuit::X_V]),
+        (vr::U_PCV, e.u_pcv),
+        (vr::P_X, e.p_x),
+    ];
+    for (r, x) in outputs {
+        values.set_real(r, x);
+    }
+}
+
+/// Writes the integrator's counters.
+pub(crate) fn solver_outputs(stats: &SolverStats, values: &mut Values) {
+    values.set_real(vr::SOLVER_STEPS, stats.accepted_steps as f64);
+    values.set_real(vr::SOLVER_REJECTED, stats.rejected_steps as f64);
+    values.set_real(vr::SOLVER_RHS, stats.rhs_evals as f64);
+    values.set_real(vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64);
+}
+
+/// `state` if given and `dim` finite numbers, else `start()`.
+pub(crate) fn checked_state(
+    dim: usize,
+    state: Option<&[f64]>,
+    start: impl FnOnce() -> Result<Vec<f64>, String>,
+) -> Result<Vec<f64>, String> {
+    match state {
+        None => start(),
+        Some(s) if s.len() == dim && s.iter().all(|x| x.is_finite()) => Ok(s.to_vec()),
+        Some(s) => Err(format!("expected {dim} finite states, got {}", s.len())),
+    }
+}
+
+/// Advances `state` of `sys` from `t` to `t + h` with relative tolerance `rtol` and absolute
+/// tolerances `atol`, logging the integrator statistics of the step.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn advance<S: OdeSystem>(
+    solver: &mut Radau5,
+    sys: &S,
+    state: &mut [f64],
+    t: f64,
+    h: f64,
+    rtol: f64,
+    atol: &[f64],
+    log: &mut dyn Log,
+) -> Result<(), StepError> {
+    let fail = |time, message: String| StepError { time, message };
+    solver.set_rtol(rtol).and_then(|_| solver.set_atol(atol)).map_err(|e| fail(t, e.to_string()))?;
+    let before = *solver.stats();
+    solver.integrate(sys, t, state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
+    log_step(log, t + h, &before, solver.stats());
+    Ok(())
+}
+
+/// A saved model: `head` (time, port values), the state, the integrator's state.
+pub(crate) fn save(head: &[f64], state: &[f64], solver: &Radau5) -> Vec<f64> {
+    [head, state, &solver.save_state()].concat()
+}
+
+/// A saved model's parts: head, state, integrator state.
+type Saved<'a> = (&'a [f64], &'a [f64], &'a [f64; Radau5::STATE_LEN]);
+
+/// The parts of a model saved by [`save`] with `n_head` leading numbers.
+pub(crate) fn split_saved(saved: &[f64], n_head: usize) -> Result<Saved<'_>, String> {
+    let n = saved.len().checked_sub(n_head + Radau5::STATE_LEN).ok_or("the saved model state is too short")?;
+    let (head, rest) = saved.split_at(n_head);
+    let (state, solver) = rest.split_at(n);
+    Ok((head, state, solver.try_into().map_err(|_| "solver state length".to_string())?))
+}
+
 /// Logs the integrator statistics of the step that ended at `t` (category `logSolver`).
-pub(crate) fn log_step(log: &mut dyn Log, t: f64, before: &SolverStats, after: &SolverStats) {
+fn log_step(log: &mut dyn Log, t: f64, before: &SolverStats, after: &SolverStats) {
     log.info(
         "logSolver",
         &format!(
