@@ -11,13 +11,11 @@ use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::params::PARAMS;
 use crate::solver::{OdeSystem, Radau5};
 
-/// Value references: those of HydraulicBoom for the same names, the port's from [`port::vr`].
+/// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
+/// ([`port::vr`]; its `F` is `port.F`).
 pub mod vr {
-    pub use crate::models::hydraulic_boom::vr::{
-        BEAM, BOOM, F, FLEXIBLE, HYDRAULICS, OMEGA, PAYLOAD_X, PAYLOAD_Y, SECTIONS, SOLVER_JACOBIANS,
-        SOLVER_REJECTED, SOLVER_RHS, SOLVER_STEPS, THETA, TIP_DEFLECTION, V, X, X0,
-    };
-    pub use crate::models::port::vr::*;
+    pub use crate::models::parts::vr::*;
+    pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, START_F, Z_C};
 }
 
 /// Index of `cylinder.stroke` in the circuit parameters: the boom's range of motion.

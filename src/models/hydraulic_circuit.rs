@@ -17,13 +17,11 @@ use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
 use crate::solver::{OdeSystem, Radau5};
 
-/// Value references: those of HydraulicBoom for the same names, the port's from [`port::vr`].
+/// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
+/// ([`port::vr`]; its `F` is `port.F`).
 pub mod vr {
-    pub use crate::models::hydraulic_boom::vr::{
-        P1, P2, P3, P4, P_X, Q1, Q2, Q3, Q4, SOLVER_JACOBIANS, SOLVER_REJECTED, SOLVER_RHS, SOLVER_STEPS, U, U_CBV,
-        U_CV, U_PCV, U_REF, X, X0, X_V, HYDRAULICS, F, F_FR, V,
-    };
-    pub use crate::models::port::vr::*;
+    pub use crate::models::parts::vr::*;
+    pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, M, START_F, Z_C};
     /// Stroke and velocity the circuit uses (the plain inputs, or the TLM rod's states).
     pub const PORT_X: u32 = 87;
     pub const PORT_V: u32 = 88;
@@ -37,7 +35,7 @@ const PORT_MASS: ParamSpec = ParamSpec {
     min: 1e-3,
     max: 1e5,
     description: "TLM port: mass the circuit integrates at the rod (rod + piston); the mechanics keeps its own",
-    source: "cylinder.m_rod, 5 kg (thesis nomenclature); 0.04 % of the boom's 14 t effective mass",
+    source: "cylinder.m_rod, 5 kg (thesis nomenclature); 0.03 % of the rigid boom's 16.9 t effective mass at 480 mm",
 };
 
 /// Default: the rigid boom's holding force at the 480 mm start stroke (23 751 N; test
