@@ -7,240 +7,49 @@
 //! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
 //! angle of each section). The operator's reference `valve.u_ref` is held over each step.
 
+pub use super::parts::Boom;
+use super::parts::{
+    self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, FLEXIBLE_SWITCH, N_BOOM_ROWS,
+    SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
+};
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
-use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
-use crate::mechanics::rigid_boom::RigidBoom;
-use crate::mechanics::BoomMechanics;
-use crate::params::ParamSpec;
 use crate::solver::{OdeSystem, Radau5};
 
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
-    pub const U_REF: u32 = 0;
-    pub const P1: u32 = 1;
-    pub const P2: u32 = 2;
-    pub const P3: u32 = 3;
-    pub const P4: u32 = 4;
-    pub const U: u32 = 5;
-    pub const U_CV: u32 = 6;
-    pub const U_CBV: u32 = 7;
-    pub const Q1: u32 = 8;
-    pub const Q2: u32 = 9;
-    pub const Q3: u32 = 10;
-    pub const Q4: u32 = 11;
-    pub const X: u32 = 12;
-    pub const V: u32 = 13;
-    pub const F: u32 = 14;
-    pub const F_FR: u32 = 15;
-    pub const THETA: u32 = 16;
-    pub const OMEGA: u32 = 17;
-    pub const PAYLOAD_X: u32 = 18;
-    pub const PAYLOAD_Y: u32 = 19;
-    pub const X_V: u32 = 20;
-    pub const U_PCV: u32 = 21;
-    pub const P_X: u32 = 22;
-    pub const SOLVER_STEPS: u32 = 23;
-    pub const SOLVER_REJECTED: u32 = 24;
-    pub const SOLVER_RHS: u32 = 25;
-    pub const SOLVER_JACOBIANS: u32 = 26;
-    pub const X0: u32 = 30;
-    pub const FLEXIBLE: u32 = 31;
-    pub const TIP_DEFLECTION: u32 = 40;
-    /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
-    pub const SECTIONS: u32 = 41;
-    /// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
-    pub const HYDRAULICS: u32 = 100;
-    /// Boom parameters: `BOOM + index` in [`crate::mechanics::params::SPECS`].
-    pub const BOOM: u32 = 200;
-    /// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_SPECS`].
-    pub const BEAM: u32 = 250;
-}
-
-const START_STROKE: ParamSpec = ParamSpec {
-    name: "start.x",
-    default: 0.480,
-    unit: "m",
-    display_unit: "mm",
-    min: 0.0,
-    max: 10.0,
-    description: "Initial stroke; the load starts at rest, held by the closed CBV, pressures in equilibrium",
-    source: "Start stroke of the experiments, 480 mm (sections 6.2, chapter 7)",
-};
-
-const fn out(name: &'static str, r: u32, unit: &'static str, display: &'static str, d: &'static str) -> Variable {
-    Variable::real_output(name, r, unit, display, d)
+    pub use crate::models::parts::vr::*;
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 30] = [
-    Variable::real_input("valve.u_ref", vr::U_REF, 0.0, "1", "%", (-1.0, 1.0),
-        "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV"),
-    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
-    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV"),
-    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3)"),
-    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot)"),
-    out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
-    out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
-    out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
-    out("Q1", vr::Q1, "m3/s", "l/min", "PCV flow, supply to line 1 (eq. 2.50)"),
-    out("Q2", vr::Q2, "m3/s", "l/min", "DCV flow into line 2, P->A / A->T (eq. 2.40, 2.42)"),
-    out("Q3", vr::Q3, "m3/s", "l/min", "CBV flow, line 2 to line 3 (eq. 2.58, 2.59)"),
-    out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
-    out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
-    out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
-    out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops"),
-    out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity"),
-    out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
-    out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
-    out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
-    out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
-    Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
-    Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
-    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
-    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
-    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
-    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
-    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
-    Variable::param(vr::X0, START_STROKE).fixed(),
-    Variable::bool_param("boom.flexible", vr::FLEXIBLE, true,
-        "Lumped flexible arm (boom.n2 + boom.n3 sections, eq. 2.34-2.39); false: rigid boom").fixed(),
-    out("boom.tip_deflection", vr::TIP_DEFLECTION, "m", "mm",
-        "Deflection of the arm's end normal to the rigid boom line at the same cylinder length, > 0 up (0 when rigid)"),
-];
+const OWN: [Variable; 30] = TableBuilder::new(&[U_REF_INPUT])
+    .vars(&CIRCUIT_OUTPUTS)
+    .vars(&[
+        out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
+        out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
+        out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops"),
+        out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity"),
+        out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
+        out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
+        out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
+        out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
+    ])
+    .vars(&CIRCUIT_LOCALS)
+    .vars(&SOLVER_LOCALS)
+    .vars(&[
+        Variable::param(vr::X0, START_STROKE).fixed(),
+        FLEXIBLE_SWITCH,
+        TIP_DEFLECTION,
+    ])
+    .build();
 
-/// Names of the section-angle outputs (structured names, 1-based as in the thesis).
-const SECTION_NAMES: [&str; MAX_SECTIONS] = [
-    "boom.section[1].phi",
-    "boom.section[2].phi",
-    "boom.section[3].phi",
-    "boom.section[4].phi",
-    "boom.section[5].phi",
-    "boom.section[6].phi",
-    "boom.section[7].phi",
-    "boom.section[8].phi",
-    "boom.section[9].phi",
-    "boom.section[10].phi",
-    "boom.section[11].phi",
-    "boom.section[12].phi",
-    "boom.section[13].phi",
-    "boom.section[14].phi",
-    "boom.section[15].phi",
-    "boom.section[16].phi",
-    "boom.section[17].phi",
-    "boom.section[18].phi",
-    "boom.section[19].phi",
-    "boom.section[20].phi",
-    "boom.section[21].phi",
-    "boom.section[22].phi",
-    "boom.section[23].phi",
-    "boom.section[24].phi",
-    "boom.section[25].phi",
-    "boom.section[26].phi",
-    "boom.section[27].phi",
-    "boom.section[28].phi",
-    "boom.section[29].phi",
-    "boom.section[30].phi",
-    "boom.section[31].phi",
-    "boom.section[32].phi",
-];
-
-const N_VARS: usize = OWN.len() + MAX_SECTIONS + PARAMS.len() + BOOM_SPECS.len() + BEAM_SPECS.len();
-
-/// Parameters that count or select (a model index, section counts): exposed as Integers.
-const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
-
-const fn str_eq(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
-
-const fn is_selector(name: &str) -> bool {
-    let mut i = 0;
-    while i < SELECTORS.len() {
-        if str_eq(name, SELECTORS[i]) {
-            return true;
-        }
-        i += 1;
-    }
-    false
-}
-
-/// The FMU variable of a physical parameter: fixed, an Integer where it counts or selects.
-const fn param(r: u32, p: ParamSpec) -> Variable {
-    if is_selector(p.name) {
-        Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
-    } else {
-        Variable::param(r, p).fixed()
-    }
-}
-
-/// The value of parameter `p` with value reference `r`, as a number.
-fn param_value(values: &Values, r: u32, p: &ParamSpec) -> f64 {
-    if is_selector(p.name) {
-        values.integer(r) as f64
-    } else {
-        values.real(r)
-    }
-}
+const N_VARS: usize = OWN.len() + PARAMS.len() + N_BOOM_ROWS;
 
 /// The table: own variables, the section angles, then every hydraulic, boom and beam parameter
 /// (fixed: set them before initialisation ends).
-const TABLE: [Variable; N_VARS] = {
-    let mut t = [OWN[0]; N_VARS];
-    let mut n = 0;
-    while n < OWN.len() {
-        t[n] = OWN[n];
-        n += 1;
-    }
-    let mut k = 0;
-    while k < MAX_SECTIONS {
-        t[n] = out(
-            SECTION_NAMES[k],
-            vr::SECTIONS + k as u32,
-            "rad",
-            "deg",
-            "Absolute angle of the arm section (from the joint outwards); beyond the last section, the last one's",
-        );
-        (n, k) = (n + 1, k + 1);
-    }
-    let mut k = 0;
-    while k < PARAMS.len() {
-        t[n] = param(vr::HYDRAULICS + k as u32, PARAMS[k].spec);
-        (n, k) = (n + 1, k + 1);
-    }
-    let mut k = 0;
-    while k < BOOM_SPECS.len() {
-        t[n] = param(vr::BOOM + k as u32, BOOM_SPECS[k]);
-        (n, k) = (n + 1, k + 1);
-    }
-    let mut k = 0;
-    while k < BEAM_SPECS.len() {
-        t[n] = param(vr::BEAM + k as u32, BEAM_SPECS[k]);
-        (n, k) = (n + 1, k + 1);
-    }
-    t
-};
-
-/// Scales of the circuit states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar,
-/// 1 mm of spool travel, full valve opening.
-const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
-/// Scales of the boom coordinates and velocities: 1 mm and 1 mm/s of stroke (rigid); 0.1 mrad
-/// and 1 mrad/s of section angle (flexible: deflection angles are ~1 mrad).
-const RIGID_SCALE: (f64, f64) = (1e-3, 1e-3);
-const FLEXIBLE_SCALE: (f64, f64) = (1e-4, 1e-3);
+const TABLE: [Variable; N_VARS] =
+    TableBuilder::new(&OWN).sections().hydraulics(PARAMS, 0, PARAMS.len()).boom_params().build();
 
 const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
 PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48), counterbalance valve with check valve and
@@ -251,23 +60,6 @@ volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving th
 <p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
 spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>"#;
-
-/// The boom the circuit drives.
-#[derive(Debug, Clone)]
-pub enum Boom {
-    Rigid(RigidBoom),
-    Flexible(FlexibleBoom),
-}
-
-impl Boom {
-    /// The boom's mechanics.
-    pub fn mechanics(&self) -> &dyn BoomMechanics {
-        match self {
-            Boom::Rigid(b) => b,
-            Boom::Flexible(b) => b,
-        }
-    }
-}
 
 /// Circuit + boom as one ODE, with the operator's reference held.
 #[derive(Debug, Clone)]
@@ -299,35 +91,8 @@ impl OdeSystem for Plant {
 impl Plant {
     /// The plant from the FMU's parameter values; refuses inconsistent combinations.
     pub fn from_values(values: &Values) -> Result<Self, String> {
-        let mut circuit = Circuit::default();
-        for (k, p) in PARAMS.iter().enumerate() {
-            (p.set)(&mut circuit, param_value(values, vr::HYDRAULICS + k as u32, &p.spec));
-        }
-        let cyl = &circuit.cylinder;
-        if cyl.d_rod >= cyl.d_piston {
-            return Err(format!(
-                "cylinder.d_rod = {} must be less than cylinder.d_piston = {}",
-                cyl.d_rod, cyl.d_piston
-            ));
-        }
-        if circuit.dcv.x_db >= circuit.dcv.x_max {
-            return Err(format!(
-                "valve.x_db = {} must be less than valve.x_max = {}",
-                circuit.dcv.x_db, circuit.dcv.x_max
-            ));
-        }
-        let lookup = |specs: &[ParamSpec], base: u32, name: &str| {
-            let k = specs.iter().position(|s| s.name == name).expect("parameter name");
-            param_value(values, base + k as u32, &specs[k])
-        };
-        let params = BoomParams::from_lookup(|n| lookup(BOOM_SPECS, vr::BOOM, n));
-        let boom = if values.boolean(vr::FLEXIBLE) {
-            let beam = BeamParams::from_lookup(|n| lookup(BEAM_SPECS, vr::BEAM, n));
-            FlexibleBoom::new(&params, &beam, cyl.stroke).map(Boom::Flexible)
-        } else {
-            RigidBoom::new(&params, cyl.stroke).map(Boom::Rigid)
-        };
-        let boom = boom.map_err(|e| format!("boom geometry (boom.*, cylinder.l_retracted, cylinder.stroke): {e}"))?;
+        let circuit = parts::circuit_from_values(values)?;
+        let boom = Boom::from_values(values, circuit.cylinder.stroke)?;
         Ok(Plant { circuit, boom, u_ref: values.real(vr::U_REF) })
     }
 
@@ -358,11 +123,7 @@ impl Plant {
 
     /// Absolute tolerances for relative tolerance `rtol`.
     fn atol(&self, rtol: f64) -> Vec<f64> {
-        let dof = self.boom.mechanics().dof();
-        let (q, qd) = if let Boom::Rigid(_) = self.boom { RIGID_SCALE } else { FLEXIBLE_SCALE };
-        let scales =
-            CIRCUIT_SCALE.iter().copied().chain(std::iter::repeat_n(q, dof)).chain(std::iter::repeat_n(qd, dof));
-        scales.map(|s| s * rtol).collect()
+        CIRCUIT_SCALE.iter().map(|s| s * rtol).chain(self.boom.atol(rtol)).collect()
     }
 }
 
@@ -372,21 +133,15 @@ pub struct HydraulicBoom {
     plant: Plant,
     state: Vec<f64>,
     solver: Radau5,
-    /// The relative tolerance the solver is set to (NaN: not yet).
-    rtol: f64,
 }
 
 impl HydraulicBoom {
     /// The model with the plant of `values` and the given state (the equilibrium if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
         let plant = Plant::from_values(values)?;
-        let state = match state {
-            None => plant.equilibrium(values.real(vr::X0))?,
-            Some(s) if s.len() == plant.dim() && s.iter().all(|x| x.is_finite()) => s.to_vec(),
-            Some(s) => return Err(format!("expected {} finite states, got {}", plant.dim(), s.len())),
-        };
+        let state = parts::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0)))?;
         let solver = Radau5::new(plant.dim());
-        Ok(HydraulicBoom { plant, state, solver, rtol: f64::NAN })
+        Ok(HydraulicBoom { plant, state, solver })
     }
 }
 
@@ -421,51 +176,12 @@ impl Model for HydraulicBoom {
         let (q, qd) = boom.split_at(b.dof());
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
         let e = self.plant.circuit.evaluate(c.try_into().expect("circuit slice"), values.real(vr::U_REF), x, v);
-        let (theta, omega, tip) = match &self.plant.boom {
-            Boom::Rigid(r) => {
-                let st = r.state(x, v);
-                (st.theta2, st.theta2_dot, 0.0)
-            }
-            Boom::Flexible(f) => (q[0], qd[0], f.tip_deflection(q)),
-        };
-        let payload = b.payload(q);
-        let stats = self.solver.stats();
-        let outputs = [
-            (vr::P1, c[circuit::P1]),
-            (vr::P2, c[circuit::P2]),
-            (vr::P3, c[circuit::P3]),
-            (vr::P4, c[circuit::P4]),
-            (vr::U, e.u),
-            (vr::U_CV, e.u_cv),
-            (vr::U_CBV, c[circuit::U_CBV]),
-            (vr::Q1, e.q[0]),
-            (vr::Q2, e.q[1]),
-            (vr::Q3, e.q[2]),
-            (vr::Q4, e.q[3]),
-            (vr::X, x),
-            (vr::V, v),
-            (vr::F, e.force),
-            (vr::F_FR, e.f_friction),
-            (vr::THETA, theta),
-            (vr::OMEGA, omega),
-            (vr::PAYLOAD_X, payload.x),
-            (vr::PAYLOAD_Y, payload.y),
-            (vr::X_V, c[circuit::X_V]),
-            (vr::U_PCV, e.u_pcv),
-            (vr::P_X, e.p_x),
-            (vr::SOLVER_STEPS, stats.accepted_steps as f64),
-            (vr::SOLVER_REJECTED, stats.rejected_steps as f64),
-            (vr::SOLVER_RHS, stats.rhs_evals as f64),
-            (vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64),
-            (vr::TIP_DEFLECTION, tip),
-        ];
-        for (r, x) in outputs {
-            values.set_real(r, x);
+        parts::circuit_outputs(c.try_into().expect("circuit slice"), &e, values);
+        parts::solver_outputs(self.solver.stats(), values);
+        for (r, y) in [(vr::X, x), (vr::V, v)] {
+            values.set_real(r, y);
         }
-        for k in 0..MAX_SECTIONS {
-            let phi = if let Boom::Flexible(_) = self.plant.boom { q[k.min(q.len() - 1)] } else { theta };
-            values.set_real(vr::SECTIONS + k as u32, phi);
-        }
+        self.plant.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
 
     fn do_step(
@@ -477,49 +193,19 @@ impl Model for HydraulicBoom {
         tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        let fail = |time, message: String| StepError { time, message };
         self.plant.u_ref = values.real(vr::U_REF);
-        if tolerance != self.rtol {
-            let atol = self.plant.atol(tolerance);
-            self.solver
-                .set_rtol(tolerance)
-                .and_then(|_| self.solver.set_atol(&atol))
-                .map_err(|e| fail(t, e.to_string()))?;
-            self.rtol = tolerance;
-        }
-        let before = *self.solver.stats();
-        self.solver.integrate(&self.plant, t, &mut self.state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
-        if log.enabled("logSolver") {
-            let s = self.solver.stats();
-            log.info(
-                "logSolver",
-                &format!(
-                    "t = {}: {} steps ({} rejected), {} RHS, {} Jacobians",
-                    t + h,
-                    s.accepted_steps - before.accepted_steps,
-                    s.rejected_steps - before.rejected_steps,
-                    s.rhs_evals - before.rhs_evals,
-                    s.jacobian_evals - before.jacobian_evals
-                ),
-            );
-        }
-        Ok(())
+        let atol = self.plant.atol(tolerance);
+        parts::advance(&mut self.solver, &self.plant, &mut self.state, t, h, tolerance, &atol, log)
     }
 
     fn save(&self) -> Vec<f64> {
-        let mut v = self.state.clone();
-        v.extend_from_slice(&self.solver.save_state());
-        v
+        parts::save(&[], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let plant = Plant::from_values(values)?;
-        let n = plant.dim();
-        if saved.len() != n + Radau5::new(n).state_len() {
-            return Err(format!("expected {} numbers, got {}", n + Radau5::new(n).state_len(), saved.len()));
-        }
-        let mut m = Self::with_state(values, Some(&saved[..n]))?;
-        m.solver.load_state(&saved[n..]).map_err(|e| e.to_string())?;
+        let (_, state, solver) = parts::split_saved(saved, 0)?;
+        let mut m = Self::with_state(values, Some(state))?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)
     }
 }

@@ -1,9 +1,15 @@
 //! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].
 
+pub mod boom_mechanics;
 pub mod hydraulic_boom;
+pub mod hydraulic_circuit;
+pub mod parts;
+pub mod port;
 pub mod pressure_feedback_controller;
 
+pub use boom_mechanics::BoomMechanics;
 pub use hydraulic_boom::HydraulicBoom;
+pub use hydraulic_circuit::HydraulicCircuit;
 pub use pressure_feedback_controller::PressureFeedbackController;
 
 use crate::fmi2::Fmu;
@@ -13,5 +19,7 @@ pub fn all() -> Vec<Fmu> {
     vec![
         Fmu::of::<PressureFeedbackController>("fmu-pressure-feedback-controller"),
         Fmu::of::<HydraulicBoom>("fmu-hydraulic-boom"),
+        Fmu::of::<HydraulicCircuit>("fmu-hydraulic-circuit"),
+        Fmu::of::<BoomMechanics>("fmu-boom-mechanics"),
     ]
 }

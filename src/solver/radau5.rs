@@ -282,6 +282,11 @@ impl Radau5 {
         self.faccon = 1.0;
     }
 
+    /// Number of `f64` that [`save_state`](Self::save_state) writes for dimension `n`.
+    pub fn saved_len(n: usize) -> usize {
+        7 + n * n + 4 * n
+    }
+
     /// Number of `f64` in [`save_state`](Self::save_state): `7 + n² + 4n`.
     pub fn state_len(&self) -> usize {
         7 + self.n * self.n + 4 * self.n

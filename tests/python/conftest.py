@@ -83,3 +83,13 @@ def controller(tmp_path_factory):
 @pytest.fixture(scope="session")
 def boom(tmp_path_factory):
     return Fmu("HydraulicBoom", tmp_path_factory)
+
+
+@pytest.fixture(scope="session")
+def circuit(tmp_path_factory):
+    return Fmu("HydraulicCircuit", tmp_path_factory)
+
+
+@pytest.fixture(scope="session")
+def mechanics(tmp_path_factory):
+    return Fmu("BoomMechanics", tmp_path_factory)

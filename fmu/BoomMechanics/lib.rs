@@ -1,0 +1,3 @@
+//! The BoomMechanics FMU: exports the FMI 2.0 C ABI for the model.
+#![allow(non_snake_case)]
+boomsim::export_fmu!(boomsim::models::BoomMechanics);

@@ -1,0 +1,277 @@
+"""SSP 1.0 packages of the boom systems and their runs in three SSP importers.
+
+    .venv/bin/python scripts/ssp.py [--scenario B] [--boom rigid] [--coupling tlm] [--out target/ssp]
+
+writes
+    target/ssp/BoomSystem.ssp       HydraulicBoom + PressureFeedbackController (two FMUs)
+    target/ssp/BoomSystemSplit.ssp  HydraulicCircuit + BoomMechanics + PressureFeedbackController
+each a zip of SystemStructure.ssd (components, connectors, connections, inline parameter bindings
+of the scenario, default experiment) and resources/<FMU>.fmu; then runs both in fmpy's SSP
+simulator, libcosimpy (CosimExecution.from_ssp_file) and ecospy (EcosSimulation(ssp_path=...))
+and compares the regression metrics with the fmpy runner (cosim.py / split.py, Jacobi for the
+split system, as these masters step all FMUs from the same values).
+
+The operator reference of the scenario must be constant (U, B, ...): it is bound as the start value
+of the controller's u_ref input. Masters that start the connections at 0 (fmpy's simulate_ssp) get
+the documented first-step deviation; see scripts/README.md, "SSP".
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import sys
+import tempfile
+import zipfile
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import cosim  # noqa: E402
+import metrics as mx  # noqa: E402
+import split  # noqa: E402
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+#: Recorded outputs: (component, variable, metric column).
+RECORD = {
+    "monolithic": [("Plant", c, c) for c in ("p3", "cbv.u_cbv", "Q3", "cylinder.x", "cylinder.v")],
+    "split": [("Circuit", c, c) for c in ("p3", "cbv.u_cbv", "Q3")]
+    + [("Mechanics", c, c) for c in ("cylinder.x", "cylinder.v")],
+}
+for _r in RECORD.values():
+    _r.append(("Controller", "u_comp", "u_comp"))
+#: Name of every component's inline parameter set (ecos applies a set by name at init).
+PARAMETER_SET = "scenario"
+NAMES = {"monolithic": "BoomSystem", "split": "BoomSystemSplit"}
+
+
+def components(system: str, sc: dict, boom: str, coupling: str) -> tuple[dict, list]:
+    """({component: (FMU id, {parameter: value})}, [(from comp, output, to comp, input)])."""
+    ctrl = {k: sc["controller"][k] for k in ("K_f", "omega_f") if k in sc["controller"]}
+    ctrl["enable"] = bool(sc["controller"]["enable"])
+    u_ref = float(sc["reference"][0, 1])
+    if np.ptp(sc["reference"][:, 1]) != 0:
+        raise ValueError(f"{sc['id']}: the SSP binds a constant operator reference; this one varies")
+    ctrl["u_ref"] = u_ref
+    flexible = boom == "flexible"
+    if system == "monolithic":
+        plant = {"start.x": sc["start_stroke"], "boom.flexible": flexible, **sc["plant"]}
+        comps = {"Plant": ("HydraulicBoom", plant), "Controller": ("PressureFeedbackController", ctrl)}
+        conns = [("Plant", "p4", "Controller", "p"), ("Controller", "u", "Plant", "valve.u_ref")]
+        return comps, conns
+    mode = 1 if coupling.startswith("tlm") else 0
+    mech = {"start.x": sc["start_stroke"], "boom.flexible": flexible, "port.coupling": mode}
+    f_start = start_force(mech)
+    circ = {"start.x": sc["start_stroke"], "start.F": f_start, "port.coupling": mode, "port.c_m": f_start,
+            "cylinder.x": sc["start_stroke"]}
+    mech["port.c_h"] = mech["cylinder.F"] = f_start
+    comps = {"Circuit": ("HydraulicCircuit", circ), "Mechanics": ("BoomMechanics", mech),
+             "Controller": ("PressureFeedbackController", ctrl)}
+    conns = [("Circuit", "p4", "Controller", "p"), ("Controller", "u", "Circuit", "valve.u_ref")]
+    if mode:
+        conns += [("Circuit", "port.c_h", "Mechanics", "port.c_h"), ("Mechanics", "port.c_m", "Circuit", "port.c_m")]
+    else:
+        conns += [("Circuit", "cylinder.F", "Mechanics", "cylinder.F"), ("Mechanics", "cylinder.x", "Circuit", "cylinder.x"),
+                  ("Mechanics", "cylinder.v", "Circuit", "cylinder.v")]
+    return comps, conns
+
+
+def start_force(mech: dict) -> float:
+    """BoomMechanics' start.F for these parameters (the circuit's start.F binding)."""
+    f = cosim.FmuFile.get("BoomMechanics")
+    s = f.slave("start_force")
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    for k, v in mech.items():
+        f.set(s, k, v)
+    s.exitInitializationMode()
+    value = s.getReal([f.vr["start.F"]])[0]
+    s.terminate()
+    s.freeInstance()
+    return value
+
+
+def ssd(system: str, sc: dict, boom: str, coupling: str) -> str:
+    """SystemStructure.ssd of `system` for scenario `sc`."""
+    comps, conns = components(system, sc, boom, coupling)
+    kinds = {}
+    for a, out, b, inp in conns:
+        kinds.setdefault(a, {})[out] = "output"
+        kinds.setdefault(b, {})[inp] = "input"
+    for comp, var, _ in RECORD[system]:
+        kinds.setdefault(comp, {})[var] = "output"
+    lines = [f'<?xml version="1.0" encoding="UTF-8"?>',
+             f'<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" '
+             f'version="1.0" name="{NAMES[system]}">',
+             f'  <ssd:System name="{NAMES[system]}">', "    <ssd:Elements>"]
+    for name, (fmu, params) in comps.items():
+        md = cosim.FmuFile.get(fmu)
+        lines.append(f'      <ssd:Component name="{name}" type="application/x-fmu-sharedlibrary" '
+                     f'source="resources/{fmu}.fmu">')
+        lines.append("        <ssd:Connectors>")
+        for var, kind in kinds.get(name, {}).items():
+            lines.append(f"          <ssd:Connector name={quoteattr(var)} kind=\"{kind}\"><ssc:Real/></ssd:Connector>")
+        lines.append("        </ssd:Connectors>")
+        lines += ["        <ssd:ParameterBindings>", "          <ssd:ParameterBinding>", "            <ssd:ParameterValues>",
+                  f'              <ssv:ParameterSet version="1.0" name="{PARAMETER_SET}">', "                <ssv:Parameters>"]
+        for k, v in params.items():
+            ty = md.vars[k].type
+            text = str(v).lower() if ty == "Boolean" else repr(int(v) if ty == "Integer" else float(v))
+            lines.append(f"                  <ssv:Parameter name={quoteattr(k)}><ssv:{ty} value=\"{text}\"/></ssv:Parameter>")
+        lines += ["                </ssv:Parameters>", "              </ssv:ParameterSet>", "            </ssd:ParameterValues>",
+                  "          </ssd:ParameterBinding>", "        </ssd:ParameterBindings>", "      </ssd:Component>"]
+    lines += ["    </ssd:Elements>", "    <ssd:Connections>"]
+    for a, out, b, inp in conns:
+        lines.append(f'      <ssd:Connection startElement="{a}" startConnector={quoteattr(out)} '
+                     f'endElement="{b}" endConnector={quoteattr(inp)}/>')
+    lines += ["    </ssd:Connections>", "  </ssd:System>",
+              f'  <ssd:DefaultExperiment startTime="0" stopTime="{sc["stop_time"]:g}"/>',
+              "</ssd:SystemStructureDescription>", ""]
+    return "\n".join(lines)
+
+
+def write(system: str, sc: dict, boom: str = "rigid", coupling: str = "tlm", out=cosim.ROOT / "target" / "ssp"):
+    """Writes <out>/<BoomSystem|BoomSystemSplit>.ssp; returns its path."""
+    out = pathlib.Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{NAMES[system]}.ssp"
+    comps, _ = components(system, sc, boom, coupling)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("SystemStructure.ssd", ssd(system, sc, boom, coupling))
+        for fmu, _ in comps.values():
+            z.write(cosim.FmuFile.get(fmu).path, f"resources/{fmu}.fmu")
+    return path
+
+
+# --------------------------------------------------------------------------- importers
+
+
+def bindings(path) -> dict:
+    """{component: {parameter: value}} from the SSD's inline parameter bindings."""
+    from fmpy.ssp.ssd import read_ssd
+
+    out = {}
+
+    def walk(system):
+        for c in system.elements:
+            for b in c.parameterBindings:
+                for ps in b.parameterValues:
+                    out.setdefault(c.name, {}).update({p.name: p.value for p in ps.parameters})
+
+    walk(read_ssd(str(path)).system)
+    return out
+
+
+def run_fmpy(path, system: str, stop: float, step: float) -> dict:
+    """fmpy.ssp.simulation.simulate_ssp; it validates the SSD against the SSP schema but does not
+    apply its parameter bindings, so they go in as its `parameter_set` (names <component>.<var>,
+    Booleans as 0/1)."""
+    from fmpy.ssp.simulation import simulate_ssp
+    from fmpy.ssp.ssd import Parameter, ParameterSet
+
+    # its set_value writes a Boolean as `value != 0.0`, so a literal "false" would set true
+    def number(v):
+        return {"true": 1.0, "false": 0.0}.get(str(v).lower(), v)
+
+    params = [Parameter(name=f"{c}.{k}", value=number(v)) for c, kv in bindings(path).items() for k, v in kv.items()]
+    r = simulate_ssp(str(path), stop_time=stop, step_size=step, parameter_set=ParameterSet(parameters=params))
+    # each row holds the outputs after the step that starts at its time
+    data = {"time": r["time"] + step}
+    for comp, var, col in RECORD[system]:
+        data[col] = r[f"{comp}.{var}"]
+    return data
+
+
+def run_libcosim(path, system: str, stop: float, step: float) -> dict:
+    """libcosimpy: CosimExecution.from_ssp_file (fixed-step Jacobi master), a time-series observer."""
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.WARNING)
+    ex = CosimExecution.from_ssp_file(str(path), step_size=int(round(step * 1e9)))
+    obs = CosimObserver.create_time_series(buffer_size=int(round(stop / step)) + 10)
+    ex.add_observer(obs)
+    index = {s.name.decode(): s.index for s in ex.slave_infos()}
+    refs = []
+    for comp, var, col in RECORD[system]:
+        i = index[comp]
+        vr = next(v.reference for v in ex.slave_variables(i) if v.name.decode() == var)
+        obs.start_time_series(i, vr, CosimVariableType.REAL)
+        refs.append((i, vr, col))
+    ex.simulate_until(stop * 1e9)
+    data = {}
+    n = int(round(stop / step)) + 1
+    for i, vr, col in refs:
+        times, _, values = obs.time_series_real_samples(i, vr, from_step=0, sample_count=n)
+        data[col] = np.asarray(values)
+        data["time"] = np.asarray(times) * 1e-9
+    return data
+
+
+def run_ecos(path, system: str, stop: float, step: float) -> dict:
+    """ecospy: EcosSimulation(step_size, ssp_path); values read after every step."""
+    from ecospy import EcosSimulation
+
+    rows = []
+    ids = [f"{comp}::{var}" for comp, var, _ in RECORD[system]]
+    with EcosSimulation(step_size=step, ssp_path=str(path)) as sim:
+        sim.init(parameter_set=PARAMETER_SET)
+        for _ in range(int(round(stop / step))):
+            t = sim.step()
+            rows.append([t] + [sim.get_real(i) for i in ids])
+        sim.terminate()
+    a = np.array(rows)
+    return {"time": a[:, 0], **{col: a[:, k + 1] for k, (_, _, col) in enumerate(RECORD[system])}}
+
+
+IMPORTERS = {"fmpy": run_fmpy, "libcosimpy": run_libcosim, "ecospy": run_ecos}
+
+
+def as_result(data: dict, sc: dict, boom: str, step: float) -> cosim.Result:
+    """The importer's record as a cosim.Result for metrics.compute (u_ref constant)."""
+    d = dict(data)
+    d["u_ref"] = np.full_like(d["time"], sc["reference"][0, 1])
+    return cosim.Result(sc, boom, step, False, d, 0.0)
+
+
+def reference(system: str, sc: dict, boom: str, coupling: str, step: float) -> dict:
+    """Metrics of the fmpy runner for the same system (Jacobi for the split one)."""
+    if system == "monolithic":
+        return mx.compute(cosim.run(sc, boom, step))
+    return mx.compute(split.run(sc, boom, {"tlm": "tlm-jacobi", "plain": "jacobi"}[coupling], step))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenario", default="B")
+    ap.add_argument("--boom", default="rigid")
+    ap.add_argument("--coupling", default="tlm", choices=("plain", "tlm"))
+    ap.add_argument("--step", type=float, default=1e-3)
+    ap.add_argument("--out", default=str(cosim.ROOT / "target" / "ssp"))
+    ap.add_argument("--no-run", action="store_true", help="only write the .ssp files")
+    args = ap.parse_args(argv)
+    sc = cosim.load_scenario(args.scenario)
+    for system in ("monolithic", "split"):
+        path = write(system, sc, args.boom, args.coupling, args.out)
+        print(path)
+        if args.no_run:
+            continue
+        ref = reference(system, sc, args.boom, args.coupling, args.step)
+        for tool, fn in IMPORTERS.items():
+            try:
+                m = mx.compute(as_result(fn(path, system, sc["stop_time"], args.step), sc, args.boom, args.step))
+            except Exception as e:  # noqa: BLE001 - report any importer failure
+                print(f"  {tool}: FAILED: {type(e).__name__}: {e}")
+                continue
+            cmp = split.compare(ref, m)
+            bad = {k: (a, b) for k, (a, b, ok) in cmp.items() if not ok}
+            print(f"  {tool}: " + ("matches the fmpy runner" if not bad else f"differs: {bad}"))
+
+
+if __name__ == "__main__":
+    main()

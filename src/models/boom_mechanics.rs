@@ -1,0 +1,221 @@
+//! The BoomMechanics FMU model: the rigid or lumped flexible boom of HydraulicBoom alone, driven
+//! through the mechanical port ([`super::port`]) by the cylinder force (plain) or the TLM wave of
+//! [`super::HydraulicCircuit`], advanced by the Radau IIA integrator.
+//!
+//! States: the boom's generalised coordinates and velocities (rigid: the stroke; flexible: the
+//! section angles). The boom carries the rod and piston (mass and weight), as in HydraulicBoom.
+
+use super::parts::{
+    self, out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION,
+};
+use super::port::{self, Coupling, Ramp, FORCE_RANGE};
+use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::hydraulics::params::PARAMS;
+use crate::solver::{OdeSystem, Radau5};
+
+/// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
+/// ([`port::vr`]; its `F` is `port.F`).
+pub mod vr {
+    pub use crate::models::parts::vr::*;
+    pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, START_F, Z_C};
+}
+
+/// Index of `cylinder.stroke` in the circuit parameters: the boom's range of motion.
+const STROKE_INDEX: usize = {
+    let mut k = 0;
+    while !parts::str_eq(PARAMS[k].spec.name, "cylinder.stroke") {
+        k += 1;
+    }
+    k
+};
+
+#[rustfmt::skip]
+const OWN: [Variable; 17] = [
+    Variable::real_input("cylinder.F", vr::F, 0.0, "N", "kN", FORCE_RANGE,
+        "Plain port: force on the rod from the circuit, pushing it out (linear over a step with its derivative)"),
+    out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
+    out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
+    out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
+    out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
+    out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
+    out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
+    Variable::param(vr::X0, START_STROKE).fixed(),
+    FLEXIBLE_SWITCH,
+    TIP_DEFLECTION,
+    port::COUPLING,
+    Variable::param(vr::Z_C, port::Z_C).fixed(),
+    Variable::param(vr::ALPHA, port::ALPHA).fixed(),
+    out("start.F", vr::START_F, "N", "kN",
+        "Cylinder force that holds the boom at rest at start.x (set HydraulicCircuit's start.F to it)"),
+    Variable::real_input("port.c_h", vr::C_H, 0.0, "N", "kN", FORCE_RANGE,
+        "TLM port: wave from the circuit, c_h = F_H + Z_c v_H (linear over a step with its derivative)"),
+    out("port.c_m", vr::C_M, "N", "kN", "TLM port: wave to the circuit, c_m = F_M - Z_c v_M at the step end"),
+    port::PORT_F,
+];
+
+const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 1 + N_BOOM_ROWS;
+const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
+    .vars(&SOLVER_LOCALS)
+    .sections()
+    .hydraulics(PARAMS, STROKE_INDEX, STROKE_INDEX + 1)
+    .boom_params()
+    .build();
+
+const DOCUMENTATION: &str = r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
+flexible (2.1.4, 3.1.2), with the same parameters, names and value references, the rod and piston included. It
+starts at rest at <code>start.x</code>; <code>start.F</code> is the cylinder force that holds it there.
+<code>port.coupling</code> selects the port, as in HydraulicCircuit: <b>0, plain</b>: input <code>cylinder.F</code>
+(linear over a step with fmi2SetRealInputDerivatives); <b>1, TLM</b>: input wave c<sub>h</sub>, the boom is pushed by
+F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub> and emits c<sub>m</sub> = F<sub>M</sub> &minus;
+Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). Outputs: stroke, velocity, boom angle, payload
+position, tip deflection and section angles.</p>"#;
+
+/// The boom driven through the port, as one ODE over a step.
+#[derive(Debug, Clone)]
+pub struct PortedBoom {
+    pub boom: Boom,
+    pub coupling: Coupling,
+    /// Plain: the cylinder force; TLM: the wave c_h.
+    pub input: Ramp,
+}
+
+impl PortedBoom {
+    /// Force pushing the rod out at `t`, coordinates `q`, velocities `qd`.
+    pub fn force(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+        match self.coupling {
+            Coupling::Plain => self.input.at(t),
+            Coupling::Tlm { z_c, .. } => self.input.at(t) - z_c * self.boom.mechanics().stroke_rate(q, qd),
+        }
+    }
+}
+
+impl OdeSystem for PortedBoom {
+    fn dim(&self) -> usize {
+        2 * self.boom.mechanics().dof()
+    }
+
+    fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
+        let b = self.boom.mechanics();
+        let (q, qd) = s.split_at(b.dof());
+        let (dq, dqd) = dx.split_at_mut(b.dof());
+        dq.copy_from_slice(qd);
+        b.accelerations(q, qd, self.force(t, q, qd), dqd);
+    }
+}
+
+/// The BoomMechanics model: ported boom, state, integrator.
+#[derive(Debug, Clone)]
+pub struct BoomMechanics {
+    sys: PortedBoom,
+    /// Holding force at the start.
+    f_start: f64,
+    t: f64,
+    /// The wave emitted at `t` (TLM).
+    c_m: f64,
+    state: Vec<f64>,
+    solver: Radau5,
+}
+
+impl BoomMechanics {
+    /// The model at time `t` with the port input `input`, the emitted wave `c_m` and the given
+    /// state (at rest at start.x if `None`).
+    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [input, c_m]: [f64; 2]) -> Result<Self, String> {
+        let stroke = values.real(vr::HYDRAULICS + STROKE_INDEX as u32);
+        let boom = Boom::from_values(values, stroke)?;
+        let x0 = values.real(vr::X0);
+        if !(0.0..=stroke).contains(&x0) {
+            return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
+        }
+        let rest =
+            boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
+        let sys =
+            PortedBoom { boom, coupling: Coupling::from_values(values), input: Ramp { t0: t, y0: input, slope: 0.0 } };
+        let state = parts::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
+        let solver = Radau5::new(sys.dim());
+        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
+    }
+
+    /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
+    fn input_vr(&self) -> u32 {
+        match self.sys.coupling {
+            Coupling::Plain => vr::F,
+            Coupling::Tlm { .. } => vr::C_H,
+        }
+    }
+}
+
+impl Model for BoomMechanics {
+    const INFO: ModelInfo = ModelInfo {
+        identifier: "BoomMechanics",
+        description:
+            "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
+        version: "0.1.0",
+        start_time: 0.0,
+        stop_time: 15.0,
+        step_size: 1e-3,
+        default_tolerance: 1e-6,
+        log_categories: &[("logSolver", "Integrator statistics per communication step")],
+        can_interpolate_inputs: true,
+        documentation: DOCUMENTATION,
+    };
+    const VARIABLES: &'static [Variable] = &TABLE;
+
+    /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).
+    fn initialize(values: &Values) -> Result<Self, String> {
+        let mut m = Self::with_state(values, None, 0.0, [0.0, 0.0])?;
+        m.sys.input.y0 = if m.sys.coupling == Coupling::Plain { values.real(vr::F) } else { m.f_start };
+        m.c_m = m.f_start;
+        Ok(m)
+    }
+
+    fn retune(&mut self, _values: &Values) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn outputs(&self, values: &mut Values) {
+        let mut sys = self.sys.clone();
+        if sys.coupling == Coupling::Plain {
+            sys.input = Ramp { t0: self.t, y0: values.real(vr::F), slope: 0.0 };
+        }
+        let b = sys.boom.mechanics();
+        let (q, qd) = self.state.split_at(b.dof());
+        let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
+        let f = sys.force(self.t, q, qd);
+        let c_m = if sys.coupling == Coupling::Plain { f } else { self.c_m };
+        for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
+            values.set_real(r, y);
+        }
+        parts::solver_outputs(self.solver.stats(), values);
+        sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
+    }
+
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
+        let atol: Vec<f64> = self.sys.boom.atol(tolerance).collect();
+        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, &atol, log)?;
+        self.t = t + h;
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        let v = self.sys.boom.mechanics().stroke_rate(q, qd);
+        self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, q, qd), -v);
+        Ok(())
+    }
+
+    fn save(&self) -> Vec<f64> {
+        parts::save(&[self.t, self.sys.input.at(self.t), self.c_m], &self.state, &self.solver)
+    }
+
+    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
+        let (head, state, solver) = parts::split_saved(saved, 3)?;
+        let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
+        Ok(m)
+    }
+}

@@ -1,0 +1,174 @@
+//! The mechanical port between [`super::HydraulicCircuit`] and [`super::BoomMechanics`] (or any
+//! external mechanics): the coupling modes, their parameters and the wave variables.
+//!
+//! Signs: stroke `x` and velocity `v` are positive extending; a force is positive when it pushes
+//! the rod out (extends the cylinder).
+//!
+//! - **Plain** (`port.coupling = 0`): the circuit takes `cylinder.x`, `cylinder.v` and returns
+//!   `cylinder.F`; the mechanics takes `cylinder.F` and returns x, v. Exact, but the force seen by
+//!   the mechanics is one communication step old: stable while omega h < 2 for every mode the
+//!   oil column couples to the mechanics (omega^2 ~ k_oil / m_local).
+//! - **TLM** (`port.coupling = 1`): a bilateral delay line (transmission-line element) of
+//!   characteristic impedance `Z_c` and delay one communication step. The circuit integrates a
+//!   local rod mass `m` with the line force `F_H = c_m + Z_c v_H` and emits
+//!   `c_h = F_H + Z_c v_H`; the mechanics is pushed by `F_M = c_h - Z_c v_M` and emits
+//!   `c_m = F_M - Z_c v_M`. The waves are exchanged once per step and need no iteration; the
+//!   line is passive, so the exchange is stable at any step. Its price is a spring `Z_c / h` in
+//!   series with the oil column and a mass `Z_c h` at the pin; `Z_c = sqrt(k_oil m_eff)` makes
+//!   both relative errors equal to omega h.
+
+use crate::fmi2::{Values, Variable};
+use crate::params::ParamSpec;
+
+/// Value references of the port (the same in both FMUs; 80-99, after the section angles 41-72).
+pub mod vr {
+    pub const COUPLING: u32 = 80;
+    pub const Z_C: u32 = 81;
+    pub const M: u32 = 82;
+    pub const START_F: u32 = 83;
+    /// Wave from the mechanics to the circuit.
+    pub const C_M: u32 = 84;
+    /// Wave from the circuit to the mechanics.
+    pub const C_H: u32 = 85;
+    pub const F: u32 = 86;
+    pub const ALPHA: u32 = 89;
+}
+
+/// How the circuit and the mechanics exchange the port variables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Coupling {
+    /// x, v to the circuit, F to the mechanics.
+    Plain,
+    /// Wave variables of a transmission line with impedance `z_c` [N s/m], each emitted wave
+    /// low-pass filtered with `alpha` (0: none).
+    Tlm { z_c: f64, alpha: f64 },
+}
+
+impl Coupling {
+    /// The coupling selected by `port.coupling` and `port.Z_c`.
+    pub fn from_values(values: &Values) -> Self {
+        match values.integer(vr::COUPLING) {
+            0 => Coupling::Plain,
+            _ => Coupling::Tlm { z_c: values.real(vr::Z_C), alpha: values.real(vr::ALPHA) },
+        }
+    }
+}
+
+/// `port.coupling`: 0 plain, 1 TLM.
+pub const COUPLING: Variable = Variable::int_param(
+    "port.coupling",
+    vr::COUPLING,
+    0,
+    (0, 1),
+    "Mechanical port: 0 plain (inputs cylinder.x, cylinder.v / output cylinder.F), 1 TLM (wave variables port.c_h, port.c_m with impedance port.Z_c)",
+);
+
+/// Default characteristic impedance: sqrt(k_oil m_eff) at the 480 mm start stroke with the
+/// thesis parameters, k_oil = A^2/C_3 + A_B^2/C_4 = 8.3e6 N/m (C = V/beta + hose compliance,
+/// eq. 5.2) and the rigid boom's m_eff = 16.9 t (test `default_impedance_matches_the_oil_column`).
+pub const Z_C: ParamSpec = ParamSpec {
+    name: "port.Z_c",
+    default: 3.75e5,
+    unit: "N.s/m",
+    display_unit: "",
+    min: 1.0,
+    max: 1e9,
+    description: "TLM characteristic impedance: line stiffness Z_c/h and mass Z_c h per communication step h",
+    source: "sqrt(k_oil m_eff) at the start stroke (boomsim: port module); equal stiffness and mass errors omega h",
+};
+
+/// Wave damping: the emitted wave is `c_k+1 = alpha c_k + (1 - alpha) (F + Z_c v)`.
+pub const ALPHA: ParamSpec = ParamSpec {
+    name: "port.alpha",
+    default: 0.0,
+    unit: "1",
+    display_unit: "",
+    min: 0.0,
+    max: 0.9,
+    description: "TLM wave damping (low-pass factor of each emitted wave per step); > 0 damps the numerical line mode at half the communication frequency",
+    source: "signal damping of TLM wave variables (Hopsan C-type components); see the README, Coupling your own mechanics",
+};
+
+impl Coupling {
+    /// The wave to emit after a step: the previous one `c` filtered toward `f_line + z_c v`
+    /// (`f_line`: line force pushing the rod out on the emitting side, `v` its velocity toward
+    /// the line; the mechanics passes `-v`). The line force itself when plain.
+    pub fn emit(&self, c: f64, f_line: f64, v: f64) -> f64 {
+        match *self {
+            Coupling::Plain => f_line,
+            Coupling::Tlm { z_c, alpha } => alpha * c + (1.0 - alpha) * (f_line + z_c * v),
+        }
+    }
+}
+
+/// `port.F`: the line force on the own side.
+pub const PORT_F: Variable = Variable::real_output(
+    "port.F",
+    vr::F,
+    "N",
+    "kN",
+    "TLM line force pushing the rod out: c_m + Z_c v (circuit), c_h - Z_c v (mechanics); the cylinder force when plain",
+);
+
+/// A Real input over the current step: its value at `t0` and its slope (set with
+/// fmi2SetRealInputDerivatives; 0 holds it).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Ramp {
+    pub t0: f64,
+    pub y0: f64,
+    pub slope: f64,
+}
+
+impl Ramp {
+    /// Input `r` from `values` and its derivative, at the step start `t0`.
+    pub fn read(values: &Values, derivatives: &[f64], r: u32, t0: f64) -> Self {
+        let slope = values.position(r).map_or(0.0, |i| derivatives[i]);
+        Ramp { t0, y0: values.real(r), slope }
+    }
+
+    /// The value at `t`.
+    pub fn at(&self, t: f64) -> f64 {
+        self.y0 + self.slope * (t - self.t0)
+    }
+
+    /// Its integral from `t0` to `t`.
+    pub fn integral(&self, t: f64) -> f64 {
+        let tau = t - self.t0;
+        tau * (self.y0 + 0.5 * self.slope * tau)
+    }
+}
+
+/// Admissible port force and wave values [N]: far beyond the 93 kN the cylinder can push.
+pub const FORCE_RANGE: (f64, f64) = (-1e8, 1e8);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hydraulics::circuit::Circuit;
+    use crate::mechanics::params::BoomParams;
+    use crate::mechanics::rigid_boom::RigidBoom;
+
+    /// Z_C's default against sqrt(k_oil m_eff) recomputed from the circuit and boom defaults at
+    /// the 480 mm start stroke (p3 ~ 70 bar, p4 ~ 0: the bulk modulus is that of the oil there,
+    /// the air term changes it by < 0.1 %). 5 %: the default is rounded.
+    #[test]
+    fn default_impedance_matches_the_oil_column() {
+        let c = Circuit::default();
+        let (cyl, ln, fl) = (&c.cylinder, &c.lines, &c.fluid);
+        let x = 0.48;
+        let c3 = (ln.v_l3 + cyl.volume_a(x)) / fl.beta + ln.hose_compliance(ln.v_l3);
+        let c4 = (ln.v_l4 + cyl.volume_b(x)) / fl.beta + ln.hose_compliance(ln.v_l4);
+        let k = cyl.area_a().powi(2) / c3 + cyl.area_b().powi(2) / c4;
+        let m = RigidBoom::new(&BoomParams::default(), cyl.stroke).unwrap().m_eff(x);
+        let z = (k * m).sqrt();
+        assert!((z / Z_C.default - 1.0).abs() < 0.05, "k = {k:.3e} N/m, m_eff = {m:.0} kg, sqrt(k m) = {z:.3e}");
+        assert!((k / 8.3e6 - 1.0).abs() < 0.05 && (m / 16.9e3 - 1.0).abs() < 0.05, "k = {k:.3e}, m = {m:.0}");
+    }
+
+    #[test]
+    fn ramp_value_and_integral() {
+        let r = Ramp { t0: 1.0, y0: 2.0, slope: 4.0 };
+        assert_eq!(r.at(1.5), 4.0);
+        assert_eq!(r.integral(1.5), 0.5 * (2.0 + 4.0) / 2.0);
+    }
+}
