@@ -264,7 +264,15 @@ impl<M: Model> Instance<M> {
         }
         let tolerance = c.tolerance.unwrap_or(M::INFO.default_tolerance);
         let model = c.model.as_mut().ok_or("the model is not initialised")?;
-        let result = model.do_step(&c.values, &c.input_derivatives, t, h, tolerance, &mut ModelLog(&self.log));
+        // The model steps from the instance's own clock to the master's t + h: a master that
+        // accumulates t_k + h instead of k h (rounding-level differences, accepted above) then
+        // still continues exactly where the last step ended, so results do not depend on it.
+        let (start, end) = (c.time, t + h);
+        if end <= start {
+            return Err(format!("communicationStepSize = {h} does not advance the instance time {start}"));
+        }
+        let result =
+            model.do_step(&c.values, &c.input_derivatives, start, end - start, tolerance, &mut ModelLog(&self.log));
         c.outputs_current = false;
         match result {
             Ok(()) => {
