@@ -149,14 +149,9 @@ impl Model for BoomMechanics {
         identifier: "BoomMechanics",
         description:
             "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
-        version: "0.1.0",
-        start_time: 0.0,
-        stop_time: 15.0,
-        step_size: 1e-3,
-        default_tolerance: 1e-6,
-        log_categories: &[("logSolver", "Integrator statistics per communication step")],
         can_interpolate_inputs: true,
         documentation: DOCUMENTATION,
+        ..parts::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
 

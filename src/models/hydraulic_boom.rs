@@ -149,15 +149,10 @@ impl Model for HydraulicBoom {
     const INFO: ModelInfo = ModelInfo {
         identifier: "HydraulicBoom",
         description:
-            "Pressure-compensated valve, counterbalance valve, cylinder and rigid boom (thesis Fig. 2.8, section 2.1)",
-        version: "0.1.0",
-        start_time: 0.0,
-        stop_time: 15.0,
-        step_size: 1e-3,
-        default_tolerance: 1e-6,
-        log_categories: &[("logSolver", "Integrator statistics per communication step")],
+            "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
         can_interpolate_inputs: false,
         documentation: DOCUMENTATION,
+        ..parts::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
 

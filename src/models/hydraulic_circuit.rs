@@ -207,14 +207,9 @@ impl Model for HydraulicCircuit {
     const INFO: ModelInfo = ModelInfo {
         identifier: "HydraulicCircuit",
         description: "Pressure-compensated valve, counterbalance valve and cylinder with a mechanical port (plain or TLM) for external mechanics (thesis Fig. 2.8)",
-        version: "0.1.0",
-        start_time: 0.0,
-        stop_time: 15.0,
-        step_size: 1e-3,
-        default_tolerance: 1e-6,
-        log_categories: &[("logSolver", "Integrator statistics per communication step")],
         can_interpolate_inputs: true,
         documentation: DOCUMENTATION,
+        ..parts::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
 
