@@ -194,8 +194,8 @@ impl Model for BoomMechanics {
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
         self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
-        let atol: Vec<f64> = self.sys.boom.atol(tolerance).collect();
-        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, &atol, log)?;
+        let sys = &self.sys;
+        parts::advance(&mut self.solver, sys, &mut self.state, t, h, tolerance, || sys.boom.scale().collect(), log)?;
         self.t = t + h;
         let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
         let v = self.sys.boom.mechanics().stroke_rate(q, qd);

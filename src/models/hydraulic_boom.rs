@@ -118,12 +118,7 @@ impl Plant {
 
     /// Typical magnitude of each state (atol = rtol x scale).
     pub fn state_scale(&self) -> Vec<f64> {
-        self.atol(1.0)
-    }
-
-    /// Absolute tolerances for relative tolerance `rtol`.
-    fn atol(&self, rtol: f64) -> Vec<f64> {
-        CIRCUIT_SCALE.iter().map(|s| s * rtol).chain(self.boom.atol(rtol)).collect()
+        CIRCUIT_SCALE.iter().copied().chain(self.boom.scale()).collect()
     }
 }
 
@@ -189,8 +184,8 @@ impl Model for HydraulicBoom {
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
         self.plant.u_ref = values.real(vr::U_REF);
-        let atol = self.plant.atol(tolerance);
-        parts::advance(&mut self.solver, &self.plant, &mut self.state, t, h, tolerance, &atol, log)
+        let plant = &self.plant;
+        parts::advance(&mut self.solver, plant, &mut self.state, t, h, tolerance, || plant.state_scale(), log)
     }
 
     fn save(&self) -> Vec<f64> {

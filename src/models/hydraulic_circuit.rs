@@ -197,9 +197,10 @@ impl HydraulicCircuit {
         Ok(HydraulicCircuit { sys, t, c_h, state, solver })
     }
 
-    /// Absolute tolerances for `rtol`: the circuit's scales, 1 mm and 1 mm/s for the rod.
-    fn atol(&self, rtol: f64) -> Vec<f64> {
-        CIRCUIT_SCALE.iter().chain(&[1e-3, 1e-3]).take(self.sys.dim()).map(|s| s * rtol).collect()
+    /// Typical magnitude of each of `n` states (atol = rtol x scale): the circuit's scales, 1 mm
+    /// and 1 mm/s for the rod.
+    fn state_scale(n: usize) -> Vec<f64> {
+        CIRCUIT_SCALE.iter().chain(&[1e-3, 1e-3]).take(n).copied().collect()
     }
 }
 
@@ -253,8 +254,8 @@ impl Model for HydraulicCircuit {
         sys.x0 = values.real(vr::X);
         sys.v = Ramp::read(values, input_derivatives, vr::V, t);
         sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);
-        let atol = self.atol(tolerance);
-        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, &atol, log)?;
+        let n = self.sys.dim();
+        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, || Self::state_scale(n), log)?;
         self.t = t + h;
         let (_, v) = self.sys.motion(self.t, &self.state);
         self.c_h = self.sys.coupling.emit(self.c_h, self.sys.evaluate(self.t, &self.state).1, v);

@@ -123,6 +123,8 @@ fn eigen() -> (f64, f64, f64) {
 pub struct Radau5 {
     n: usize,
     rtol: f64,
+    /// The rtol for which [`Radau5::set_tolerance`] last scaled atol (NaN: none).
+    scaled_for: f64,
     atol: Vec<f64>,
     max_step: f64,
     max_steps: u64,
@@ -178,6 +180,7 @@ impl Radau5 {
         let mut s = Self {
             n,
             rtol: 0.0,
+            scaled_for: f64::NAN,
             atol: vec![1e-6; n],
             max_step: f64::INFINITY,
             max_steps: 100_000,
@@ -222,6 +225,21 @@ impl Radau5 {
             return Err(invalid(format!("rtol = {rtol} outside (1e-14, 1)")));
         }
         self.rtol = rtol;
+        self.scaled_for = f64::NAN;
+        Ok(())
+    }
+
+    /// Sets `rtol` and `atol_i = rtol * scale_i` (`scale`: each state's typical magnitude), unless
+    /// they are already set for this `rtol`: called every communication step, it costs nothing
+    /// while the tolerance stays the same.
+    pub fn set_tolerance(&mut self, rtol: f64, scale: impl FnOnce() -> Vec<f64>) -> Result<(), SolveError> {
+        if rtol == self.scaled_for {
+            return Ok(());
+        }
+        self.set_rtol(rtol)?;
+        let atol: Vec<f64> = scale().iter().map(|s| s * rtol).collect();
+        self.set_atol(&atol)?;
+        self.scaled_for = rtol;
         Ok(())
     }
 
@@ -234,6 +252,7 @@ impl Radau5 {
             return Err(invalid(format!("atol entry {a} is not positive and finite")));
         }
         self.atol.copy_from_slice(atol);
+        self.scaled_for = f64::NAN;
         Ok(())
     }
 
