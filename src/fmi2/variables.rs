@@ -223,16 +223,21 @@ impl Value {
 pub struct Values {
     table: &'static [Variable],
     values: Vec<Value>,
-    /// (vr, table index), sorted by vr.
-    index: Vec<(u32, usize)>,
+    /// Table index by value reference ([`NONE`](Self::NONE) where there is no variable): the
+    /// references are small and dense, so a direct table makes every get and set O(1).
+    slot: Vec<u32>,
 }
 
 impl Values {
+    const NONE: u32 = u32::MAX;
+
     /// All variables at their start values.
     pub fn new(table: &'static [Variable]) -> Self {
-        let mut index: Vec<(u32, usize)> = table.iter().enumerate().map(|(i, v)| (v.vr, i)).collect();
-        index.sort_unstable();
-        Values { table, values: table.iter().map(Variable::start_value).collect(), index }
+        let mut slot = vec![Self::NONE; table.iter().map(|v| v.vr as usize + 1).max().unwrap_or(0)];
+        for (i, v) in table.iter().enumerate() {
+            slot[v.vr as usize] = i as u32;
+        }
+        Values { table, values: table.iter().map(Variable::start_value).collect(), slot }
     }
 
     /// The variable table.
@@ -242,7 +247,7 @@ impl Values {
 
     /// Table index of a value reference.
     pub fn position(&self, vr: u32) -> Option<usize> {
-        self.index.binary_search_by_key(&vr, |&(r, _)| r).ok().map(|k| self.index[k].1)
+        self.slot.get(vr as usize).filter(|&&i| i != Self::NONE).map(|&i| i as usize)
     }
 
     /// The value at a table index.

@@ -431,7 +431,7 @@ impl BoomMechanics for FlexibleBoom {
 
     /// The articulated-body sweeps of the module documentation, in the frame turned by q_0
     /// (where a vector is written (x, y) below, it is in that frame).
-    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]) {
+    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64, out: &mut [f64]) {
         let n = self.n;
         let p = self.n_ii - 1;
         let t = self.relative_trig(q, n);
@@ -445,7 +445,7 @@ impl BoomMechanics for FlexibleBoom {
         let c_dot = self.pin_velocity(&t, qd);
         let l_dot = u.dot(&c_dot);
         // F_rod: g_acc sin(theta1) = -u . g_vec.
-        let f_rod = f_cyl - self.m_rod * ((c_dot.norm_squared() - l_dot * l_dot) / l - (u.x * gx + u.y * gy));
+        let f_rod = f_cyl(l - self.l_retracted, l_dot) - self.m_rod * ((c_dot.norm_squared() - l_dot * l_dot) / l - (u.x * gx + u.y * gy));
         let mut sweep = [Sweep::default(); MAX_SECTIONS];
         // K_(j+1) and b_(j+1); zero beyond the free end.
         let (mut kxx, mut kxy, mut kyy, mut bx, mut by) = (0.0, 0.0, 0.0, 0.0, 0.0);
@@ -686,7 +686,7 @@ mod tests {
             let (q, qd) = (&y[..n], &y[n..2 * n]);
             let f = force(t);
             dy[..n].copy_from_slice(qd);
-            boom.accelerations(q, qd, f, &mut dy[n..2 * n]);
+            boom.accelerations(q, qd, &mut |_, _| f, &mut dy[n..2 * n]);
             let theta1 = boom.pin_of(&boom.trig(q)).u;
             dy[2 * n] = (f - p.m_rod * p.g * theta1.y) * boom.stroke_rate(q, qd);
         };
@@ -803,7 +803,7 @@ mod tests {
                     let qd: Vec<f64> = (0..n).map(|_| [0.1, 2.0, 20.0][trial % 3] * rand()).collect();
                     let f = 24e3 * (1.0 + 0.5 * rand());
                     let mut qdd = vec![0.0; n];
-                    boom.accelerations(&q, &qd, f, &mut qdd);
+                    boom.accelerations(&q, &qd, &mut |_, _| f, &mut qdd);
                     let (m, rhs) = lagrange(&boom, &q, &qd, f);
                     for j in 0..n {
                         let terms: f64 = (0..n).map(|k| (m[(j, k)] * qdd[k]).abs()).sum::<f64>() + rhs[j].abs();
@@ -839,7 +839,7 @@ mod tests {
         let calls = 1_000_000;
         let start = std::time::Instant::now();
         for i in 0..calls {
-            boom.accelerations(std::hint::black_box(&q), &qd, 24e3 + i as f64 * 1e-6, &mut out);
+            boom.accelerations(std::hint::black_box(&q), &qd, &mut |_, _| 24e3 + i as f64 * 1e-6, &mut out);
             std::hint::black_box(&out);
         }
         println!("accelerations, 4 + 5 sections: {:.0} ns per call", start.elapsed().as_nanos() as f64 / calls as f64);

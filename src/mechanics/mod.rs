@@ -32,8 +32,10 @@ pub trait BoomMechanics {
     fn stroke(&self, q: &[f64]) -> f64;
     /// Stroke rate dx/dt = (dl_cyl/dq) q_dot.
     fn stroke_rate(&self, q: &[f64], qd: &[f64]) -> f64;
-    /// Writes q_ddot into `out` (length [`dof`](Self::dof)); allocation-free.
-    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]);
+    /// Writes q_ddot into `out` (length [`dof`](Self::dof)) under the cylinder force
+    /// `f_cyl(x, x_dot)`, called once with the stroke and stroke rate at (q, q_dot) (a hydraulic
+    /// model evaluates its circuit there, so the geometry is computed once); allocation-free.
+    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64, out: &mut [f64]);
     /// Rest configuration at stroke `x` and the cylinder force that holds it.
     fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError>;
     /// Payload mass centre in the global frame (origin: lower cylinder pin A).

@@ -263,8 +263,8 @@ impl BoomMechanics for RigidBoom {
         qd[0]
     }
 
-    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: f64, out: &mut [f64]) {
-        out[0] = self.acceleration(q[0], qd[0], f_cyl);
+    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64, out: &mut [f64]) {
+        out[0] = self.acceleration(q[0], qd[0], f_cyl(q[0], qd[0]));
     }
 
     fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError> {

@@ -11,7 +11,7 @@ use super::parts::{
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::params::PARAMS;
-use crate::solver::{OdeSystem, Radau5};
+use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
 /// ([`port::vr`]; its `F` is `port.F`).
@@ -80,11 +80,11 @@ pub struct PortedBoom {
 }
 
 impl PortedBoom {
-    /// Force pushing the rod out at `t`, coordinates `q`, velocities `qd`.
-    pub fn force(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+    /// Force pushing the rod out at `t` and stroke rate `v`.
+    pub fn force(&self, t: f64, v: f64) -> f64 {
         match self.coupling {
             Coupling::Plain => self.input.at(t),
-            Coupling::Tlm { z_c, .. } => self.input.at(t) - z_c * self.boom.mechanics().stroke_rate(q, qd),
+            Coupling::Tlm { z_c, .. } => self.input.at(t) - z_c * v,
         }
     }
 }
@@ -99,7 +99,13 @@ impl OdeSystem for PortedBoom {
         let (q, qd) = s.split_at(b.dof());
         let (dq, dqd) = dx.split_at_mut(b.dof());
         dq.copy_from_slice(qd);
-        b.accelerations(q, qd, self.force(t, q, qd), dqd);
+        b.accelerations(q, qd, &mut |_, v| self.force(t, v), dqd);
+    }
+
+    /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
+    fn second_order(&self) -> Option<SecondOrder> {
+        let dof = self.boom.mechanics().dof();
+        Some(SecondOrder { pos: 0, vel: dof, len: dof })
     }
 }
 
@@ -175,7 +181,7 @@ impl Model for BoomMechanics {
         let b = sys.boom.mechanics();
         let (q, qd) = self.state.split_at(b.dof());
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
-        let f = sys.force(self.t, q, qd);
+        let f = sys.force(self.t, v);
         let c_m = if sys.coupling == Coupling::Plain { f } else { self.c_m };
         for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
             values.set_real(r, y);
@@ -199,7 +205,7 @@ impl Model for BoomMechanics {
         self.t = t + h;
         let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
         let v = self.sys.boom.mechanics().stroke_rate(q, qd);
-        self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, q, qd), -v);
+        self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, v), -v);
         Ok(())
     }
 

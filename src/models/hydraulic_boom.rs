@@ -15,7 +15,7 @@ use super::parts::{
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::solver::{OdeSystem, Radau5};
+use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
@@ -79,12 +79,21 @@ impl OdeSystem for Plant {
         let (c, boom) = s.split_at(N_CIRCUIT);
         let (q, qd) = boom.split_at(b.dof());
         let c: &circuit::State = c.try_into().expect("circuit slice");
-        let e = self.circuit.evaluate(c, self.u_ref, b.stroke(q), b.stroke_rate(q, qd));
         let (dc, dboom) = dx.split_at_mut(N_CIRCUIT);
-        dc.copy_from_slice(&e.dx);
         let (dq, dqd) = dboom.split_at_mut(b.dof());
         dq.copy_from_slice(qd);
-        b.accelerations(q, qd, e.force, dqd);
+        let mut force = |x, v| {
+            let e = self.circuit.evaluate(c, self.u_ref, x, v);
+            dc.copy_from_slice(&e.dx);
+            e.force
+        };
+        b.accelerations(q, qd, &mut force, dqd);
+    }
+
+    /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
+    fn second_order(&self) -> Option<SecondOrder> {
+        let dof = self.boom.mechanics().dof();
+        Some(SecondOrder { pos: N_CIRCUIT, vel: N_CIRCUIT + dof, len: dof })
     }
 }
 

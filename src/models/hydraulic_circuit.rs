@@ -15,7 +15,7 @@ use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
-use crate::solver::{OdeSystem, Radau5};
+use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
 /// ([`port::vr`]; its `F` is `port.F`).
@@ -150,6 +150,14 @@ impl OdeSystem for PortedCircuit {
         if let Coupling::Tlm { .. } = self.coupling {
             dx[N_CIRCUIT] = s[N_CIRCUIT + 1];
             dx[N_CIRCUIT + 1] = (e.force - f_line) / self.m;
+        }
+    }
+
+    /// The local rod's dx/dt = v (TLM): the integrator eliminates x from its linear systems.
+    fn second_order(&self) -> Option<SecondOrder> {
+        match self.coupling {
+            Coupling::Plain => None,
+            Coupling::Tlm { .. } => Some(SecondOrder { pos: N_CIRCUIT, vel: N_CIRCUIT + 1, len: 1 }),
         }
     }
 }

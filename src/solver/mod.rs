@@ -8,11 +8,13 @@
 use nalgebra::DMatrix;
 use std::fmt;
 
+mod iteration;
 mod lu;
 pub mod radau5;
 #[cfg(test)]
 mod tests;
 
+pub use iteration::SecondOrder;
 pub use radau5::{plan, Radau5};
 
 /// An ODE `dx/dt = f(t, x)` of fixed dimension.
@@ -28,6 +30,12 @@ pub trait OdeSystem {
     /// `true`. The default returns `false`: the integrator then uses forward differences.
     fn jacobian(&self, _t: f64, _x: &[f64], _jac: &mut DMatrix<f64>) -> bool {
         false
+    }
+
+    /// Optionally declares position states whose derivative is exactly a velocity state; the
+    /// integrator then eliminates them from its linear systems ([`SecondOrder`]). Default: none.
+    fn second_order(&self) -> Option<SecondOrder> {
+        None
     }
 }
 

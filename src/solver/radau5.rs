@@ -6,7 +6,8 @@
 //! `Z = (z1, z2, z3)`, `z_i = y(t + c_i h) - y(t)`, solve `Z = h (A ⊗ I) F(Z)`. The simplified
 //! Newton iteration uses the transformation `T⁻¹ A⁻¹ T = diag(γ, [[α, -β], [β, α]])`, so each
 //! iteration solves one real system with `γ/h·I - J` and one complex system with
-//! `(α + iβ)/h·I - J`; both are LU-factorised (partial pivoting, `lu.rs`) once per step size.
+//! `(α + iβ)/h·I - J`; both are LU-factorised (partial pivoting, `lu.rs`) once per step size,
+//! after eliminating the positions of a second-order system (`iteration.rs`).
 //! Convergence is judged by the contraction rate `θ` (stop when `θ/(1-θ)·‖ΔZ‖ ≤ κ`,
 //! `κ = max(10ε/rtol, min(0.03, √rtol))`; abort and reduce `h` if `θ ≥ 0.99` or the predicted
 //! error after 7 iterations is too large). Starting values extrapolate the collocation polynomial
@@ -52,7 +53,8 @@
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
 
-use super::{lu, FailureCause, OdeSystem, SolveError, SolveErrorKind, SolverStats};
+use super::iteration::IterationMatrices;
+use super::{FailureCause, OdeSystem, SolveError, SolveErrorKind, SolverStats};
 use nalgebra::DMatrix;
 
 /// Unit round-off used in RADAU5's formulas.
@@ -156,12 +158,8 @@ pub struct Radau5 {
     tmp: Vec<f64>,
     ftmp: Vec<f64>,
     jac: DMatrix<f64>,
-    /// LU factors of `γ/h·I - J` and `(α + iβ)/h·I - J`, column-major `n × n`.
-    e1: Vec<f64>,
-    e2_re: Vec<f64>,
-    e2_im: Vec<f64>,
-    piv1: Vec<usize>,
-    piv2: Vec<usize>,
+    /// LU factors of `γ/h·I - J` and `(α + iβ)/h·I - J`.
+    mats: IterationMatrices,
 }
 
 /// Outcome of the Newton iteration that forces a smaller step.
@@ -204,11 +202,7 @@ impl Radau5 {
             tmp: v(),
             ftmp: v(),
             jac: DMatrix::zeros(n, n),
-            e1: vec![0.0; n * n],
-            e2_re: vec![0.0; n * n],
-            e2_im: vec![0.0; n * n],
-            piv1: vec![0; n],
-            piv2: vec![0; n],
+            mats: IterationMatrices::new(n),
         };
         s.set_rtol(1e-6).expect("default tolerance is valid");
         s
@@ -391,6 +385,16 @@ impl Radau5 {
         }
         if t_end == t0 {
             return Ok(());
+        }
+        let structure = sys.second_order();
+        if structure != self.mats.structure() {
+            if let Some(s) = structure.filter(|s| !s.fits(n)) {
+                return Err(invalid_at(t0, format!("second-order structure {s:?} does not fit {n} states")));
+            }
+            self.mats.set_structure(structure);
+            if self.h_lu > 0.0 && !self.decompose(self.h_lu) {
+                self.h_lu = 0.0;
+            }
         }
         // A call that starts where the last accepted step ended continues that integration: its
         // first step extrapolates the last collocation polynomial like any other step.
@@ -596,22 +600,7 @@ impl Radau5 {
     /// step size `h`.
     fn decompose(&mut self, h: f64) -> bool {
         self.stats.lu_decompositions += 1;
-        let (fac1, alphn, betan) = (self.gamma / h, self.alpha / h, self.beta / h);
-        let n = self.n;
-        let cols = self.jac.as_slice().chunks_exact(n).zip(self.e1.chunks_exact_mut(n));
-        let cols = cols.zip(self.e2_re.chunks_exact_mut(n).zip(self.e2_im.chunks_exact_mut(n)));
-        for (j, ((jc, e1c), (e2r, e2i))) in cols.enumerate() {
-            for (((&jij, e1), e2r), e2i) in jc.iter().zip(e1c.iter_mut()).zip(e2r.iter_mut()).zip(e2i.iter_mut()) {
-                *e1 = 0.0 - jij;
-                *e2r = 0.0 - jij;
-                *e2i = 0.0;
-            }
-            e1c[j] = fac1 - jc[j];
-            e2r[j] = alphn - jc[j];
-            e2i[j] = betan;
-        }
-        let ok = lu::factor(&mut self.e1, &mut self.piv1)
-            && lu::factor_complex(&mut self.e2_re, &mut self.e2_im, &mut self.piv2);
+        let ok = self.mats.factor(&self.jac, self.gamma / h, self.alpha / h, self.beta / h);
         self.h_lu = if ok { h } else { 0.0 };
         ok
     }
@@ -704,9 +693,9 @@ impl Radau5 {
                     z2[i] = r3;
                 }
             }
-            lu::solve(&self.e1, &self.piv1, &mut self.z[0]);
-            let [_, z1, z2] = &mut self.z;
-            lu::solve_complex(&self.e2_re, &self.e2_im, &self.piv2, z1, z2);
+            let [z0, z1, z2] = &mut self.z;
+            self.mats.solve_real(z0);
+            self.mats.solve_complex(z1, z2);
             let mut dyno = 0.0;
             {
                 let [z0, z1, z2] = &self.z;
@@ -776,7 +765,7 @@ impl Radau5 {
                 tmp[i] = ftmp[i] + y0[i];
             }
         }
-        lu::solve(&self.e1, &self.piv1, &mut self.tmp);
+        self.mats.solve_real(&mut self.tmp);
         let err = self.norm(&self.tmp);
         if err < 1.0 || !refine {
             return err;
@@ -790,7 +779,7 @@ impl Radau5 {
         for ((x, &w), &f) in self.tmp.iter_mut().zip(&self.w[0]).zip(&self.ftmp) {
             *x = w + f;
         }
-        lu::solve(&self.e1, &self.piv1, &mut self.tmp);
+        self.mats.solve_real(&mut self.tmp);
         let refined = self.norm(&self.tmp);
         if refined.is_finite() {
             refined
