@@ -20,7 +20,7 @@ pub struct FmuState<M: Model> {
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Serialises a core into the checked byte format.
 pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {

@@ -330,18 +330,24 @@ impl FlexibleBoom {
     /// Global position (origin A) of the centre-line point at arm coordinate `x_a` from B
     /// (x_a < 0 is part I).
     pub fn point(&self, q: &[f64], x_a: f64) -> Vector2<f64> {
+        self.point_at(&self.trig(q), x_a)
+    }
+
+    /// [`Self::point`] with the sections' sin and cos.
+    fn point_at(&self, t: &Trig, x_a: f64) -> Vector2<f64> {
         let i = self.section_at(x_a);
-        let node = (0..i).fold(self.b, |r, j| r + self.len[j] * Vector2::new(q[j].cos(), q[j].sin()));
-        node + (x_a - self.start[i]) * Vector2::new(q[i].cos(), q[i].sin())
+        let node = (0..i).fold(self.b, |r, j| r + self.len[j] * Vector2::new(t.c[j], t.s[j]));
+        node + (x_a - self.start[i]) * Vector2::new(t.c[i], t.s[i])
     }
 
     /// Deflection of the arm's end normal to the rigid boom's centre line at the same cylinder
     /// length, positive up in the boom frame (the sign of v in 2.22).
     pub fn tip_deflection(&self, q: &[f64]) -> f64 {
-        let theta2 = self.triangle.theta2(self.l_cyl(q));
+        let t = self.trig(q);
+        let theta2 = self.triangle.theta2(self.pin_of(&t).l);
         let end = self.start[self.n - 1] + self.len[self.n - 1];
         let (s, c) = theta2.sin_cos();
-        Vector2::new(-s, c).dot(&(self.point(q, end) - self.b))
+        Vector2::new(-s, c).dot(&(self.point_at(&t, end) - self.b))
     }
 
     /// Section angles for the spring deflections `delta` (q[i + 1] - q[i]) at cylinder length
@@ -515,10 +521,9 @@ impl BoomMechanics for FlexibleBoom {
     }
 
     fn payload(&self, q: &[f64]) -> Vector2<f64> {
-        let i = self.payload_section;
-        let (s, c) = q[i].sin_cos();
-        let p = self.payload;
-        self.point(q, self.start[i]) + Vector2::new(c * p.x - s * p.y, s * p.x + c * p.y)
+        let (i, t) = (self.payload_section, self.trig(q));
+        let (s, c, p) = (t.s[i], t.c[i], self.payload);
+        self.point_at(&t, self.start[i]) + Vector2::new(c * p.x - s * p.y, s * p.x + c * p.y)
     }
 
     /// Kinetic energy of the sections and payload (node velocity v and angular velocity w of each:

@@ -54,20 +54,16 @@ pub(crate) fn solve(lu: &[f64], piv: &[usize], b: &mut [f64]) {
         b.swap(k, p);
     }
     for (j, col) in lu.chunks_exact(n).enumerate() {
-        let (head, tail) = b.split_at_mut(j + 1);
-        let bj = head[j];
-        if bj != 0.0 {
-            for (bi, &l) in tail.iter_mut().zip(&col[j + 1..]) {
-                *bi -= l * bj;
-            }
+        let bj = b[j];
+        for i in j + 1..n {
+            b[i] -= col[i] * bj;
         }
     }
     for (j, col) in lu.chunks_exact(n).enumerate().rev() {
-        let (head, tail) = b.split_at_mut(j);
-        let bj = tail[0] / col[j];
-        tail[0] = bj;
-        for (bi, &u) in head.iter_mut().zip(col) {
-            *bi -= u * bj;
+        let bj = b[j] / col[j];
+        b[j] = bj;
+        for i in 0..j {
+            b[i] -= col[i] * bj;
         }
     }
 }

@@ -297,18 +297,19 @@ impl Radau5 {
 
     /// Number of `f64` that [`save_state`](Self::save_state) writes for dimension `n`.
     pub fn saved_len(n: usize) -> usize {
-        7 + n * n + 4 * n
+        8 + n * n + 4 * n
     }
 
-    /// Number of `f64` in [`save_state`](Self::save_state): `7 + n² + 4n`.
+    /// Number of `f64` in [`save_state`](Self::save_state): `8 + n² + 4n`.
     pub fn state_len(&self) -> usize {
-        7 + self.n * self.n + 4 * self.n
+        Self::saved_len(self.n)
     }
 
     /// The persistent state carried between calls: step-size hint (0 = none), last Newton
     /// contraction, Jacobian validity (0/1), the step size of the LU factors (0 = none), size
     /// and end time of the last accepted step (size 0 = none), the Newton convergence factor
-    /// carried between steps (`θ/(1-θ)` of the last iteration), the Jacobian (column-major), the
+    /// carried between steps (`θ/(1-θ)` of the last iteration), the number of solves the LU
+    /// factors have served (`iteration.rs`: when they are inverted), the Jacobian (column-major), the
     /// collocation polynomial of the last step (3n) and its end state (n). The LU factors are
     /// not saved: they are a deterministic function of the Jacobian and their step size, and
     /// [`load_state`](Self::load_state) recomputes them bit-identically.
@@ -321,6 +322,7 @@ impl Radau5 {
             self.h_cont,
             self.t_cont,
             self.faccon,
+            self.mats.uses() as f64,
         ];
         s.extend_from_slice(self.jac.as_slice());
         for v in self.cont.iter().chain([&self.y]) {
@@ -337,10 +339,12 @@ impl Radau5 {
         }
         let jac_valid = s[2] == 1.0;
         let ok = s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && s[4] >= 0.0;
-        if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0) {
+        let uses_ok = s[7] >= 0.0 && s[7] <= u32::MAX as f64 && s[7].fract() == 0.0;
+        if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0 && uses_ok) {
             return Err(invalid(format!(
-                "step-size hint {}, contraction {}, flag {}, LU step size {}, last step {}, convergence factor {} are invalid",
-                s[0], s[1], s[2], s[3], s[4], s[6]
+                "step-size hint {}, contraction {}, flag {}, LU step size {}, last step {}, convergence factor {}, \
+                 LU uses {} are invalid",
+                s[0], s[1], s[2], s[3], s[4], s[6], s[7]
             )));
         }
         let n = self.n;
@@ -348,15 +352,18 @@ impl Radau5 {
         self.theta = s[1];
         self.jac_valid = jac_valid;
         (self.h_cont, self.t_cont, self.faccon) = (s[4], s[5], s[6]);
-        let (jac, rest) = s[7..].split_at(n * n);
+        let (jac, rest) = s[8..].split_at(n * n);
         self.jac.as_mut_slice().copy_from_slice(jac);
         for (v, saved) in self.cont.iter_mut().chain([&mut self.y]).zip(rest.chunks_exact(n)) {
             v.copy_from_slice(saved);
         }
         self.h_lu = 0.0;
-        if s[3] > 0.0 && !self.decompose(s[3]) {
-            self.jac_valid = false;
-            return Err(invalid(format!("the saved Jacobian is singular at step size {}", s[3])));
+        if s[3] > 0.0 {
+            if !self.decompose(s[3]) {
+                self.jac_valid = false;
+                return Err(invalid(format!("the saved Jacobian is singular at step size {}", s[3])));
+            }
+            self.mats.set_uses(s[7] as u32);
         }
         Ok(())
     }
@@ -391,9 +398,16 @@ impl Radau5 {
             if let Some(s) = structure.filter(|s| !s.fits(n)) {
                 return Err(invalid_at(t0, format!("second-order structure {s:?} does not fit {n} states")));
             }
+            // Refactorise for the structure (first call after construction or loading), as
+            // many solves into the factors' life as before.
+            let uses = self.mats.uses();
             self.mats.set_structure(structure);
-            if self.h_lu > 0.0 && !self.decompose(self.h_lu) {
-                self.h_lu = 0.0;
+            if self.h_lu > 0.0 {
+                if self.decompose(self.h_lu) {
+                    self.mats.set_uses(uses);
+                } else {
+                    self.h_lu = 0.0;
+                }
             }
         }
         // A call that starts where the last accepted step ended continues that integration: its
