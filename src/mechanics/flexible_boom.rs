@@ -451,7 +451,8 @@ impl BoomMechanics for FlexibleBoom {
         let c_dot = self.pin_velocity(&t, qd);
         let l_dot = u.dot(&c_dot);
         // F_rod: g_acc sin(theta1) = -u . g_vec.
-        let f_rod = f_cyl(l - self.l_retracted, l_dot) - self.m_rod * ((c_dot.norm_squared() - l_dot * l_dot) / l - (u.x * gx + u.y * gy));
+        let f_rod = f_cyl(l - self.l_retracted, l_dot)
+            - self.m_rod * ((c_dot.norm_squared() - l_dot * l_dot) / l - (u.x * gx + u.y * gy));
         let mut sweep = [Sweep::default(); MAX_SECTIONS];
         // K_(j+1) and b_(j+1); zero beyond the free end.
         let (mut kxx, mut kxy, mut kyy, mut bx, mut by) = (0.0, 0.0, 0.0, 0.0, 0.0);

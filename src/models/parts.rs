@@ -343,8 +343,8 @@ impl Boom {
     /// Typical magnitudes of q and q_dot (atol = rtol x scale): 1 mm and 1 mm/s of stroke
     /// (rigid); for the flexible boom's section angles the same 1 mm and 1 mm/s of stroke through
     /// the cylinder's lever about B (dx/dtheta2 = 0.55 m at 465 mm stroke): 2 mrad and 2 mrad/s.
-    /// The section angles themselves (0.5-0.9 rad) make rtol |q| the binding bound on q; the
-    /// beam's deflection angles (~1 mrad) are thereby resolved to ~1e-9 rad.
+    /// Away from the horizontal the section angles themselves (tenths of a radian) make
+    /// rtol |q| the binding bound; the beam's deflection angles (~1 mrad) are resolved to ~1e-9.
     pub(crate) fn scale(&self) -> impl Iterator<Item = f64> {
         let dof = self.mechanics().dof();
         let (q, qd) = if let Boom::Rigid(_) = self { (1e-3, 1e-3) } else { (2e-3, 2e-3) };

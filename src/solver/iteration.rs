@@ -325,7 +325,8 @@ mod tests {
     /// A Jacobian with the declared structure (identity rows for the positions) and otherwise
     /// arbitrary, well-conditioned entries.
     fn structured_jacobian(n: usize, s: SecondOrder) -> DMatrix<f64> {
-        let mut j = DMatrix::from_fn(n, n, |i, k| ((i * 7 + k * 13) % 11) as f64 - 5.0 + if i == k { -30.0 } else { 0.0 });
+        let mut j =
+            DMatrix::from_fn(n, n, |i, k| ((i * 7 + k * 13) % 11) as f64 - 5.0 + if i == k { -30.0 } else { 0.0 });
         for k in 0..s.len {
             j.row_mut(s.pos + k).fill(0.0);
             j[(s.pos + k, s.vel + k)] = 1.0;
@@ -335,40 +336,41 @@ mod tests {
 
     /// The reduced solves equal the dense solve of the full `a·I - J` (nalgebra's LU, a second
     /// implementation), for the real and the complex shift, with the positions before and after
-    /// the velocities; and without structure. Bound: 1e-12 relative, a few hundred ulps of
+    /// the velocities, and without structure; by triangular sweeps and by the inverses. Bound: 1e-12 relative, a few hundred ulps of
     /// the two eliminations' round-off on a matrix of condition ~10.
     #[test]
     fn reduced_solve_equals_full_solve() {
         let n = 8;
         let (fac1, alphn, betan) = (3.6, 2.7, 1.9);
-        for structure in [
-            Some(SecondOrder { pos: 2, vel: 5, len: 3 }),
-            Some(SecondOrder { pos: 5, vel: 1, len: 3 }),
-            None,
-        ] {
+        for structure in
+            [Some(SecondOrder { pos: 2, vel: 5, len: 3 }), Some(SecondOrder { pos: 5, vel: 1, len: 3 }), None]
+        {
             let j = structured_jacobian(n, structure.unwrap_or(SecondOrder { pos: 0, vel: 0, len: 0 }));
             let mut m = IterationMatrices::new(n);
             m.set_structure(structure);
             assert!(m.factor(&j, fac1, alphn, betan));
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin() + 0.1).collect();
             let c: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
+            // Every solve before and after the factors are inverted (INVERT_AFTER) is checked.
+            for _ in 0..INVERT_AFTER + 2 {
+                let e1 = DMatrix::identity(n, n) * fac1 - &j;
+                let want = e1.lu().solve(&DVector::from_column_slice(&b)).unwrap();
+                let mut got = b.clone();
+                m.solve_real(&mut got);
+                let err = (DVector::from_column_slice(&got) - &want).amax() / want.amax();
+                assert!(err < 1e-12, "{structure:?}: real error {err}");
 
-            let e1 = DMatrix::identity(n, n) * fac1 - &j;
-            let want = e1.lu().solve(&DVector::from_column_slice(&b)).unwrap();
-            let mut got = b.clone();
-            m.solve_real(&mut got);
-            let err = (DVector::from_column_slice(&got) - &want).amax() / want.amax();
-            assert!(err < 1e-12, "{structure:?}: real error {err}");
-
-            let a = Complex::new(alphn, betan);
-            let e2 = DMatrix::from_fn(n, n, |i, k| if i == k { a } else { Complex::new(0.0, 0.0) } - j[(i, k)]);
-            let rhs = DVector::from_fn(n, |i, _| Complex::new(b[i], c[i]));
-            let want = e2.lu().solve(&rhs).unwrap();
-            let (mut gr, mut gi) = (b.clone(), c.clone());
-            m.solve_complex(&mut gr, &mut gi);
-            let err = (0..n).map(|i| (Complex::new(gr[i], gi[i]) - want[i]).norm()).fold(0.0, f64::max);
-            let scale = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
-            assert!(err < 1e-12 * scale, "{structure:?}: complex error {err}");
+                let a = Complex::new(alphn, betan);
+                let e2 = DMatrix::from_fn(n, n, |i, k| if i == k { a } else { Complex::new(0.0, 0.0) } - j[(i, k)]);
+                let rhs = DVector::from_fn(n, |i, _| Complex::new(b[i], c[i]));
+                let want = e2.lu().solve(&rhs).unwrap();
+                let (mut gr, mut gi) = (b.clone(), c.clone());
+                m.solve_complex(&mut gr, &mut gi);
+                let err = (0..n).map(|i| (Complex::new(gr[i], gi[i]) - want[i]).norm()).fold(0.0, f64::max);
+                let scale = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
+                assert!(err < 1e-12 * scale, "{structure:?}: complex error {err}");
+            }
+            assert!(m.inverted, "the last solves used the inverses");
         }
     }
 
