@@ -56,6 +56,9 @@ def components(system: str, sc: dict, boom: str, coupling: str) -> tuple[dict, l
     if np.ptp(sc["reference"][:, 1]) != 0:
         raise ValueError(f"{sc['id']}: the SSP binds a constant operator reference; this one varies")
     ctrl["u_ref"] = u_ref
+    # the importers are Jacobi masters (no input derivatives, u read before p4 of the step end is
+    # passed): the controller extrapolates p4 from its last two samples (scripts/README.md, "SSP")
+    ctrl["p.extrapolation"] = True
     flexible = boom == "flexible"
     if system == "monolithic":
         plant = {"start.x": sc["start_stroke"], "boom.flexible": flexible, **sc["plant"]}
