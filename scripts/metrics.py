@@ -22,6 +22,11 @@ BAND = 0.02
 WINDOW = 1.0
 #: Motion start: the cylinder lowers faster than this fraction of the expected steady speed.
 MOTION_FRACTION = 0.1
+#: p3 oscillates when its dominant spectral peak is at least this large [bar] (the same limit as
+#: f_dom's comparison in baselines/tolerances.toml).
+OSCILLATING = 0.5
+#: Hysteresis of the cycle detection, as a fraction of the swing (ringing near the mean is not a cycle).
+HYSTERESIS = 0.1
 
 
 def expected_velocity(u_ref: float) -> float:
@@ -80,10 +85,24 @@ def dominant_frequency(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     return float(f[i]), float(spec[i])
 
 
+def whole_cycles(t: np.ndarray, y: np.ndarray, hysteresis: float = HYSTERESIS):
+    """(t_a, t_b): the first and last upward crossings of y through its mean, linearly
+    interpolated between samples, so that [t_a, t_b] holds whole periods. A crossing counts only
+    after y has been below mean - hysteresis * swing. None with fewer than two crossings."""
+    mean, low = y.mean(), y.mean() - hysteresis * np.ptp(y)
+    ups, armed = [], False
+    for i in range(1, len(y)):
+        armed = armed or y[i - 1] < low
+        if armed and y[i - 1] < mean <= y[i]:
+            ups.append(t[i - 1] + (mean - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]))
+            armed = False
+    return (ups[0], ups[-1]) if len(ups) >= 2 else None
+
+
 def compute(res) -> dict:
     """The regression metrics of one result (see scripts/README.md)."""
     d = res.data
-    t, p3, v, u_comp = d["time"], d["p3"], d["cylinder.v"], d["u_comp"]
+    t, p3, u_comp = d["time"], d["p3"], d["u_comp"]
     u_ss = float(res.scenario["reference"][-1, 1])
     v_exp = expected_velocity(u_ss)
     t_end = t[-1]
@@ -109,14 +128,20 @@ def compute(res) -> dict:
     m["t_settle"] = ts
     m["t_settle_motion"] = None if ts is None else max(0.0, ts - m["t_motion"])
     m["v_expected"] = v_exp * 1e3
-    # mean velocity from the motion start to the end: displacement / time
+    f, amp = dominant_frequency(t[late], p3[late])
+    # Velocities are displacement / time. While p3 oscillates (U's limit cycle: the velocity
+    # swings by +-120 mm/s around its mean) they end at the last whole cycle of p3 and the steady
+    # one spans whole cycles: a window with a fraction of a period left over is biased by up to
+    # amplitude / (pi f window), +-17 % of U's mean over 5 s, depending on where in the cycle the
+    # record ends.
+    x = d["cylinder.x"]
+    cycles = whole_cycles(t[late], p3[late]) if amp / BAR >= OSCILLATING else None
+    t_a, t_b = cycles if cycles else (t[late][0], t_end)
     if m["t_motion"] is not None:
-        i0 = moving[0]
-        m["v_mean"] = float((d["cylinder.x"][-1] - d["cylinder.x"][i0]) / (t_end - t[i0]) * 1e3)
+        m["v_mean"] = float((np.interp(t_b, t, x) - x[moving[0]]) / (t_b - m["t_motion"]) * 1e3)
     else:
         m["v_mean"] = 0.0
-    m["v_steady"] = float(v[late].mean() * 1e3)
-    f, amp = dominant_frequency(t[late], p3[late])
+    m["v_steady"] = float((np.interp(t_b, t, x) - np.interp(t_a, t, x)) / (t_b - t_a) * 1e3)
     m["f_dom"] = f
     m["f_dom_amp"] = amp / BAR
     after = t >= (ts if ts is not None else t_end - t_end / 3)
@@ -134,8 +159,8 @@ DEFINITIONS = {
     "t_motion": ("s", "motion start: CBV outflow above 10 % of the expected steady flow"),
     "t_cbv_open": ("s", "first opening of the CBV's load-holding valve"),
     "v_expected": ("mm/s", "-Q_rated |u_ref| / A_rod_side"),
-    "v_mean": ("mm/s", "mean velocity from the motion start to the end (displacement / time)"),
-    "v_steady": ("mm/s", "mean velocity over the last third"),
+    "v_mean": ("mm/s", "mean velocity from the motion start to the end, or to the last whole p3 cycle when p3 oscillates (displacement / time)"),
+    "v_steady": ("mm/s", "mean velocity over the last third, or over its whole p3 cycles when p3 oscillates (displacement / time)"),
     "f_dom": ("Hz", "dominant frequency of p3 over the last third (>= 0.3 Hz)"),
     "f_dom_amp": ("bar", "amplitude of that spectral peak"),
     "u_comp_rms": ("1", "RMS of u_comp after the settling time (last third if not settled)"),

@@ -9,7 +9,9 @@ each a zip of SystemStructure.ssd (components, connectors, connections, inline p
 of the scenario, default experiment) and resources/<FMU>.fmu; then runs both in fmpy's SSP
 simulator, libcosimpy (CosimExecution.from_ssp_file) and ecospy (EcosSimulation(ssp_path=...))
 and compares the regression metrics with the fmpy runner (cosim.py / split.py, Jacobi for the
-split system, as these masters step all FMUs from the same values).
+split system, as these masters step all FMUs from the same values). The controller is bound with
+p.extrapolation = true: these masters pass no input derivatives and read its command before they
+pass the new p4, so it extrapolates p4 from its last two samples (scripts/README.md, "Coupling").
 
 The operator reference of the scenario must be constant (U, B, ...): it is bound as the start value
 of the controller's u_ref input. Masters that start the connections at 0 (fmpy's simulate_ssp) get
@@ -56,6 +58,9 @@ def components(system: str, sc: dict, boom: str, coupling: str) -> tuple[dict, l
     if np.ptp(sc["reference"][:, 1]) != 0:
         raise ValueError(f"{sc['id']}: the SSP binds a constant operator reference; this one varies")
     ctrl["u_ref"] = u_ref
+    # the importers are Jacobi masters (no input derivatives, u read before p4 of the step end is
+    # passed): the controller extrapolates p4 from its last two samples (scripts/README.md, "SSP")
+    ctrl["p.extrapolation"] = True
     flexible = boom == "flexible"
     if system == "monolithic":
         plant = {"start.x": sc["start_stroke"], "boom.flexible": flexible, **sc["plant"]}

@@ -212,6 +212,9 @@ impl<M: Model> Instance<M> {
                 return Err(e);
             }
         }
+        if let (State::StepComplete, Some(model)) = (self.core.state, self.core.model.as_mut()) {
+            model.inputs_set(vrs);
+        }
         self.core.outputs_current = false;
         Ok(())
     }

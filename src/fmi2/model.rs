@@ -62,6 +62,11 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Writes outputs and locals from the current state and inputs.
     fn outputs(&self, values: &mut Values);
 
+    /// The master set the variables `vrs` between two steps (inputs and tunable parameters,
+    /// after [`Model::retune`]): a model that extrapolates an input takes a new value as a sample
+    /// at the current time. Default: nothing to do.
+    fn inputs_set(&mut self, _vrs: &[u32]) {}
+
     /// Advances from `t` to `t + h`. Inputs are `values` at `t`, changing with the given first
     /// derivatives (one per table row; zero unless set) when the model interpolates inputs.
     fn do_step(

@@ -1,6 +1,15 @@
 //! The PressureFeedbackController FMU model: the high-pass filtered pressure feedback of thesis
 //! section 6.1 ([`crate::control::pressure_feedback`]) with operator reference and output limits.
+//!
+//! The fed-back pressure over a step is a [`Ramp`]: its value at the step start and the slope the
+//! master passes with fmi2SetRealInputDerivatives (0: held). With `p.extrapolation` a step without
+//! a slope takes it from the last two received samples, `(p_k - p_k-1) / (t_k - t_k-1)`, and the
+//! outputs after the step use `p_k + slope h` until the master sets the next sample: a Jacobi
+//! master, which steps plant and controller from the values at t_k and reads u before it passes
+//! p_k+1, then gets the command of the Gauss-Seidel order (plant first, controller with the
+//! slope of p over the step) to second order in h.
 
+use super::port::Ramp;
 use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 
@@ -17,6 +26,7 @@ pub mod vr {
     pub const U_MIN: u32 = 8;
     pub const U_MAX: u32 = 9;
     pub const P_LP: u32 = 10;
+    pub const EXTRAPOLATION: u32 = 11;
 }
 
 /// Admissible fed-back pressure: absolute zero (gauge) up to 1000 bar, far above the PVG32's
@@ -75,6 +85,13 @@ const VARIABLES: &[Variable] = &[
         "bar",
         "Filter state: low-passed pressure x, x' = omega_f (p - x)",
     ),
+    Variable::bool_param(
+        "p.extrapolation",
+        vr::EXTRAPOLATION,
+        false,
+        "Without an input derivative of p, extrapolate p linearly through its last two received samples (for Jacobi masters: libcosim, ecos, fmpy's SSP simulator); false holds p over a step",
+    )
+    .fixed(),
 ];
 
 const DOCUMENTATION: &str = r#"<p>High-pass filtered pressure feedback of thesis section 6.1 (Fig. 6.1, 6.2).
@@ -85,39 +102,84 @@ u = clamp(u<sub>ref</sub> + u<sub>comp</sub>, u<sub>min</sub>, u<sub>max</sub>).
 A falling pressure opens the valve further in the lowering direction (u &lt; 0), a rising one closes it.</p>
 <p>Realisation: x' = &omega;<sub>f</sub>(p &minus; x), Q<sub>f</sub> = K<sub>f</sub>&omega;<sub>f</sub>(p &minus; x), advanced exactly
 for inputs that are constant or linear over a step (set the slope with fmi2SetRealInputDerivatives, order 1), so any
-communication step gives the same result. The filter starts at rest at the initial pressure (x = p at the end of
-initialisation): no kick at t = 0. Defaults: experiment B (K<sub>f</sub> = 1.24e-11 m<sup>4</sup>s<sup>2</sup>/kg,
+communication step gives the same result. Masters that step all FMUs from the values at the same communication
+point (Jacobi: libcosim, ecos, fmpy's SSP simulator) pass no slope and read <i>u</i> before they pass the new
+<i>p</i>: with <code>p.extrapolation</code> = true the controller then extrapolates <i>p</i> through its last two
+received samples over the step and for the outputs at its end, which gives the command of a master that steps the
+plant first and passes the slope (default false: <i>p</i> held). The filter starts at rest at the initial pressure
+(x = p at the end of initialisation): no kick at t = 0. Defaults: experiment B (K<sub>f</sub> = 1.24e-11 m<sup>4</sup>s<sup>2</sup>/kg,
 &omega;<sub>f</sub> = 35.8 rad/s, Table 7.2).</p>"#;
 
-/// The controller's parameters and filter state.
+/// The controller's parameters, filter state and fed-back pressure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PressureFeedbackController {
     feedback: HighPassFeedback,
     enable: bool,
     u_min: f64,
     u_max: f64,
+    /// `p.extrapolation`.
+    extrapolate: bool,
     /// Low-passed pressure x [Pa].
     x: f64,
+    /// Time of `x` (the end of the last step).
+    t: f64,
+    /// The pressure over the last step: its sample at the step start and the slope used.
+    p: Ramp,
+    /// Whether `p` holds a received sample (false before the first step).
+    sampled: bool,
+    /// Whether the master set p since the last step (a sample at the current time).
+    fresh: bool,
 }
 
 impl PressureFeedbackController {
+    /// The controller with filter state `x`, at rest at the current input p.
     fn from_values(values: &Values, x: f64) -> Result<Self, String> {
-        let (u_min, u_max) = (values.real(vr::U_MIN), values.real(vr::U_MAX));
-        if u_min >= u_max {
-            return Err(format!("u_min = {u_min} must be less than u_max = {u_max}"));
-        }
-        let feedback = HighPassFeedback {
-            k_f: values.real(vr::K_F),
-            omega_f: values.real(vr::OMEGA_F),
-            q_rated: values.real(vr::Q_RATED),
+        let mut c = PressureFeedbackController {
+            feedback: HighPassFeedback::default(),
+            enable: true,
+            u_min: -1.0,
+            u_max: 1.0,
+            extrapolate: values.boolean(vr::EXTRAPOLATION),
+            x,
+            t: 0.0,
+            p: Ramp { t0: 0.0, y0: values.real(vr::P), slope: 0.0 },
+            sampled: false,
+            fresh: true,
         };
-        Ok(PressureFeedbackController { feedback, enable: values.boolean(vr::ENABLE), u_min, u_max, x })
+        c.retune(values)?;
+        Ok(c)
     }
 
-    /// (u_comp, unclamped u) for the current inputs.
-    fn command(&self, values: &Values) -> (f64, f64) {
-        let u_comp = if self.enable { self.feedback.u_comp(values.real(vr::P), self.x) } else { 0.0 };
+    /// The fed-back pressure now: the extrapolated one after a step until the master sets the
+    /// next sample, else the input.
+    fn pressure(&self, values: &Values) -> f64 {
+        if self.extrapolate && self.sampled && !self.fresh {
+            self.p.at(self.t)
+        } else {
+            values.real(vr::P)
+        }
+    }
+
+    /// (u_comp, unclamped u) for pressure `p`.
+    fn command(&self, values: &Values, p: f64) -> (f64, f64) {
+        let u_comp = if self.enable { self.feedback.u_comp(p, self.x) } else { 0.0 };
         (u_comp, values.real(vr::U_REF) + u_comp)
+    }
+
+    /// The pressure over the step from `t`: the input with the master's slope; with
+    /// `p.extrapolation` and no slope, a new sample with the slope through the previous one, or,
+    /// if the master set none since the last step, the last ramp continued.
+    fn pressure_ramp(&self, values: &Values, input_derivatives: &[f64], t: f64) -> Ramp {
+        let given = Ramp::read(values, input_derivatives, vr::P, t);
+        if !self.extrapolate || given.slope != 0.0 {
+            given
+        } else if !self.fresh {
+            self.p
+        } else if self.sampled && t > self.p.t0 {
+            Ramp { slope: (given.y0 - self.p.y0) / (t - self.p.t0), ..given }
+        } else {
+            given
+        }
     }
 }
 
@@ -140,16 +202,30 @@ impl Model for PressureFeedbackController {
         Self::from_values(values, values.real(vr::P))
     }
 
+    /// Re-reads the tunable parameters; keeps the filter state and the pressure samples.
     fn retune(&mut self, values: &Values) -> Result<(), String> {
-        *self = Self::from_values(values, self.x)?;
+        let (u_min, u_max) = (values.real(vr::U_MIN), values.real(vr::U_MAX));
+        if u_min >= u_max {
+            return Err(format!("u_min = {u_min} must be less than u_max = {u_max}"));
+        }
+        self.feedback = HighPassFeedback {
+            k_f: values.real(vr::K_F),
+            omega_f: values.real(vr::OMEGA_F),
+            q_rated: values.real(vr::Q_RATED),
+        };
+        (self.enable, self.u_min, self.u_max) = (values.boolean(vr::ENABLE), u_min, u_max);
         Ok(())
     }
 
     fn outputs(&self, values: &mut Values) {
-        let (u_comp, u) = self.command(values);
+        let (u_comp, u) = self.command(values, self.pressure(values));
         values.set_real(vr::U_COMP, u_comp);
         values.set_real(vr::U, u.clamp(self.u_min, self.u_max));
         values.set_real(vr::P_LP, self.x);
+    }
+
+    fn inputs_set(&mut self, vrs: &[u32]) {
+        self.fresh |= vrs.contains(&vr::P);
     }
 
     fn do_step(
@@ -161,9 +237,10 @@ impl Model for PressureFeedbackController {
         _tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        let dp = values.position(vr::P).map_or(0.0, |i| input_derivatives[i]);
-        self.x = self.feedback.advance(self.x, values.real(vr::P), dp, h);
-        let (_, u) = self.command(values);
+        let p = self.pressure_ramp(values, input_derivatives, t);
+        self.x = self.feedback.advance(self.x, p.at(t), p.slope, h);
+        (self.p, self.sampled, self.fresh, self.t) = (p, true, false, t + h);
+        let (_, u) = self.command(values, p.at(self.t));
         if u < self.u_min || u > self.u_max {
             log.info(
                 "logSaturation",
@@ -174,13 +251,22 @@ impl Model for PressureFeedbackController {
     }
 
     fn save(&self) -> Vec<f64> {
-        vec![self.x]
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        vec![self.x, self.t, self.p.t0, self.p.y0, self.p.slope, flag(self.sampled), flag(self.fresh)]
     }
 
     fn load(values: &Values, state: &[f64]) -> Result<Self, String> {
-        match state {
-            [x] if x.is_finite() => Self::from_values(values, *x),
-            _ => Err(format!("expected one finite filter state, got {state:?}")),
+        match *state {
+            [x, t, t0, y0, slope, sampled, fresh]
+                if state.iter().all(|v| v.is_finite()) && [sampled, fresh].iter().all(|f| *f == 0.0 || *f == 1.0) =>
+            {
+                let c = Self::from_values(values, x)?;
+                let p = Ramp { t0, y0, slope };
+                Ok(PressureFeedbackController { t, p, sampled: sampled == 1.0, fresh: fresh == 1.0, ..c })
+            }
+            _ => Err(format!(
+                "expected the filter state, time, pressure ramp (t0, p, slope) and two flags (0/1), all finite; got {state:?}"
+            )),
         }
     }
 }

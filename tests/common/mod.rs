@@ -97,6 +97,16 @@ impl<M: Model> Slave<M> {
         unsafe { api::set_real::<M>(self.c, &vr, 1, &x) }
     }
 
+    pub fn set_boolean(&self, vr: u32, x: bool) -> fmi2Status {
+        let x = if x { FMI2_TRUE } else { FMI2_FALSE };
+        unsafe { api::set_boolean::<M>(self.c, &vr, 1, &x) }
+    }
+
+    /// fmi2SetRealInputDerivatives, first order.
+    pub fn set_slope(&self, vr: u32, d: f64) -> fmi2Status {
+        unsafe { api::set_real_input_derivatives::<M>(self.c, &vr, 1, &1, &d) }
+    }
+
     pub fn real(&self, vr: u32) -> f64 {
         let mut x = f64::NAN;
         assert_eq!(unsafe { api::get_real::<M>(self.c, &vr, 1, &mut x) }, fmi2Status::OK);

@@ -77,12 +77,13 @@ def test_plain_port_compresses_the_oil_column(circuit):
 #: (scenario, boom, coupling, communication step): each coupling at a step where it meets 2 %.
 EQUIVALENCE = [
     ("U", "rigid", "tlm", 1e-3),
+    ("U", "flexible", "tlm", 1e-3),
     ("B", "rigid", "tlm", 1e-3),
     ("B", "flexible", "tlm", 1e-3),
     ("B", "rigid", "plain", 1e-3),
-    # U's cavitating limit cycle needs the plain port at 0.1 ms for its steady velocity (2.7 %
-    # off at 0.25 ms, 7 % at 0.5 ms): the force held over a step feeds energy into the cycle
-    ("U", "rigid", "plain", 1e-4),
+    # at 1 ms the held force feeds energy into U's cavitating limit cycle: its spectral amplitude
+    # is 2.5 % high (100.9 against 98.4 bar), 0.9 % at 0.5 ms
+    ("U", "rigid", "plain", 5e-4),
 ]
 
 
@@ -149,23 +150,32 @@ def test_monolithic_rings_down_in_the_stability_scenario():
 # --------------------------------------------------------------------------- SSP
 
 
+#: Scenarios run through the SSPs: U (no feedback: the coupling of the plant) and B (the feedback,
+#: whose rod-side build-up is sensitive to how the master feeds the controller).
+SSP_SCENARIOS = ("U", "B")
+
+
 @pytest.fixture(scope="module")
 def ssp_files(tmp_path_factory):
-    """Both SSPs for scenario U (constant reference, no feedback: the coupling of the plant is
-    what the importers must reproduce)."""
-    sc = cosim.load_scenario("U")
+    """Both SSPs for each scenario of SSP_SCENARIOS."""
     out = tmp_path_factory.mktemp("ssp")
-    return sc, {s: ssp.write(s, sc, "rigid", "tlm", out) for s in ("monolithic", "split")}
+    files = {}
+    for sid in SSP_SCENARIOS:
+        sc = cosim.load_scenario(sid)
+        files[sid] = (sc, {s: ssp.write(s, sc, "rigid", "tlm", out / sid) for s in ("monolithic", "split")})
+    return files
 
 
 def test_ssd_validates_against_the_ssp_schema(ssp_files):
     """fmpy's read_ssd validates SystemStructure.ssd against the SSP 1.0 XSD; the bindings
-    carry the scenario and the split system's start.F is BoomMechanics' holding force."""
+    carry the scenario, the split system's start.F is BoomMechanics' holding force and the
+    controller extrapolates p4 (the importers are Jacobi masters)."""
     from fmpy.ssp.ssd import read_ssd
 
-    sc, files = ssp_files
+    sc, files = ssp_files["B"]
     for path in files.values():
         read_ssd(str(path), validate=True)
+        assert ssp.bindings(path)["Controller"]["p.extrapolation"] in (True, "true")
     b = ssp.bindings(files["split"])
     assert float(b["Controller"]["u_ref"]) == sc["reference"][0, 1]
     assert float(b["Circuit"]["start.F"]) == pytest.approx(23751.0, abs=1.0)
@@ -173,16 +183,31 @@ def test_ssd_validates_against_the_ssp_schema(ssp_files):
 
 @pytest.fixture(scope="module")
 def ssp_references(ssp_files):
-    sc, _ = ssp_files
-    return {s: ssp.reference(s, sc, "rigid", "tlm", 1e-3) for s in ("monolithic", "split")}
+    return {(sid, s): ssp.reference(s, sc, "rigid", "tlm", 1e-3)
+            for sid, (sc, _) in ssp_files.items() for s in ("monolithic", "split")}
+
+
+#: Metrics an importer cannot reproduce, with the reason. fmpy's simulate_ssp starts every
+#: connection at 0 for the first step: in the split system the TLM waves then drop the 23.7 kN
+#: load for 1 ms, a ~1 bar pulse in p4 that the high-pass filter answers with u_comp up to 0.14
+#: within 10 ms (0.09 without p.extrapolation). Such a metric is compared after that start (the
+#: runner's largest u_comp, 0.051, comes at 0.076 s: the pressure peak of the build-up).
+FIRST_STEP = {("fmpy", "split", "B"): {"u_comp_max"}}
+#: Start-up excluded from those metrics [s].
+START_UP = 0.05
 
 
 @pytest.mark.parametrize("tool", list(ssp.IMPORTERS))
 @pytest.mark.parametrize("system", ["monolithic", "split"])
-def test_ssp_runs_in_importer(ssp_files, ssp_references, tool, system):
-    """The SSP in `tool` gives the fmpy runner's metrics within 2 % (+ floors)."""
-    sc, files = ssp_files
+@pytest.mark.parametrize("sid", SSP_SCENARIOS)
+def test_ssp_runs_in_importer(ssp_files, ssp_references, tool, system, sid):
+    """The SSP in `tool` gives the fmpy runner's metrics within 2 % (+ floors): for B, the motion
+    starts at 2.80 s as in the runner only because the controller extrapolates p4 (3.73 s with
+    p4 held)."""
+    sc, files = ssp_files[sid]
     data = ssp.IMPORTERS[tool](files[system], system, sc["stop_time"], 1e-3)
     got = mx.compute(ssp.as_result(data, sc, "rigid", 1e-3))
-    bad = {k: (m, s) for k, (m, s, ok) in split.compare(ssp_references[system], got).items() if not ok}
-    assert not bad, f"{tool} / {system}: fmpy runner vs SSP {bad}"
+    for k in FIRST_STEP.get((tool, system, sid), ()):
+        got[k] = float(data[k.removesuffix("_max")][data["time"] > START_UP].max())
+    bad = {k: (m, s) for k, (m, s, ok) in split.compare(ssp_references[sid, system], got).items() if not ok}
+    assert not bad, f"{tool} / {system} / {sid}: fmpy runner vs SSP {bad}"
