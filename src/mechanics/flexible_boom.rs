@@ -492,9 +492,9 @@ impl BoomMechanics for FlexibleBoom {
                 ixy += mu.x * u.y;
                 iyy += mu.y * u.y;
             }
-            (kxx, kxy, kyy) = (ixx - hx * hx / d, ixy - hx * hy / d, iyy - hy * hy / d);
             let inv_d = 1.0 / d;
             let (hdx, hdy) = (hx * inv_d, hy * inv_d);
+            (kxx, kxy, kyy) = (ixx - hx * hdx, ixy - hx * hdy, iyy - hy * hdy);
             let ed = (e0 - (x * betay - y * betax)) * inv_d;
             // b = beta + (fx, fy) + h e / d, written as a linear map of beta (shorter b -> b path).
             (bx, by) = (

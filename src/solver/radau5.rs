@@ -522,17 +522,21 @@ impl Radau5 {
                 fail = Some(FailureCause::ErrorTest);
                 continue;
             }
-            // Candidate new state and f there; a non-finite f rejects the step.
+            // Candidate new state and f there, which starts the next step; a non-finite f
+            // rejects the step. The last step of a call skips it: the next call evaluates f
+            // there itself (with its own inputs), and the Newton iteration's last evaluation
+            // of the final stage lies within its tolerance of this state.
             for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(&self.z[2]) {
                 *x = y + z;
             }
-            sys.rhs(tph, &self.tmp, &mut self.ftmp);
-            self.stats.rhs_evals += 1;
-            if !all_finite(&self.ftmp) {
-                h *= 0.5;
-                last = false;
-                fail = Some(FailureCause::NonFiniteRhs);
-                continue;
+            if !last {
+                sys.rhs(tph, &self.tmp, &mut self.ftmp);
+                self.stats.rhs_evals += 1;
+                if !all_finite(&self.ftmp) {
+                    h *= 0.5;
+                    fail = Some(FailureCause::NonFiniteRhs);
+                    continue;
+                }
             }
 
             // Accepted.
@@ -551,7 +555,9 @@ impl Radau5 {
             hold = h;
             t = tph;
             self.y.copy_from_slice(&self.tmp);
-            self.y0.copy_from_slice(&self.ftmp);
+            if !last {
+                self.y0.copy_from_slice(&self.ftmp);
+            }
             self.update_scal();
             self.update_cont();
             (self.h_cont, self.t_cont) = (h, t);
