@@ -9,7 +9,7 @@
 //! `(α + iβ)/h·I - J`; both are LU-factorised (partial pivoting, `lu.rs`) once per step size,
 //! after eliminating the positions of a second-order system (`iteration.rs`).
 //! Convergence is judged by the contraction rate `θ` (stop when `θ/(1-θ)·‖ΔZ‖ ≤ κ`,
-//! `κ = max(10ε/rtol, min(0.03, √rtol))`; abort and reduce `h` if `θ ≥ 0.99` or the predicted
+//! `κ = max(10ε/rtol, 0.01)` (`KAPPA`); abort and reduce `h` if `θ ≥ 0.99` or the predicted
 //! error after 7 iterations is too large). Starting values extrapolate the collocation polynomial
 //! of the previous accepted step, also across `integrate` calls when the call continues the
 //! last one (see below); zero otherwise.
@@ -66,6 +66,13 @@ const UROUND: f64 = 1e-16;
 const NIT: u32 = 7;
 /// Safety factor of the step-size controller.
 const SAFE: f64 = 0.9;
+/// Newton stopping tolerance κ, in units of the error tolerance: the lower end of the range
+/// 1e-2..1e-1 that Hairer–Wanner (IV.8) recommend. radau5.f's default `min(0.03, √rtol')` with
+/// its internal `rtol' = 0.1 rtol^(2/3)` gives 3e-3 at rtol 1e-6, and 1e-3 if applied to the
+/// untransformed rtol used here. Measured against rtol 1e-9 references: every output of the
+/// flexible boom's U (15 s) within 2.5 tolerance units (1.2 at κ = 1e-3), B unchanged, the oil
+/// column of the solver tests within 1.6 units; 10-12 % fewer RHS evaluations.
+const KAPPA: f64 = 0.01;
 /// Reuse the Jacobian while the Newton contraction rate is below this.
 const THET: f64 = 0.01;
 /// `h_new/h >= 1/FACL`.
@@ -431,7 +438,7 @@ impl Radau5 {
         }
         self.update_scal();
 
-        let fnewt = (10.0 * UROUND / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
+        let fnewt = (10.0 * UROUND / self.rtol).max(KAPPA);
         let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_end.abs());
         let cfac = SAFE * (1 + 2 * NIT) as f64;
 
