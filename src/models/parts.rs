@@ -345,10 +345,10 @@ impl Boom {
     /// lever about B, dx/dtheta2 = 0.55 m at 465 mm; away from the horizontal rtol |q| binds
     /// anyway) and 0.1 rad/s for their rates, the boom's angular rate while lowering (U peaks at
     /// 0.24 rad/s). Convergence study (scenario U, 15 s, against rtol 1e-9): every output stays as
-    /// close to the reference as with 2 mrad/s (pressures 28 Pa, stroke 2e-8 m, tip deflection
-    /// 1e-7 m, section angles 5e-8 rad, all regression metrics to 5 digits), while the tighter
-    /// scale made the integrator resolve the beam's chatter during cylinder stiction (v < v_s) to
-    /// 1e-9 rad/s at a third more steps.
+    /// close to the reference as with 2 mrad/s (pressures within 28 Pa, stroke 2e-8 m, tip
+    /// deflection 1e-7 m, section angles 5e-8 rad, regression metrics to 5 digits, both at a Newton
+    /// tolerance of 1e-3), while the tighter scale made the integrator resolve the beam's chatter
+    /// during cylinder stiction (v < v_s) to 1e-9 rad/s at a third more steps.
     pub(crate) fn scale(&self) -> impl Iterator<Item = f64> {
         let dof = self.mechanics().dof();
         let (q, qd) = if let Boom::Rigid(_) = self { (1e-3, 1e-3) } else { (2e-3, 0.1) };
