@@ -204,6 +204,12 @@ fn deflection(json: bool) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
+    // A closed pipe (`boomsim eigen --json | head`) ends the program quietly, as it does other
+    // command-line tools, instead of a panic in println!.
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread or output exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let result = match Cli::parse().command {
         Cmd::Pack { out } => pack(&out),
         Cmd::Bench { json, duration } => bench(json, duration),
