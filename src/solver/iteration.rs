@@ -216,7 +216,7 @@ impl IterationMatrices {
     /// Restores the count of [`uses`](Self::uses) after a refactorisation from a saved state.
     pub(crate) fn set_uses(&mut self, uses: u32) {
         self.uses = uses;
-        if uses >= INVERT_AFTER {
+        if uses >= INVERT_AFTER && !self.keep.is_empty() {
             self.invert();
         }
     }
@@ -411,6 +411,27 @@ mod tests {
                 assert!(err < 1e-12 * scale, "{structure:?}: complex error {err}");
             }
             assert!(m.inverted, "the last solves used the inverses");
+        }
+    }
+
+    /// With every state decoupled (a diagonal Jacobian, e.g. a circuit whose valves are all
+    /// closed) nothing is left to factorise: x_i = b_i / (a - J_ii) exactly, also after
+    /// INVERT_AFTER solves.
+    #[test]
+    fn all_states_decoupled() {
+        let j = DMatrix::from_diagonal(&DVector::from_column_slice(&[-2.0, -30.0, -0.5]));
+        let mut m = IterationMatrices::new(3);
+        assert!(m.factor(&j, 4.0, 3.0, 1.5));
+        for _ in 0..2 * INVERT_AFTER {
+            let mut x = [1.0, 2.0, 3.0];
+            m.solve_real(&mut x);
+            assert_eq!(x, [1.0 / 6.0, 2.0 / 34.0, 3.0 / 4.5]);
+            let (mut xr, mut xi) = ([1.0; 3], [0.0; 3]);
+            m.solve_complex(&mut xr, &mut xi);
+            let want = |jii: f64| Complex::new(1.0, 0.0) / Complex::new(3.0 - jii, 1.5);
+            for (k, jii) in [-2.0, -30.0, -0.5].into_iter().enumerate() {
+                assert!((Complex::new(xr[k], xi[k]) - want(jii)).norm() < 1e-15, "{k}");
+            }
         }
     }
 

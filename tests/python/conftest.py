@@ -26,10 +26,18 @@ def fmu_path(identifier):
     return str(path)
 
 
+#: fmpy's logger proxy keeps the logger registered last in one global of its C library and
+#: forwards every proxied message there (also those of FMUs instantiated with fmpy's default
+#: callbacks). A Recorder therefore lives as long as the session: a collected one would leave
+#: the proxy calling a freed callback, which crashed the interpreter when a later FMU logged.
+_ALIVE = []
+
+
 class Recorder:
     """FMI callbacks whose logger records (status, category, message)."""
 
     def __init__(self):
+        _ALIVE.append(self)
         self.messages = []
 
         def log(env, name, status, category, message):
