@@ -161,7 +161,9 @@ impl IterationMatrices {
         self.inv1 = 1.0 / fac1;
         self.inv2 = (alphn / norm, -betan / norm);
         let (inv1, (ir, ii)) = (self.inv1, self.inv2);
-        (self.keep.clear(), self.decoupled.clear(), self.j_dd.clear());
+        self.keep.clear();
+        self.decoupled.clear();
+        self.j_dd.clear();
         for i in (0..n).filter(|i| !positions.contains(i)) {
             if position_of(i).is_none() && (0..n).all(|j| j == i || jac[i + j * n] == 0.0) {
                 self.decoupled.push(i);
