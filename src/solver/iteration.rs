@@ -161,6 +161,7 @@ impl IterationMatrices {
         self.inv1 = 1.0 / fac1;
         self.inv2 = (alphn / norm, -betan / norm);
         let (inv1, (ir, ii)) = (self.inv1, self.inv2);
+        (self.uses, self.inverted) = (0, false);
         self.keep.clear();
         self.decoupled.clear();
         self.j_dd.clear();
@@ -202,7 +203,6 @@ impl IterationMatrices {
                 self.jd[k + kd * r] = jac[i + d * n];
             }
         }
-        (self.uses, self.inverted) = (0, false);
         self.piv1.resize(r, 0);
         self.piv2.resize(r, 0);
         r == 0
