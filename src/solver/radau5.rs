@@ -7,7 +7,8 @@
 //! Newton iteration uses the transformation `T⁻¹ A⁻¹ T = diag(γ, [[α, -β], [β, α]])`, so each
 //! iteration solves one real system with `γ/h·I - J` and one complex system with
 //! `(α + iβ)/h·I - J`; both are LU-factorised (partial pivoting, `lu.rs`) once per step size,
-//! after eliminating the positions of a second-order system (`iteration.rs`).
+//! after eliminating the positions of a second-order system and the decoupled states
+//! (`iteration.rs`).
 //! Convergence is judged by the contraction rate `θ` (stop when `θ/(1-θ)·‖ΔZ‖ ≤ κ`,
 //! `κ = max(10ε/rtol, 0.01)` (`KAPPA`); abort and reduce `h` if `θ ≥ 0.99` or the predicted
 //! error after 7 iterations is too large). Starting values extrapolate the collocation polynomial
