@@ -29,8 +29,8 @@
 //! **Reused factors.** Once the factors have served [`INVERT_AFTER`] solves (a co-simulation step
 //! of constant size keeps them for hundreds of steps), both reduced matrices are inverted from
 //! them and later solves are matrix-vector products: full-length column updates instead of two
-//! triangular sweeps, about a third of the instructions. The count is part of the integrator's
-//! saved state, so a restored integrator switches at the same solve.
+//! triangular sweeps. The count is part of the integrator's saved state, so a restored
+//! integrator switches at the same solve.
 
 use super::lu;
 use nalgebra::DMatrix;
@@ -205,9 +205,8 @@ impl IterationMatrices {
         }
         self.piv1.resize(r, 0);
         self.piv2.resize(r, 0);
-        r == 0
-            || lu::factor(&mut self.e1[..r * r], &mut self.piv1)
-                && lu::factor_complex(&mut self.e2_re[..r * r], &mut self.e2_im[..r * r], &mut self.piv2)
+        lu::factor(&mut self.e1[..r * r], &mut self.piv1)
+            && lu::factor_complex(&mut self.e2_re[..r * r], &mut self.e2_im[..r * r], &mut self.piv2)
     }
 
     /// Solves served by the current factors.
@@ -215,7 +214,8 @@ impl IterationMatrices {
         self.uses
     }
 
-    /// Restores the count of [`uses`](Self::uses) after a refactorisation from a saved state.
+    /// Restores the count of [`uses`](Self::uses) after a refactorisation from a saved state. An
+    /// empty reduced system (every state decoupled) has nothing to invert.
     pub(crate) fn set_uses(&mut self, uses: u32) {
         self.uses = uses;
         if uses >= INVERT_AFTER && !self.keep.is_empty() {
@@ -271,7 +271,7 @@ impl IterationMatrices {
                 axpy(y, col, x);
             }
             br.copy_from_slice(y);
-        } else if r > 0 {
+        } else {
             lu::solve(&self.e1[..r * r], &self.piv1, br);
         }
         for (&x, &i) in br.iter().zip(&self.keep) {
@@ -326,7 +326,7 @@ impl IterationMatrices {
             }
             xr.copy_from_slice(yr);
             xi.copy_from_slice(yi);
-        } else if r > 0 {
+        } else {
             lu::solve_complex(&self.e2_re[..r * r], &self.e2_im[..r * r], &self.piv2, xr, xi);
         }
         for ((&xr, &xi), &i) in xr.iter().zip(xi.iter()).zip(&self.keep) {

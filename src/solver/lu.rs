@@ -46,10 +46,14 @@ pub(crate) fn factor(a: &mut [f64], piv: &mut [usize]) -> bool {
     true
 }
 
-/// Solves `A x = b` in place (`b` becomes `x`) with the factors from [`factor`].
+/// Solves `A x = b` in place (`b` becomes `x`) with the factors from [`factor`]; an empty
+/// system (n = 0) has nothing to solve.
 pub(crate) fn solve(lu: &[f64], piv: &[usize], b: &mut [f64]) {
     let n = piv.len();
     assert!(lu.len() == n * n && b.len() == n, "dimensions differ");
+    if n == 0 {
+        return;
+    }
     for (k, &p) in piv.iter().enumerate() {
         b.swap(k, p);
     }
@@ -114,10 +118,13 @@ pub(crate) fn factor_complex(re: &mut [f64], im: &mut [f64], piv: &mut [usize]) 
 }
 
 /// Solves `A x = b` in place for the complex factors of [`factor_complex`]; `b = br + i·bi`
-/// becomes `x`.
+/// becomes `x` (nothing to do for n = 0).
 pub(crate) fn solve_complex(re: &[f64], im: &[f64], piv: &[usize], br: &mut [f64], bi: &mut [f64]) {
     let n = piv.len();
     assert!(re.len() == n * n && im.len() == n * n && br.len() == n && bi.len() == n, "dimensions differ");
+    if n == 0 {
+        return;
+    }
     for (k, &p) in piv.iter().enumerate() {
         br.swap(k, p);
         bi.swap(k, p);

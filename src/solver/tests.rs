@@ -203,14 +203,16 @@ fn nan_rhs_returns_error_at_last_good_state() {
 /// bit-identically to the original. The continuation runs in calls of 10 µs, shorter than the
 /// steps the integrator wants, so the LU factors of the previous call are reused at call
 /// boundaries (checked): the restored integrator must rebuild exactly the factors the original
-/// carries.
+/// carries, and, saved after those factors were inverted (they serve hundreds of calls), their
+/// inverses at the same solve.
 #[test]
 fn saved_state_reproduces_bit_identical_results() {
-    let run = |s: &mut Radau5, x: &mut [f64; 3]| {
-        for k in 5000..5500 {
+    let run_from = |k0: usize, calls: usize, s: &mut Radau5, x: &mut [f64; 3]| {
+        for k in k0..k0 + calls {
             s.integrate(&OilColumn, k as f64 * 1e-5, x, (k + 1) as f64 * 1e-5).unwrap();
         }
     };
+    let run = |s: &mut Radau5, x: &mut [f64; 3]| run_from(5000, 500, s, x);
     let mut a = Radau5::new(3);
     oil_tolerances(&mut a, 1e-6);
     let mut xa = [4e6, 0.0, 0.0];
@@ -232,6 +234,19 @@ fn saved_state_reproduces_bit_identical_results() {
     assert_eq!(xa.map(f64::to_bits), xb.map(f64::to_bits));
     assert_eq!(xa.map(f64::to_bits), xc.map(f64::to_bits));
     assert_eq!(a.save_state(), b.save_state());
+
+    let saved = a.save_state();
+    assert!(saved[7] >= super::iteration::INVERT_AFTER as f64, "saved after the factors were inverted");
+    let mut d = Radau5::new(3);
+    oil_tolerances(&mut d, 1e-6);
+    d.load_state(&saved).unwrap();
+    let mut xd = xa;
+    // A few calls: the original solves with its inverses, the restored one must too (the state
+    // compared includes the last collocation polynomial, i.e. the solves' rounding).
+    run_from(5500, 10, &mut a, &mut xa);
+    run_from(5500, 10, &mut d, &mut xd);
+    assert_eq!(xa.map(f64::to_bits), xd.map(f64::to_bits));
+    assert_eq!(a.save_state(), d.save_state());
 
     // Inconsistent saved states are refused: LU step size without a Jacobian, negative values.
     let mut bad = saved.clone();
