@@ -5,7 +5,7 @@
 //! exported symbols call), through the C ABI by loading the built shared libraries with `dlopen`
 //! as an importer would.
 
-use crate::fmi2::instance::Instance;
+use crate::fmi2::instance::{Instance, Step};
 use crate::fmi2::log::Logger;
 use crate::fmi2::types::*;
 use crate::fmi2::variables::BaseType;
@@ -31,7 +31,8 @@ pub struct InProcess<M: Model>(Instance<M>);
 impl<M: Model> InProcess<M> {
     /// Instantiated, set up with `rtol`, initialised with the given Real and Boolean values.
     pub fn new(rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
-        let mut i = Instance::<M>::new(Logger::new(None, std::ptr::null_mut(), "bench", &[], false));
+        let log = Logger::new(None, std::ptr::null_mut(), "bench", &[], false);
+        let mut i = Instance::<M>::new(log, guid::<M>());
         i.setup_experiment(Some(rtol), 0.0, None)?;
         i.enter_initialization_mode();
         for (r, x) in start {
@@ -53,8 +54,8 @@ impl<M: Model> Slave for InProcess<M> {
     }
     fn step(&mut self, t: f64, h: f64) -> Result<(), String> {
         match self.0.do_step(t, h)? {
-            None => Ok(()),
-            Some(why) => Err(why),
+            Step::Done(_) => Ok(()),
+            Step::Discarded(why) => Err(why),
         }
     }
 }

@@ -46,12 +46,34 @@ fn instantiate_refuses_bad_arguments_with_a_reason() {
     let (n, g) = (CString::new("x").unwrap(), CString::new(guid::<Pfc>()).unwrap());
     let null = unsafe { api::instantiate::<Pfc>(n.as_ptr(), 1, g.as_ptr(), std::ptr::null(), std::ptr::null(), 0, 0) };
     assert!(null.is_null());
+}
+
+/// FMI 2.0, 2.1.5 and 4.3.1: with canNotUseMemoryManagementFunctions="true" the importer may pass
+/// NULL allocateMemory/freeMemory (fmusim does); boomsim also runs with a NULL logger, silently.
+#[test]
+fn instantiate_accepts_null_memory_callbacks_and_a_null_logger() {
+    let (n, g) = (CString::new("x").unwrap(), CString::new(guid::<Pfc>()).unwrap());
     let messages = common::Messages::default();
-    let mut cb = common::callbacks(&messages);
-    cb.allocateMemory = None;
-    let null = unsafe { api::instantiate::<Pfc>(n.as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 0) };
-    assert!(null.is_null());
-    assert!(messages.lock().unwrap()[0].2.contains("allocateMemory"));
+    for (logger, memory) in [(true, false), (false, false), (false, true)] {
+        let mut cb = common::callbacks(&messages);
+        if !memory {
+            (cb.allocateMemory, cb.freeMemory) = (None, None);
+        }
+        if !logger {
+            cb.logger = None;
+        }
+        let c = unsafe { api::instantiate::<Pfc>(n.as_ptr(), 1, g.as_ptr(), std::ptr::null(), &cb, 0, 1) };
+        assert!(!c.is_null(), "logger {logger}, memory callbacks {memory}");
+        unsafe {
+            assert_eq!(api::enter_initialization_mode::<Pfc>(c), OK);
+            assert_eq!(api::exit_initialization_mode::<Pfc>(c), OK);
+            assert_eq!(api::do_step::<Pfc>(c, 0.0, 1e-3, 1), OK);
+            // An error without a logger is still an error status.
+            assert_eq!(api::do_step::<Pfc>(c, 5.0, 1e-3, 1), ERR);
+            api::free_instance::<Pfc>(c);
+        }
+    }
+    assert!(messages.lock().unwrap().iter().all(|m| !m.2.contains("NULL")), "no complaint about NULL callbacks");
 }
 
 /// Section 2.2.7 (setting rules) and the declared min/max: refused with name, value and range.

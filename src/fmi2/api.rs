@@ -7,7 +7,7 @@
 
 use super::fmu_state::{self, FmuState};
 use super::guid::guid;
-use super::instance::{Core, Instance};
+use super::instance::{Core, Instance, Step, Warning};
 use super::log::{Logger, LOG_FMI_CALLS};
 use super::model::Model;
 use super::state::{allowed, describe, Mask, State};
@@ -67,6 +67,17 @@ fn call<M: Model>(
     }
 }
 
+/// fmi2Warning with the message logged if there is one, else fmi2OK.
+fn warn<M: Model>(inst: &Instance<M>, function: &str, warning: Warning) -> fmi2Status {
+    match warning {
+        Some(w) => {
+            inst.log.status(fmi2Status::Warning, &format!("{function}: {w}"));
+            fmi2Status::Warning
+        }
+        None => fmi2Status::OK,
+    }
+}
+
 /// A slice from a C array; NULL is an error unless `n` is 0.
 unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
     if n == 0 {
@@ -100,6 +111,10 @@ pub fn get_version() -> *const c_char {
     c"2.0".as_ptr()
 }
 
+/// fmi2Instantiate. The memory callbacks may be NULL: the FMU declares
+/// `canNotUseMemoryManagementFunctions="true"` and never calls them (fmusim passes NULL). A NULL
+/// logger is accepted too: the instance then runs silently, its statuses still tell every failure
+/// (FMI 2.0 requires a logger; refusing would leave the importer without any reason at all).
 pub unsafe fn instantiate<M: Model>(
     name: fmi2String,
     fmu_type: c_int,
@@ -118,9 +133,6 @@ pub unsafe fn instantiate<M: Model>(
             None
         };
         let expected = guid::<M>();
-        if f.logger.is_none() || f.allocateMemory.is_none() || f.freeMemory.is_none() {
-            return fail("the callback functions logger, allocateMemory and freeMemory must not be NULL".into());
-        }
         if instance_name.is_empty() {
             return fail("instanceName must be a non-empty UTF-8 string".into());
         }
@@ -138,18 +150,22 @@ pub unsafe fn instantiate<M: Model>(
                 ))
             }
         }
-        Some(Box::into_raw(Box::new(Instance::<M>::new(logger))) as fmi2Component)
+        Some(Box::into_raw(Box::new(Instance::<M>::new(logger, expected))) as fmi2Component)
     })
     .ok()
     .flatten()
     .unwrap_or(std::ptr::null_mut())
 }
 
+/// fmi2FreeInstance, with every FMU state of the instance the importer did not free.
 pub unsafe fn free_instance<M: Model>(c: fmi2Component) {
     let status = call::<M>(c, "fmi2FreeInstance", allowed::FREE_INSTANCE, |_| Ok(fmi2Status::OK));
     if status == fmi2Status::OK {
         let mut inst = Box::from_raw(c as *mut Instance<M>);
         inst.magic = 0;
+        for s in inst.fmu_states.drain(..) {
+            drop(Box::from_raw(s));
+        }
     }
 }
 
@@ -178,12 +194,12 @@ pub unsafe fn setup_experiment<M: Model>(
     stop: f64,
 ) -> fmi2Status {
     call::<M>(c, "fmi2SetupExperiment", allowed::SETUP_EXPERIMENT, |inst| {
-        inst.setup_experiment(
+        let warning = inst.setup_experiment(
             (tolerance_defined != 0).then_some(tolerance),
             start,
             (stop_defined != 0).then_some(stop),
         )?;
-        Ok(fmi2Status::OK)
+        Ok(warn(inst, "fmi2SetupExperiment", warning))
     })
 }
 
@@ -319,40 +335,54 @@ pub unsafe fn set_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, v
 pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     call::<M>(c, "fmi2GetFMUstate", allowed::FMU_STATE, |inst| {
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
-        if let Some(old) = (*out as *mut FmuState<M>).as_mut().filter(|s| s.magic == Instance::<M>::STATE_MAGIC) {
-            old.core = inst.core.clone();
+        if out.is_null() {
+            *out = new_fmu_state(inst, inst.core.clone());
         } else {
-            let s = FmuState { magic: Instance::<M>::STATE_MAGIC, core: inst.core.clone() };
-            *out = Box::into_raw(Box::new(s)) as fmi2FMUstate;
+            // FMI 2.0, 2.1.8: a non-NULL *FMUstate is a state of this instance, to overwrite.
+            let core = inst.core.clone();
+            own_fmu_state(inst, *out)?.core = core;
         }
         Ok(fmi2Status::OK)
     })
 }
 
-/// The FMU state behind a pointer, if it is one of ours for this model.
-unsafe fn fmu_state_ref<'a, M: Model>(s: fmi2FMUstate) -> Result<&'a mut FmuState<M>, String> {
-    (s as *mut FmuState<M>)
-        .as_mut()
-        .filter(|s| s.magic == Instance::<M>::STATE_MAGIC)
-        .ok_or_else(|| format!("FMUstate is NULL or not a state of {}", M::INFO.identifier))
+/// A new FMU state of `inst` holding `core`, registered so that fmi2FreeInstance frees it.
+fn new_fmu_state<M: Model>(inst: &mut Instance<M>, core: Core<M>) -> fmi2FMUstate {
+    let s = Box::into_raw(Box::new(FmuState { core }));
+    inst.fmu_states.push(s);
+    s as fmi2FMUstate
+}
+
+/// The FMU state behind a pointer if this instance allocated it and it was not freed: found in
+/// the instance's list, so no pointer the importer passes is dereferenced unless it is ours.
+fn own_fmu_state<'a, M: Model>(inst: &Instance<M>, s: fmi2FMUstate) -> Result<&'a mut FmuState<M>, String> {
+    let p = s as *mut FmuState<M>;
+    if s.is_null() || !inst.fmu_states.contains(&p) {
+        return Err(format!(
+            "FMUstate {s:p} is NULL, freed, or not a state of this instance of {} (fmi2GetFMUstate or fmi2DeSerializeFMUstate of this instance make one)",
+            M::INFO.identifier
+        ));
+    }
+    // SAFETY: the pointer is one this instance allocated and has not freed.
+    Ok(unsafe { &mut *p })
 }
 
 pub unsafe fn set_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
     call::<M>(c, "fmi2SetFMUstate", allowed::FMU_STATE, |inst| {
-        inst.core = fmu_state_ref::<M>(state)?.core.clone();
+        inst.core = own_fmu_state(inst, state)?.core.clone();
         Ok(fmi2Status::OK)
     })
 }
 
 pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
-    call::<M>(c, "fmi2FreeFMUstate", allowed::FMU_STATE, |_| {
+    call::<M>(c, "fmi2FreeFMUstate", allowed::FMU_STATE, |inst| {
         let p = state.as_mut().ok_or("FMUstate is NULL")?;
         if p.is_null() {
             return Ok(fmi2Status::OK);
         }
-        let s = fmu_state_ref::<M>(*p)?;
-        s.magic = 0;
-        drop(Box::from_raw(s as *mut FmuState<M>));
+        let s = own_fmu_state(inst, *p)? as *mut FmuState<M>;
+        inst.fmu_states.retain(|&x| x != s);
+        drop(Box::from_raw(s));
         *p = std::ptr::null_mut();
         Ok(fmi2Status::OK)
     })
@@ -363,9 +393,9 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
     state: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    call::<M>(c, "fmi2SerializedFMUstateSize", allowed::FMU_STATE, |_| {
+    call::<M>(c, "fmi2SerializedFMUstateSize", allowed::FMU_STATE, |inst| {
         let out = size.as_mut().ok_or("size is NULL")?;
-        *out = fmu_state::serialize(&fmu_state_ref::<M>(state)?.core, &guid::<M>()).len();
+        *out = fmu_state::serialize(&own_fmu_state(inst, state)?.core, &inst.guid).len();
         Ok(fmi2Status::OK)
     })
 }
@@ -376,8 +406,8 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     bytes: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    call::<M>(c, "fmi2SerializeFMUstate", allowed::FMU_STATE, |_| {
-        let data = fmu_state::serialize(&fmu_state_ref::<M>(state)?.core, &guid::<M>());
+    call::<M>(c, "fmi2SerializeFMUstate", allowed::FMU_STATE, |inst| {
+        let data = fmu_state::serialize(&own_fmu_state(inst, state)?.core, &inst.guid);
         if data.len() != size {
             return Err(format!(
                 "size = {size} bytes, but the state needs {} (fmi2SerializedFMUstateSize)",
@@ -395,12 +425,11 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
     size: usize,
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    call::<M>(c, "fmi2DeSerializeFMUstate", allowed::FMU_STATE, |_| {
+    call::<M>(c, "fmi2DeSerializeFMUstate", allowed::FMU_STATE, |inst| {
         let data = slice(bytes as *const u8, size, "serializedState")?;
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
-        let core = fmu_state::deserialize::<M>(data, &guid::<M>())?;
-        let s = FmuState { magic: Instance::<M>::STATE_MAGIC, core };
-        *out = Box::into_raw(Box::new(s)) as fmi2FMUstate;
+        let core = fmu_state::deserialize::<M>(data, &inst.guid)?;
+        *out = new_fmu_state(inst, core);
         Ok(fmi2Status::OK)
     })
 }
@@ -443,8 +472,8 @@ pub unsafe fn get_real_output_derivatives<M: Model>(c: fmi2Component) -> fmi2Sta
 
 pub unsafe fn do_step<M: Model>(c: fmi2Component, t: f64, h: f64, _no_set_prior: fmi2Boolean) -> fmi2Status {
     call::<M>(c, "fmi2DoStep", allowed::DO_STEP, |inst| match inst.do_step(t, h)? {
-        None => Ok(fmi2Status::OK),
-        Some(why) => {
+        Step::Done(warning) => Ok(warn(inst, "fmi2DoStep", warning)),
+        Step::Discarded(why) => {
             inst.log.status(fmi2Status::Discard, &format!("fmi2DoStep: {why}"));
             Ok(fmi2Status::Discard)
         }

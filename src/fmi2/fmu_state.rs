@@ -4,23 +4,25 @@
 //! Byte format, little endian: magic `BOOMSIM\0`, format version (u32), GUID (u32 length +
 //! UTF-8), payload length (u64), payload, CRC-32 of everything before it (u32). The payload holds
 //! the state machine state, times, every variable value, the input derivatives and the model's
-//! own state. Any mismatch (size, GUID, version, checksum, value types) is refused with a reason.
+//! own state. Any mismatch (size, GUID, version, checksum, value types) is refused with a reason,
+//! and so is a well-formed state whose values fmi2SetReal would refuse (a non-finite number, a
+//! parameter or input outside its range, inconsistent times): a checksum only proves the bytes
+//! were not damaged, not that they were written by this FMU.
 
-use super::instance::Core;
+use super::instance::{in_range, Core, TOLERANCE_RANGE};
+use super::log::num;
 use super::model::Model;
 use super::state::State;
 use super::variables::{Value, Values};
 
-/// `#[repr(C)]` so that the tag comes first: it tells our FMU states from foreign pointers.
-#[repr(C)]
+/// An FMU state: the instance's core, owned by the instance that made it (its list of states).
 pub struct FmuState<M: Model> {
-    pub(crate) magic: u64,
     pub core: Core<M>,
 }
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// Serialises a core into the checked byte format.
 pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
@@ -137,7 +139,14 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         };
         values.put(i, v);
     }
+    for (v, x) in M::VARIABLES.iter().zip(values.all()) {
+        in_range(v, x).map_err(|e| format!("the serialised FMU state holds {e}"))?;
+    }
+    check_times(time, start_time, last_successful_time, stop_time, tolerance)?;
     let input_derivatives = (0..count).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
+    if let Some(i) = input_derivatives.iter().position(|d| !d.is_finite()) {
+        return Err(format!("the serialised FMU state holds a non-finite derivative of \"{}\"", M::VARIABLES[i].name));
+    }
     let model = match r.take(1)?[0] {
         0 => None,
         _ => {
@@ -148,6 +157,11 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
     };
     if r.at != body.len() {
         return Err(format!("{} unexpected bytes after the state", body.len() - r.at));
+    }
+    // A model exists exactly once initialisation has ended (a panic may leave Error without one).
+    let initialised = !matches!(state, State::Instantiated | State::InitializationMode);
+    if model.is_some() != initialised && state != State::Error {
+        return Err(format!("state {state:?} {} a model", if initialised { "needs" } else { "cannot have" }));
     }
     Ok(Core {
         state,
@@ -161,6 +175,29 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         last_successful_time,
         outputs_current,
     })
+}
+
+/// The instance clock and experiment of a restored state: what fmi2SetupExperiment would accept
+/// and the clock between start and stop.
+fn check_times(time: f64, start: f64, last: f64, stop: Option<f64>, tolerance: Option<f64>) -> Result<(), String> {
+    let (lo, hi) = TOLERANCE_RANGE;
+    let ok = [time, start, last].iter().all(|t| t.is_finite())
+        && time >= start
+        && last <= time
+        && last >= start
+        && stop.is_none_or(|s| s.is_finite() && s >= start)
+        && tolerance.is_none_or(|t| (lo..=hi).contains(&t));
+    if ok {
+        return Ok(());
+    }
+    Err(format!(
+        "the serialised FMU state has inconsistent times or tolerance: time {}, start {}, last successful {}, stop {}, tolerance {}",
+        num(time),
+        num(start),
+        num(last),
+        stop.map_or("none".into(), num),
+        tolerance.map_or("none".into(), num)
+    ))
 }
 
 fn put_f64(out: &mut Vec<u8>, x: f64) {

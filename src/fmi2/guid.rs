@@ -12,7 +12,7 @@ fn namespace() -> Uuid {
 /// The GUID of model `M`, in braces as FMI tools write it.
 pub fn guid<M: Model>() -> String {
     let i = &M::INFO;
-    let mut name = format!("{}|{}|{}|{}", i.identifier, i.version, i.can_interpolate_inputs, M::VARIABLES.len());
+    let mut name = format!("{}|{}|{:?}|{}", i.identifier, i.version, i.interpolated_inputs, M::VARIABLES.len());
     for v in M::VARIABLES {
         name.push_str(&format!("|{v:?}"));
     }

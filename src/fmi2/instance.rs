@@ -1,14 +1,25 @@
 //! One FMU instance: variable values, model, time and state machine, in safe Rust.
 //! [`super::api`] wraps these methods in the C ABI.
 
-use super::log::Logger;
+use super::fmu_state::FmuState;
+use super::log::{num, Logger};
 use super::model::{Log, Model};
 use super::state::State;
 use super::types::fmi2Status;
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
+use std::borrow::Cow;
 
 /// Relative tolerance for matching the master's communication point with the instance time.
 pub const TIME_MATCH_RTOL: f64 = 1e-9;
+
+/// Relative tolerances the plants' integrator is used with: a tolerance of fmi2SetupExperiment
+/// outside is clamped into it with a warning. Below 1e-12 the error estimates of a stiff solver
+/// in f64 (unit round-off 1.1e-16, times the condition of the Newton matrices) are round-off;
+/// above 1e-2 the error control no longer bounds a relative error worth the name.
+pub const TOLERANCE_RANGE: (f64, f64) = (1e-12, 1e-2);
+
+/// What a call did besides succeeding: a warning to log with fmi2Warning.
+pub type Warning = Option<String>;
 
 /// A live instance. `#[repr(C)]` so that `magic` is first: it tells a boomsim instance of this
 /// model from any other pointer an importer might pass.
@@ -19,6 +30,11 @@ pub struct Instance<M: Model> {
     pub core: Core<M>,
     /// Storage behind the pointers the last fmi2GetString returned.
     pub(crate) strings: Vec<std::ffi::CString>,
+    /// The model's GUID, computed once at instantiation (FMU state bytes carry it).
+    pub guid: String,
+    /// The FMU states this instance allocated and the importer has not freed yet; freed with the
+    /// instance (FMI 2.0, 2.1.5: fmi2FreeInstance frees all memory the instance allocated).
+    pub(crate) fmu_states: Vec<*mut FmuState<M>>,
 }
 
 /// Everything an FMU state captures: the instance less its name and logger.
@@ -93,27 +109,39 @@ const fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
 impl<M: Model> Instance<M> {
     /// Tag of a live instance of model `M`.
     pub const MAGIC: u64 = fnv1a(M::INFO.identifier.as_bytes(), 0x1157);
-    /// Tag of an FMU state of model `M`.
-    pub const STATE_MAGIC: u64 = fnv1a(M::INFO.identifier.as_bytes(), 0x57a7e);
 
     /// A freshly instantiated slave.
-    pub fn new(log: Logger) -> Self {
-        Instance { magic: Self::MAGIC, log, core: Core::new(), strings: Vec::new() }
+    pub fn new(log: Logger, guid: String) -> Self {
+        Instance { magic: Self::MAGIC, log, core: Core::new(), strings: Vec::new(), guid, fmu_states: Vec::new() }
     }
 
-    /// fmi2SetupExperiment.
-    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> Result<(), String> {
+    /// fmi2SetupExperiment. A tolerance outside [`TOLERANCE_RANGE`] is clamped into it (warning).
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> Result<Warning, String> {
         if !start.is_finite() {
-            return Err(format!("startTime = {start} must be finite"));
+            return Err(format!("startTime = {} must be finite", num(start)));
         }
-        if let Some(tol) = tolerance {
-            if !(tol > 0.0 && tol < 1.0) {
-                return Err(format!("tolerance = {tol} is outside its valid range (0, 1)"));
+        let (lo, hi) = TOLERANCE_RANGE;
+        let mut warning = None;
+        let tolerance = match tolerance {
+            Some(tol) if !(tol > 0.0 && tol.is_finite()) => {
+                return Err(format!("tolerance = {} is not a relative tolerance (a finite number > 0)", num(tol)))
             }
-        }
+            Some(tol) if !(lo..=hi).contains(&tol) => {
+                let used = tol.clamp(lo, hi);
+                warning = Some(format!(
+                    "tolerance = {} is outside the integrator's range [{}, {}]; using {}",
+                    num(tol),
+                    num(lo),
+                    num(hi),
+                    num(used)
+                ));
+                Some(used)
+            }
+            tol => tol,
+        };
         if let Some(stop) = stop {
             if !(stop.is_finite() && stop >= start) {
-                return Err(format!("stopTime = {stop} must be finite and >= startTime = {start}"));
+                return Err(format!("stopTime = {} must be finite and >= startTime = {}", num(stop), num(start)));
             }
         }
         let c = &mut self.core;
@@ -122,7 +150,7 @@ impl<M: Model> Instance<M> {
         c.stop_time = stop;
         c.time = start;
         c.last_successful_time = start;
-        Ok(())
+        Ok(warning)
     }
 
     /// fmi2EnterInitializationMode.
@@ -183,8 +211,15 @@ impl<M: Model> Instance<M> {
     ) -> Result<(), String> {
         self.refresh_outputs()?;
         for (k, &vr) in vrs.iter().enumerate() {
-            let (i, _) = self.lookup(vr, wanted)?;
-            out[k] = read(self.core.values.at(i));
+            let (i, v) = self.lookup(vr, wanted)?;
+            let value = self.core.values.at(i);
+            if let Value::Real(x) = value {
+                // Never a non-finite value with fmi2OK (a model evaluated outside its range).
+                if !x.is_finite() {
+                    return Err(format!("{} = {} at t = {} is not a finite number", v.name, num(*x), num(self.core.time)));
+                }
+            }
+            out[k] = read(value);
         }
         Ok(())
     }
@@ -219,16 +254,23 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// fmi2SetRealInputDerivatives (first order only).
+    /// fmi2SetRealInputDerivatives (first order only), for the inputs the model interpolates.
     pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Result<(), String> {
-        if !M::INFO.can_interpolate_inputs {
-            return Err(format!("{} does not interpolate inputs (canInterpolateInputs=\"false\")", M::INFO.identifier));
+        let info = &M::INFO;
+        if !info.can_interpolate_inputs() {
+            return Err(format!("{} does not interpolate inputs (canInterpolateInputs=\"false\")", info.identifier));
         }
         let mut checked = Vec::with_capacity(vrs.len());
         for ((&vr, &order), &d) in vrs.iter().zip(orders).zip(values) {
             let (i, v) = self.lookup(vr, BaseType::Real)?;
-            if v.causality != Causality::Input {
-                return Err(format!("variable \"{}\" is not an input; derivatives can only be set for inputs", v.name));
+            if !info.interpolated_inputs.contains(&vr) {
+                let names: Vec<&str> = info.interpolated_inputs.iter().filter_map(|&r| self.name(r)).collect();
+                return Err(format!(
+                    "variable \"{}\" has no derivative in {}; derivatives can be set for {}",
+                    v.name,
+                    info.identifier,
+                    names.join(", ")
+                ));
             }
             if order != 1 {
                 return Err(format!("derivative order {order} of \"{}\" is outside its valid range [1, 1]", v.name));
@@ -244,24 +286,33 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// fmi2DoStep. `Ok(None)`: step done; `Ok(Some(why))`: discarded at the last good time.
-    pub fn do_step(&mut self, t: f64, h: f64) -> Result<Option<String>, String> {
+    /// The name of a value reference.
+    fn name(&self, vr: u32) -> Option<&'static str> {
+        self.core.values.position(vr).map(|i| M::VARIABLES[i].name)
+    }
+
+    /// fmi2DoStep. `Ok(Step::Done(warning))`: step done; `Ok(Step::Discarded(why))`: stopped
+    /// at the last good time.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<Step, String> {
         let c = &mut self.core;
         if !(h > 0.0 && h.is_finite()) {
-            return Err(format!("communicationStepSize = {h} is outside its valid range (0, inf)"));
+            return Err(format!("communicationStepSize = {} is outside its valid range (0, inf)", num(h)));
         }
         let eps = TIME_MATCH_RTOL * c.time.abs().max(1.0);
         if !((t - c.time).abs() <= eps) {
             return Err(format!(
-                "currentCommunicationPoint = {t} does not match the instance time {} (tolerance {eps:e})",
-                c.time
+                "currentCommunicationPoint = {} does not match the instance time {} (tolerance {})",
+                num(t),
+                num(c.time),
+                num(eps)
             ));
         }
         if let Some(stop) = c.stop_time {
             if t + h > stop + TIME_MATCH_RTOL * stop.abs().max(1.0) {
                 return Err(format!(
-                    "a step to t = {} would pass the stop time {stop} set in fmi2SetupExperiment",
-                    t + h
+                    "a step to t = {} would pass the stop time {} set in fmi2SetupExperiment",
+                    num(t + h),
+                    num(stop)
                 ));
             }
         }
@@ -272,32 +323,95 @@ impl<M: Model> Instance<M> {
         // still continues exactly where the last step ended, so results do not depend on it.
         let (start, end) = (c.time, t + h);
         if end <= start {
-            return Err(format!("communicationStepSize = {h} does not advance the instance time {start}"));
+            return Err(format!("communicationStepSize = {} does not advance the instance time {}", num(h), num(start)));
         }
-        let result =
-            model.do_step(&c.values, &c.input_derivatives, start, end - start, tolerance, &mut ModelLog(&self.log));
+        let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, end - start);
+        let result = model.do_step(&c.values, &slopes, start, end - start, tolerance, &mut ModelLog(&self.log));
         c.outputs_current = false;
-        match result {
-            Ok(()) => {
-                // Inputs with a derivative follow their ramp to the new communication point
-                // (only models that interpolate inputs accept derivatives).
-                let ramps = if M::INFO.can_interpolate_inputs { c.input_derivatives.as_slice() } else { &[] };
-                for (i, &d) in ramps.iter().enumerate() {
-                    if let (Value::Real(x), true) = (c.values.at(i), d != 0.0) {
-                        c.values.put(i, Value::Real(x + d * h));
-                    }
-                }
-                c.time = t + h;
-                c.last_successful_time = c.time;
-                Ok(None)
-            }
-            Err(e) => {
-                c.time = e.time;
-                c.last_successful_time = e.time;
-                c.state = State::StepFailed;
-                Ok(Some(format!("step from t = {t} with h = {h} stopped at t = {}: {}", e.time, e.message)))
+        if let Err(e) = result {
+            c.time = e.time;
+            c.last_successful_time = e.time;
+            c.state = State::StepFailed;
+            let why = format!("step from t = {} with h = {} stopped at t = {}: {}", num(t), num(h), num(e.time), e.message);
+            return Ok(Step::Discarded(why));
+        }
+        // Inputs with a derivative follow their ramp to the new communication point (only
+        // interpolated inputs accept derivatives).
+        for (i, &d) in slopes.iter().enumerate() {
+            if let (Value::Real(x), true) = (c.values.at(i), d != 0.0) {
+                c.values.put(i, Value::Real(x + d * (end - start)));
             }
         }
+        c.time = end;
+        c.last_successful_time = end;
+        // Every Real the importer can read is finite after a good step, or the step is an error.
+        model.outputs(&mut c.values);
+        c.outputs_current = true;
+        if let Some((v, x)) = M::VARIABLES.iter().zip(c.values.all()).find_map(|(v, x)| match x {
+            Value::Real(x) if !x.is_finite() => Some((v, *x)),
+            _ => None,
+        }) {
+            c.state = State::Error;
+            return Err(format!(
+                "{} = {} at t = {}: the model left its valid range; the instance is now in the Error state (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
+                v.name,
+                num(x),
+                num(end)
+            ));
+        }
+        Ok(Step::Done(warning))
+    }
+}
+
+/// The outcome of a step that was carried out.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    /// Done, perhaps with a warning.
+    Done(Warning),
+    /// Stopped at the last good state, with the reason.
+    Discarded(String),
+}
+
+/// The input slopes a step of length `h` uses: a slope that would carry an input out of its
+/// declared range within the step is reduced so that the input reaches the bound at the step end
+/// (it is linear in between), with a warning naming it. The master's slopes stay as set.
+pub fn bounded_slopes<'a>(values: &Values, slopes: &'a [f64], h: f64) -> (Cow<'a, [f64]>, Warning) {
+    let mut out = Cow::Borrowed(slopes);
+    let mut warnings = Vec::new();
+    for (i, &d) in slopes.iter().enumerate() {
+        if d == 0.0 {
+            continue;
+        }
+        let (Kind::Real { min, max, unit, .. }, Value::Real(x)) = (values.table()[i].kind, values.at(i)) else {
+            continue;
+        };
+        let bounded = bounded_slope(*x, d, h, (min, max));
+        if bounded != d {
+            warnings.push(format!(
+                "{} = {} with derivative {} leaves its range [{}, {}] {unit} within the step of {} s: it stops at the bound",
+                values.table()[i].name,
+                num(*x),
+                num(d),
+                num(min),
+                num(max),
+                num(h)
+            ));
+            out.to_mut()[i] = bounded;
+        }
+    }
+    (out, (!warnings.is_empty()).then(|| warnings.join("; ")))
+}
+
+/// The slope of a ramp from `x` over `h` that stays in `[min, max]`: `d` if `x + d h` is inside,
+/// else the slope reaching the nearer bound at the end of the step.
+pub fn bounded_slope(x: f64, d: f64, h: f64, (min, max): (f64, f64)) -> f64 {
+    let end = x + d * h;
+    if end > max {
+        (max - x) / h
+    } else if end < min {
+        (min - x) / h
+    } else {
+        d
     }
 }
 
@@ -330,14 +444,15 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
 }
 
 /// Checks a new value against the variable's declared range; NaN and infinities are refused.
-fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
+pub(crate) fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
     match (v.kind, value) {
         (Kind::Real { min, max, unit, .. }, Value::Real(x)) => {
+            let (lo, hi) = (num(min), num(max));
             if !x.is_finite() {
-                return Err(format!("{} = {x} is not a finite number; valid range [{min}, {max}] {unit}", v.name));
+                return Err(format!("{} = {x} is not a finite number; valid range [{lo}, {hi}] {unit}", v.name));
             }
             if *x < min || *x > max {
-                return Err(format!("{} = {x} is outside its valid range [{min}, {max}] {unit}", v.name));
+                return Err(format!("{} = {} is outside its valid range [{lo}, {hi}] {unit}", v.name, num(*x)));
             }
         }
         (Kind::Integer { min, max, .. }, Value::Integer(x)) => {

@@ -124,3 +124,32 @@ impl Logger {
 fn c_string(s: &str) -> CString {
     CString::new(s.replace('\0', " ")).unwrap_or_default()
 }
+
+/// A number as a reader wants it in a message: the shortest text that reads back to the same
+/// f64, in exponent form when very small or large (`1e-20`, not 20 zeros).
+pub fn num(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::num;
+
+    /// Round trip (Rust's shortest representation) and the exponent form outside [1e-4, 1e15).
+    #[test]
+    fn numbers_read_as_written() {
+        assert_eq!(num(1e-20), "1e-20");
+        assert_eq!(num(0.001), "0.001");
+        assert_eq!(num(-2.5e300), "-2.5e300");
+        assert_eq!(num(f64::NAN), "NaN");
+        assert_eq!(num(0.0), "0");
+        for x in [1e-20, 0.1 + 0.2, 123456.789, 7e-5, f64::MAX, f64::MIN_POSITIVE] {
+            assert_eq!(num(x).parse::<f64>().unwrap(), x);
+        }
+    }
+}

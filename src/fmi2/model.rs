@@ -18,10 +18,18 @@ pub struct ModelInfo {
     pub default_tolerance: f64,
     /// The model's own log categories (name, description), beside the generic ones.
     pub log_categories: &'static [(&'static str, &'static str)],
-    /// Whether doStep uses input derivatives set by fmi2SetRealInputDerivatives (order 1).
-    pub can_interpolate_inputs: bool,
+    /// The Real inputs whose first derivative (fmi2SetRealInputDerivatives) doStep uses;
+    /// `canInterpolateInputs` when there is one. Derivatives of other inputs are refused.
+    pub interpolated_inputs: &'static [u32],
     /// HTML fragment for documentation/index.html: equations, sources, notes.
     pub documentation: &'static str,
+}
+
+impl ModelInfo {
+    /// `canInterpolateInputs`: some input is linear over a step with its derivative.
+    pub const fn can_interpolate_inputs(&self) -> bool {
+        !self.interpolated_inputs.is_empty()
+    }
 }
 
 /// A failed step: how far the model got and why.

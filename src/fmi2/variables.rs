@@ -69,6 +69,9 @@ pub struct Variable {
     pub kind: Kind,
     /// For outputs: the value references of the inputs it depends on directly (ModelStructure).
     pub depends_on: &'static [u32],
+    /// For outputs whose initial equation differs: the inputs it depends on in Initialization
+    /// Mode (`None`: those of `depends_on`).
+    pub initial_depends_on: Option<&'static [u32]>,
 }
 
 const NO_MIN: f64 = f64::NEG_INFINITY;
@@ -84,7 +87,7 @@ impl Variable {
         kind: Kind,
         description: &'static str,
     ) -> Self {
-        Variable { name, vr, description, causality, variability, initial, kind, depends_on: &[] }
+        Variable { name, vr, description, causality, variability, initial, kind, depends_on: &[], initial_depends_on: None }
     }
 
     /// A tunable Real parameter from its physical description.
@@ -168,6 +171,12 @@ impl Variable {
     /// The same output, declaring the inputs it depends on directly.
     pub const fn depends(mut self, inputs: &'static [u32]) -> Self {
         self.depends_on = inputs;
+        self
+    }
+
+    /// The same output, declaring other inputs for Initialization Mode than after it.
+    pub const fn initial_depends(mut self, inputs: &'static [u32]) -> Self {
+        self.initial_depends_on = Some(inputs);
         self
     }
 

@@ -86,11 +86,20 @@ fn type_attrs(v: &Variable) -> (&'static str, Attrs) {
 
 /// 1-based ModelVariables indices of value references, space separated.
 fn indices<M: Model>(vrs: &[u32]) -> String {
-    vrs.iter()
-        .filter_map(|vr| M::VARIABLES.iter().position(|v| v.vr == *vr))
-        .map(|i| (i + 1).to_string())
-        .collect::<Vec<_>>()
-        .join(" ")
+    let mut i: Vec<usize> = vrs.iter().filter_map(|vr| M::VARIABLES.iter().position(|v| v.vr == *vr)).collect();
+    // FMI 2.0, 2.2.8: dependencies are ordered by index.
+    i.sort_unstable();
+    i.dedup();
+    i.iter().map(|i| (i + 1).to_string()).collect::<Vec<_>>().join(" ")
+}
+
+/// The knowns an initial unknown depends on in Initialization Mode (FMI 2.0, 2.2.8: inputs and
+/// variables with initial="exact"): the inputs it depends on in Initialization Mode (as after it
+/// unless the table says otherwise) and every parameter, since the start state is computed from
+/// them.
+pub fn initial_dependencies<M: Model>(v: &Variable) -> Vec<u32> {
+    let parameters = M::VARIABLES.iter().filter(|p| p.causality == Causality::Parameter).map(|p| p.vr);
+    v.initial_depends_on.unwrap_or(v.depends_on).iter().copied().chain(parameters).collect()
 }
 
 /// The complete modelDescription.xml of model `M`.
@@ -122,7 +131,7 @@ fn write<M: Model>() -> io::Result<String> {
                 ("modelIdentifier", info.identifier.into()),
                 ("needsExecutionTool", flag(false)),
                 ("canHandleVariableCommunicationStepSize", flag(true)),
-                ("canInterpolateInputs", flag(info.can_interpolate_inputs)),
+                ("canInterpolateInputs", flag(info.can_interpolate_inputs())),
                 ("maxOutputDerivativeOrder", "0".into()),
                 ("canRunAsynchronuously", flag(false)),
                 ("canBeInstantiatedOnlyOncePerProcess", flag(false)),
@@ -193,7 +202,7 @@ fn write<M: Model>() -> io::Result<String> {
                     })?;
                 }
                 // FMI 2.0 section 2.2.8: outputs with initial approx/calculated and calculated
-                // parameters; no dependencies attribute = may depend on every known.
+                // parameters, with their dependencies on the knowns of Initialization Mode.
                 let initial: Vec<&Variable> = M::VARIABLES
                     .iter()
                     .filter(|v| {
@@ -204,7 +213,8 @@ fn write<M: Model>() -> io::Result<String> {
                 if !initial.is_empty() {
                     w.create_element("InitialUnknowns").write_inner_content(|w| {
                         for v in &initial {
-                            element(w, "Unknown", &vec![("index", indices::<M>(&[v.vr]))])?;
+                            let deps = indices::<M>(&initial_dependencies::<M>(v));
+                            element(w, "Unknown", &vec![("index", indices::<M>(&[v.vr])), ("dependencies", deps)])?;
                         }
                         Ok(())
                     })?;

@@ -3,13 +3,19 @@
 //! [`super::HydraulicCircuit`], advanced by the Radau IIA integrator.
 //!
 //! States: the boom's generalised coordinates and velocities (rigid: the stroke; flexible: the
-//! section angles). The boom carries the rod and piston (mass and weight), as in HydraulicBoom.
+//! section angles). The boom carries the rod and piston (mass and weight), as in HydraulicBoom,
+//! and the cylinder's end stops: they are the contact of the piston with the barrel, mechanics on
+//! this side of the cut, with the law and parameters of [`crate::hydraulics::cylinder`]
+//! (`cylinder.k_stop`, `cylinder.c_stop`). HydraulicCircuit's port force has none, so the pair
+//! coupled equals HydraulicBoom, and the boom alone with no force comes to rest on the bottom stop.
 
 use super::parts::{
     self, out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION,
 };
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::hydraulics::circuit::Circuit;
+use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
@@ -20,14 +26,11 @@ pub mod vr {
     pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, START_F, Z_C};
 }
 
-/// Index of `cylinder.stroke` in the circuit parameters: the boom's range of motion.
-const STROKE_INDEX: usize = {
-    let mut k = 0;
-    while !parts::str_eq(PARAMS[k].spec.name, "cylinder.stroke") {
-        k += 1;
-    }
-    k
-};
+/// The circuit parameters the boom uses (indices in [`PARAMS`]): the cylinder's stroke, its range
+/// of motion, and its end stops.
+const STROKE: usize = parts::param_index("cylinder.stroke");
+const K_STOP: usize = parts::param_index("cylinder.k_stop");
+const C_STOP: usize = parts::param_index("cylinder.c_stop");
 
 #[rustfmt::skip]
 const OWN: [Variable; 17] = [
@@ -49,16 +52,20 @@ const OWN: [Variable; 17] = [
         "Cylinder force that holds the boom at rest at start.x (set HydraulicCircuit's start.F to it)"),
     Variable::real_input("port.c_h", vr::C_H, 0.0, "N", "kN", FORCE_RANGE,
         "TLM port: wave from the circuit, c_h = F_H + Z_c v_H (linear over a step with its derivative)"),
-    out("port.c_m", vr::C_M, "N", "kN", "TLM port: wave to the circuit, c_m = F_M - Z_c v_M at the step end"),
-    port::PORT_F,
+    // Plain port: the wave and the line force are the input cylinder.F.
+    out("port.c_m", vr::C_M, "N", "kN", "TLM port: wave to the circuit, c_m = F_M - Z_c v_M at the step end")
+        .depends(&[vr::F]),
+    port::PORT_F.depends(&[vr::F]),
 ];
 
-const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 1 + N_BOOM_ROWS;
+const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 3 + N_BOOM_ROWS;
 const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .vars(&SOLVER_LOCALS)
     .sections()
-    .hydraulics(PARAMS, STROKE_INDEX, STROKE_INDEX + 1)
+    .hydraulics(PARAMS, STROKE, STROKE + 1)
     .boom_params()
+    .hydraulics(PARAMS, K_STOP, K_STOP + 1)
+    .hydraulics(PARAMS, C_STOP, C_STOP + 1)
     .build();
 
 const DOCUMENTATION: &str = r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
@@ -67,8 +74,10 @@ starts at rest at <code>start.x</code>; <code>start.F</code> is the cylinder for
 <code>port.coupling</code> selects the port, as in HydraulicCircuit: <b>0, plain</b>: input <code>cylinder.F</code>
 (linear over a step with fmi2SetRealInputDerivatives); <b>1, TLM</b>: input wave c<sub>h</sub>, the boom is pushed by
 F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub> and emits c<sub>m</sub> = F<sub>M</sub> &minus;
-Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). Outputs: stroke, velocity, boom angle, payload
-position, tip deflection and section angles.</p>"#;
+Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). The cylinder's end stops act here
+(<code>cylinder.k_stop</code>, <code>cylinder.c_stop</code>; HydraulicCircuit's port force has none): with no force
+the boom comes to rest on the bottom stop. Outputs: stroke, velocity, boom angle, payload position, tip deflection
+and section angles.</p>"#;
 
 /// The boom driven through the port, as one ODE over a step.
 #[derive(Debug, Clone)]
@@ -77,15 +86,22 @@ pub struct PortedBoom {
     pub coupling: Coupling,
     /// Plain: the cylinder force; TLM: the wave c_h.
     pub input: Ramp,
+    /// The cylinder whose end stops bound the stroke.
+    pub cylinder: Cylinder,
 }
 
 impl PortedBoom {
-    /// Force pushing the rod out at `t` and stroke rate `v`.
+    /// Port force pushing the rod out at `t` and stroke rate `v`.
     pub fn force(&self, t: f64, v: f64) -> f64 {
         match self.coupling {
             Coupling::Plain => self.input.at(t),
             Coupling::Tlm { z_c, .. } => self.input.at(t) - z_c * v,
         }
+    }
+
+    /// Everything that pushes the rod out at `t`, stroke `x`, rate `v`: port and end stops.
+    fn rod_force(&self, t: f64, x: f64, v: f64) -> f64 {
+        self.force(t, v) + self.cylinder.end_stop_force(x, v)
     }
 }
 
@@ -99,7 +115,7 @@ impl OdeSystem for PortedBoom {
         let (q, qd) = s.split_at(b.dof());
         let (dq, dqd) = dx.split_at_mut(b.dof());
         dq.copy_from_slice(qd);
-        b.accelerations(q, qd, &mut |_, v| self.force(t, v), dqd);
+        b.accelerations(q, qd, &mut |x, v| self.rod_force(t, x, v), dqd);
     }
 
     /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
@@ -126,7 +142,11 @@ impl BoomMechanics {
     /// The model at time `t` with the port input `input`, the emitted wave `c_m` and the given
     /// state (at rest at start.x if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [input, c_m]: [f64; 2]) -> Result<Self, String> {
-        let stroke = values.real(vr::HYDRAULICS + STROKE_INDEX as u32);
+        let mut circuit = Circuit::default();
+        for k in [STROKE, K_STOP, C_STOP] {
+            (PARAMS[k].set)(&mut circuit, values.real(vr::HYDRAULICS + k as u32));
+        }
+        let (cylinder, stroke) = (circuit.cylinder, circuit.cylinder.stroke);
         let boom = Boom::from_values(values, stroke)?;
         let x0 = values.real(vr::X0);
         if !(0.0..=stroke).contains(&x0) {
@@ -134,8 +154,8 @@ impl BoomMechanics {
         }
         let rest =
             boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
-        let sys =
-            PortedBoom { boom, coupling: Coupling::from_values(values), input: Ramp { t0: t, y0: input, slope: 0.0 } };
+        let input = Ramp { t0: t, y0: input, slope: 0.0 };
+        let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input, cylinder };
         let state = parts::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
         let solver = Radau5::new(sys.dim());
         Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
@@ -155,7 +175,7 @@ impl Model for BoomMechanics {
         identifier: "BoomMechanics",
         description:
             "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
-        can_interpolate_inputs: true,
+        interpolated_inputs: &[vr::F, vr::C_H],
         documentation: DOCUMENTATION,
         ..parts::PLANT_INFO
     };

@@ -5,13 +5,15 @@
 //!
 //! States: the circuit's six (p1..p4, spool position, load-holding opening), then the boom's
 //! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
-//! angle of each section). The operator's reference `valve.u_ref` is held over each step.
+//! angle of each section). The operator's reference `valve.u_ref` is linear over a step with the
+//! slope the master passes with fmi2SetRealInputDerivatives (held without one).
 
 pub use super::parts::Boom;
 use super::parts::{
     self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, FLEXIBLE_SWITCH, N_BOOM_ROWS,
     SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
 };
+use super::port::Ramp;
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
@@ -66,7 +68,8 @@ spool has dynamics), so the FMU can be coupled to a controller without an algebr
 pub struct Plant {
     pub circuit: Circuit,
     pub boom: Boom,
-    pub u_ref: f64,
+    /// The operator's reference over the step.
+    pub u_ref: Ramp,
 }
 
 impl OdeSystem for Plant {
@@ -74,7 +77,7 @@ impl OdeSystem for Plant {
         N_CIRCUIT + 2 * self.boom.mechanics().dof()
     }
 
-    fn rhs(&self, _t: f64, s: &[f64], dx: &mut [f64]) {
+    fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
         let b = self.boom.mechanics();
         let (c, boom) = s.split_at(N_CIRCUIT);
         let (q, qd) = boom.split_at(b.dof());
@@ -83,7 +86,7 @@ impl OdeSystem for Plant {
         let (dq, dqd) = dboom.split_at_mut(b.dof());
         dq.copy_from_slice(qd);
         let mut force = |x, v| {
-            let e = self.circuit.evaluate(c, self.u_ref, x, v);
+            let e = self.circuit.evaluate(c, self.u_ref.at(t), x, v);
             dc.copy_from_slice(&e.dx);
             e.force
         };
@@ -102,7 +105,7 @@ impl Plant {
     pub fn from_values(values: &Values) -> Result<Self, String> {
         let circuit = parts::circuit_from_values(values)?;
         let boom = Boom::from_values(values, circuit.cylinder.stroke)?;
-        Ok(Plant { circuit, boom, u_ref: values.real(vr::U_REF) })
+        Ok(Plant { circuit, boom, u_ref: Ramp { t0: 0.0, y0: values.real(vr::U_REF), slope: 0.0 } })
     }
 
     /// Static equilibrium at stroke `x0`: the load held at rest by the closed CBV.
@@ -154,7 +157,7 @@ impl Model for HydraulicBoom {
         identifier: "HydraulicBoom",
         description:
             "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
-        can_interpolate_inputs: false,
+        interpolated_inputs: &[vr::U_REF],
         documentation: DOCUMENTATION,
         ..parts::PLANT_INFO
     };
@@ -186,13 +189,13 @@ impl Model for HydraulicBoom {
     fn do_step(
         &mut self,
         values: &Values,
-        _input_derivatives: &[f64],
+        input_derivatives: &[f64],
         t: f64,
         h: f64,
         tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        self.plant.u_ref = values.real(vr::U_REF);
+        self.plant.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
         let plant = &self.plant;
         parts::advance(&mut self.solver, plant, &mut self.state, t, h, tolerance, || plant.state_scale(), log)
     }

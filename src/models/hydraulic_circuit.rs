@@ -59,7 +59,7 @@ const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
             "Plain port: cylinder stroke from the mechanics (at the step start)"),
         Variable::real_input("cylinder.v", vr::V, 0.0, "m/s", "mm/s", (-10.0, 10.0),
             "Plain port: cylinder velocity from the mechanics, > 0 extending (linear over a step with its derivative)"),
-        out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops (at port.x, port.v)")
+        out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction (at port.x, port.v); the end stops are the mechanics'")
             .depends(&[vr::X, vr::V]),
         out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity").depends(&[vr::X, vr::V]),
     ])
@@ -74,10 +74,14 @@ const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
         Variable::param(vr::START_F, START_FORCE).fixed(),
         Variable::real_input("port.c_m", vr::C_M, START_FORCE.default, "N", "kN", FORCE_RANGE,
             "TLM port: wave from the mechanics, c_m = F_M - Z_c v_M (linear over a step with its derivative)"),
-        out("port.c_h", vr::C_H, "N", "kN", "TLM port: wave to the mechanics, c_h = F_H + Z_c v_H at the step end"),
-        port::PORT_F,
-        out("port.x", vr::PORT_X, "m", "mm", "Stroke the circuit uses: cylinder.x ramped with cylinder.v (plain), the rod's (TLM)"),
-        out("port.v", vr::PORT_V, "m/s", "mm/s", "Velocity the circuit uses: cylinder.v (plain), the rod's (TLM)"),
+        // Plain port: the wave and the line force are cylinder.F, so they depend on x and v.
+        out("port.c_h", vr::C_H, "N", "kN", "TLM port: wave to the mechanics, c_h = F_H + Z_c v_H at the step end")
+            .depends(&[vr::X, vr::V]),
+        port::PORT_F.depends(&[vr::X, vr::V]),
+        out("port.x", vr::PORT_X, "m", "mm", "Stroke the circuit uses: cylinder.x ramped with cylinder.v (plain), the rod's (TLM)")
+            .depends(&[vr::X]),
+        out("port.v", vr::PORT_V, "m/s", "mm/s", "Velocity the circuit uses: cylinder.v (plain), the rod's (TLM)")
+            .depends(&[vr::V]),
     ])
     .build();
 
@@ -97,7 +101,9 @@ the line force F<sub>H</sub> = c<sub>m</sub> + Z<sub>c</sub>v<sub>H</sub>, and e
 Z<sub>c</sub>v<sub>H</sub>; the mechanics is pushed by F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub>
 and emits c<sub>m</sub> = F<sub>M</sub> &minus; Z<sub>c</sub>v<sub>M</sub>. Passive at any step; it adds a spring
 Z<sub>c</sub>/h and a mass Z<sub>c</sub>h at the pin.</li></ul>
-<p>The circuit starts in the static equilibrium that holds <code>start.F</code> with the CBV closed (set it to the
+<p>The cylinder's end stops are not in the port force: they are the contact of piston and barrel, and belong to
+the mechanics (BoomMechanics has them; mechanics of your own keeps the stroke within [0, <code>cylinder.stroke</code>]).
+The circuit starts in the static equilibrium that holds <code>start.F</code> with the CBV closed (set it to the
 mechanics' static cylinder force at the start).</p>"#;
 
 /// The circuit with its port, as one ODE over a step.
@@ -107,7 +113,8 @@ pub struct PortedCircuit {
     pub coupling: Coupling,
     /// TLM rod mass (kg).
     pub m: f64,
-    pub u_ref: f64,
+    /// The operator's reference over the step.
+    pub u_ref: Ramp,
     /// Plain: stroke at the step start and the velocity over the step.
     pub x0: f64,
     pub v: Ramp,
@@ -127,7 +134,11 @@ impl PortedCircuit {
     /// The circuit's evaluation and the line force at `t`, state `s`.
     fn evaluate(&self, t: f64, s: &[f64]) -> (circuit::Eval, f64) {
         let (x, v) = self.motion(t, s);
-        let e = self.circuit.evaluate(s[..N_CIRCUIT].try_into().expect("circuit slice"), self.u_ref, x, v);
+        let mut e = self.circuit.evaluate(s[..N_CIRCUIT].try_into().expect("circuit slice"), self.u_ref.at(t), x, v);
+        // The end stops are the piston's contact with the barrel: mechanics, on the other side of
+        // the cut (BoomMechanics applies them). The port force is pressure forces - friction.
+        e.force -= e.f_stop;
+        e.f_stop = 0.0;
         let f_line = match self.coupling {
             Coupling::Plain => e.force,
             Coupling::Tlm { z_c, .. } => self.c_m.at(t) + z_c * v,
@@ -185,7 +196,7 @@ impl HydraulicCircuit {
             circuit,
             coupling: Coupling::from_values(values),
             m: values.real(vr::M),
-            u_ref: values.real(vr::U_REF),
+            u_ref: Ramp { t0: t, y0: values.real(vr::U_REF), slope: 0.0 },
             x0: values.real(vr::X),
             v: Ramp { t0: t, y0: values.real(vr::V), slope: 0.0 },
             c_m: Ramp { t0: t, y0: c_m, slope: 0.0 },
@@ -216,7 +227,8 @@ impl Model for HydraulicCircuit {
     const INFO: ModelInfo = ModelInfo {
         identifier: "HydraulicCircuit",
         description: "Pressure-compensated valve, counterbalance valve and cylinder with a mechanical port (plain or TLM) for external mechanics (thesis Fig. 2.8)",
-        can_interpolate_inputs: true,
+        // cylinder.x follows the integral of cylinder.v within a step: it has no slope of its own.
+        interpolated_inputs: &[vr::U_REF, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
         ..parts::PLANT_INFO
     };
@@ -233,7 +245,7 @@ impl Model for HydraulicCircuit {
 
     fn outputs(&self, values: &mut Values) {
         let mut sys = self.sys.clone();
-        sys.u_ref = values.real(vr::U_REF);
+        sys.u_ref = Ramp { t0: self.t, y0: values.real(vr::U_REF), slope: 0.0 };
         if sys.coupling == Coupling::Plain {
             (sys.x0, sys.v) = (values.real(vr::X), Ramp { t0: self.t, y0: values.real(vr::V), slope: 0.0 });
         }
@@ -258,7 +270,7 @@ impl Model for HydraulicCircuit {
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
         let sys = &mut self.sys;
-        sys.u_ref = values.real(vr::U_REF);
+        sys.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
         sys.x0 = values.real(vr::X);
         sys.v = Ramp::read(values, input_derivatives, vr::V, t);
         sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);

@@ -175,7 +175,7 @@ const SECTION_NAMES: [&str; MAX_SECTIONS] = [
 /// Parameters that count or select (a model index, section counts): exposed as Integers.
 const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
 
-pub(crate) const fn str_eq(a: &str, b: &str) -> bool {
+const fn str_eq(a: &str, b: &str) -> bool {
     let (a, b) = (a.as_bytes(), b.as_bytes());
     if a.len() != b.len() {
         return false;
@@ -188,6 +188,17 @@ pub(crate) const fn str_eq(a: &str, b: &str) -> bool {
         i += 1;
     }
     true
+}
+
+/// Index of the circuit parameter `name` in [`crate::hydraulics::params::PARAMS`] (compile-time
+/// error if there is none).
+pub(crate) const fn param_index(name: &str) -> usize {
+    let params = crate::hydraulics::params::PARAMS;
+    let mut k = 0;
+    while !str_eq(params[k].spec.name, name) {
+        k += 1;
+    }
+    k
 }
 
 const fn is_selector(name: &str) -> bool {
@@ -463,7 +474,7 @@ pub(crate) const PLANT_INFO: crate::fmi2::ModelInfo = crate::fmi2::ModelInfo {
     step_size: 1e-3,
     default_tolerance: 1e-6,
     log_categories: &[("logSolver", "Integrator statistics per communication step")],
-    can_interpolate_inputs: false,
+    interpolated_inputs: &[],
     documentation: "",
 };
 

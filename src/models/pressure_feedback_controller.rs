@@ -11,6 +11,7 @@
 
 use super::port::Ramp;
 use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
+use crate::fmi2::instance::bounded_slope;
 use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
 
 /// Value references (stable across releases).
@@ -44,10 +45,14 @@ const VARIABLES: &[Variable] = &[
         "Operator's spool reference; < 0 lowers the load",
     ),
     Variable::real_input("p", vr::P, 0.0, "Pa", "bar", P_RANGE, "Fed-back pressure (p4, rod side / CBV pilot)"),
+    // The filter starts at rest at the initial p (u_comp = 0): in Initialization Mode u depends
+    // on u_ref only.
     Variable::real_output("u", vr::U, "1", "%", "Spool command u = clamp(u_ref + u_comp, u_min, u_max)")
-        .depends(&[vr::U_REF, vr::P]),
+        .depends(&[vr::U_REF, vr::P])
+        .initial_depends(&[vr::U_REF]),
     Variable::real_output("u_comp", vr::U_COMP, "1", "%", "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)")
-        .depends(&[vr::P]),
+        .depends(&[vr::P])
+        .initial_depends(&[]),
     Variable::param(vr::K_F, FEEDBACK_SPECS[0]),
     Variable::param(vr::OMEGA_F, FEEDBACK_SPECS[1]),
     Variable::param(vr::Q_RATED, FEEDBACK_SPECS[2]).fixed(),
@@ -166,19 +171,27 @@ impl PressureFeedbackController {
         (u_comp, values.real(vr::U_REF) + u_comp)
     }
 
-    /// The pressure over the step from `t`: the input with the master's slope; with
-    /// `p.extrapolation` and no slope, a new sample with the slope through the previous one, or,
-    /// if the master set none since the last step, the last ramp continued.
-    fn pressure_ramp(&self, values: &Values, input_derivatives: &[f64], t: f64) -> Ramp {
+    /// The pressure over the step from `t` of length `h`: the input with the master's slope;
+    /// with `p.extrapolation` and no slope, a new sample with the slope through the previous one,
+    /// or, if the master set none since the last step, the last ramp continued. An extrapolated
+    /// ramp that would leave p's declared range within the step stops at the bound
+    /// ([`bounded_slope`], as the FMI layer bounds a master's slope), re-anchored at `t`.
+    fn pressure_ramp(&self, values: &Values, input_derivatives: &[f64], t: f64, h: f64) -> Ramp {
         let given = Ramp::read(values, input_derivatives, vr::P, t);
-        if !self.extrapolate || given.slope != 0.0 {
-            given
+        let ramp = if !self.extrapolate || given.slope != 0.0 {
+            return given;
         } else if !self.fresh {
             self.p
         } else if self.sampled && t > self.p.t0 {
             Ramp { slope: (given.y0 - self.p.y0) / (t - self.p.t0), ..given }
         } else {
             given
+        };
+        let (y, slope) = (ramp.at(t), bounded_slope(ramp.at(t), ramp.slope, h, P_RANGE));
+        if slope == ramp.slope {
+            ramp
+        } else {
+            Ramp { t0: t, y0: y, slope }
         }
     }
 }
@@ -193,7 +206,7 @@ impl Model for PressureFeedbackController {
         step_size: 1e-3,
         default_tolerance: 1e-6,
         log_categories: &[("logSaturation", "Spool command clamped at u_min or u_max")],
-        can_interpolate_inputs: true,
+        interpolated_inputs: &[vr::U_REF, vr::P],
         documentation: DOCUMENTATION,
     };
     const VARIABLES: &'static [Variable] = VARIABLES;
@@ -237,7 +250,7 @@ impl Model for PressureFeedbackController {
         _tolerance: f64,
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
-        let p = self.pressure_ramp(values, input_derivatives, t);
+        let p = self.pressure_ramp(values, input_derivatives, t, h);
         self.x = self.feedback.advance(self.x, p.at(t), p.slope, h);
         (self.p, self.sampled, self.fresh, self.t) = (p, true, false, t + h);
         let (_, u) = self.command(values, p.at(self.t));

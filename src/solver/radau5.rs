@@ -312,10 +312,10 @@ impl Radau5 {
 
     /// Number of `f64` that [`save_state`](Self::save_state) writes for dimension `n`.
     pub fn saved_len(n: usize) -> usize {
-        8 + n * n + 4 * n
+        SAVED_HEAD + n * n + 4 * n
     }
 
-    /// Number of `f64` in [`save_state`](Self::save_state): `8 + n² + 4n`.
+    /// Number of `f64` in [`save_state`](Self::save_state): `14 + n² + 4n`.
     pub fn state_len(&self) -> usize {
         Self::saved_len(self.n)
     }
@@ -324,7 +324,8 @@ impl Radau5 {
     /// contraction, Jacobian validity (0/1), the step size of the LU factors (0 = none), size
     /// and end time of the last accepted step (size 0 = none), the Newton convergence factor
     /// carried between steps (`θ/(1-θ)` of the last iteration), the number of solves the LU
-    /// factors have served (`iteration.rs`: when they are inverted), the Jacobian (column-major), the
+    /// factors have served (`iteration.rs`: when they are inverted), the six work counters of
+    /// [`SolverStats`] (exact as f64 below 2^53), the Jacobian (column-major), the
     /// collocation polynomial of the last step (3n) and its end state (n). The LU factors are
     /// not saved: they are a deterministic function of the Jacobian and their step size, and
     /// [`load_state`](Self::load_state) recomputes them bit-identically.
@@ -339,6 +340,7 @@ impl Radau5 {
             self.faccon,
             self.mats.uses() as f64,
         ];
+        s.extend(stats_array(&self.stats).map(|c| c as f64));
         s.extend_from_slice(self.jac.as_slice());
         for v in self.cont.iter().chain([&self.y]) {
             s.extend_from_slice(v);
@@ -354,7 +356,12 @@ impl Radau5 {
         }
         let jac_valid = s[2] == 1.0;
         let ok = s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && s[4] >= 0.0;
-        let uses_ok = s[7] >= 0.0 && s[7] <= u32::MAX as f64 && s[7].fract() == 0.0;
+        let count = |x: f64, max: f64| (0.0..=max).contains(&x) && x.fract() == 0.0;
+        let uses_ok = count(s[7], u32::MAX as f64);
+        let counters = &s[8..SAVED_HEAD];
+        if !counters.iter().all(|&c| count(c, (1u64 << 53) as f64)) {
+            return Err(invalid(format!("work counters {counters:?} are not counts")));
+        }
         if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0 && uses_ok) {
             return Err(invalid(format!(
                 "step-size hint {}, contraction {}, flag {}, LU step size {}, last step {}, convergence factor {}, \
@@ -367,7 +374,7 @@ impl Radau5 {
         self.theta = s[1];
         self.jac_valid = jac_valid;
         (self.h_cont, self.t_cont, self.faccon) = (s[4], s[5], s[6]);
-        let (jac, rest) = s[8..].split_at(n * n);
+        let (jac, rest) = s[SAVED_HEAD..].split_at(n * n);
         self.jac.as_mut_slice().copy_from_slice(jac);
         for (v, saved) in self.cont.iter_mut().chain([&mut self.y]).zip(rest.chunks_exact(n)) {
             v.copy_from_slice(saved);
@@ -380,6 +387,16 @@ impl Radau5 {
             }
             self.mats.set_uses(s[7] as u32);
         }
+        // After the refactorisation, which is no work of the restored integration.
+        let c = counters;
+        self.stats = SolverStats {
+            accepted_steps: c[0] as u64,
+            rejected_steps: c[1] as u64,
+            rhs_evals: c[2] as u64,
+            jacobian_evals: c[3] as u64,
+            lu_decompositions: c[4] as u64,
+            newton_iterations: c[5] as u64,
+        };
         Ok(())
     }
 
@@ -450,7 +467,10 @@ impl Radau5 {
         let mut need_jac = !self.jac_valid || self.theta > THET;
         let (mut need_lu, mut caljac) = (need_jac || !self.lu_matches(h), false);
         let (mut theta, mut hold) = (self.theta, if continues { self.h_cont } else { h });
-        let mut zero_start = !continues;
+        // Extrapolating the last collocation polynomial over more than the largest step growth
+        // within an integration (1/FACR) is no prediction: after a tiny step (1e-100 s) it would
+        // be by 1e94. Start the Newton iteration from zero then.
+        let mut zero_start = !continues || h > hold / FACR;
         let (mut hacc, mut erracc, mut n_acc) = (0.0, 0.0, 0u64);
         let (mut n_rej_row, mut n_attempts) = (0u32, 0u64);
         let mut fail: Option<FailureCause> = None;
@@ -853,6 +873,14 @@ fn bit_equal(a: &[f64], b: &[f64]) -> bool {
 
 fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
+}
+
+/// Leading numbers of a saved state: eight of the integration, six work counters.
+const SAVED_HEAD: usize = 14;
+
+/// The work counters in the order [`Radau5::save_state`] writes them.
+fn stats_array(s: &SolverStats) -> [u64; 6] {
+    [s.accepted_steps, s.rejected_steps, s.rhs_evals, s.jacobian_evals, s.lu_decompositions, s.newton_iterations]
 }
 
 fn invalid(msg: String) -> SolveError {
