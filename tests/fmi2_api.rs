@@ -235,28 +235,31 @@ fn instances_in_threads_are_independent_and_deterministic() {
     a.iter().zip(&b).for_each(|(x, y)| assert!((4.0 * x - y).abs() <= 1e-12 * y.abs().max(1e-12)));
 }
 
-/// A model that fails: panics at t >= 1 when `mode` = 1, gives up at t = 0.5 when `mode` = 2.
+/// A model that fails: panics at t >= 1 when `mode` = 1, gives up at t = 0.5 when `mode` = 2,
+/// reports a NaN output after t = 0.5 when `mode` = 3 (a model evaluated outside its range).
 #[derive(Clone)]
 struct Faulty {
     mode: f64,
+    t: f64,
 }
 
 impl Model for Faulty {
     const INFO: ModelInfo = ModelInfo { identifier: "Faulty", ..Pfc::INFO };
     const VARIABLES: &'static [Variable] = &[
-        Variable::real_input("mode", 0, 0.0, "1", "", (0.0, 2.0), "failure mode"),
+        Variable::real_input("mode", 0, 0.0, "1", "", (0.0, 3.0), "failure mode"),
         Variable::real_output("y", 1, "1", "", ""),
     ];
     fn initialize(values: &Values) -> Result<Self, String> {
-        Ok(Faulty { mode: values.real(0) })
+        Ok(Faulty { mode: values.real(0), t: 0.0 })
     }
     fn retune(&mut self, _: &Values) -> Result<(), String> {
         Ok(())
     }
     fn outputs(&self, values: &mut Values) {
-        values.set_real(1, self.mode)
+        values.set_real(1, if self.mode == 3.0 && self.t > 0.5 { f64::NAN } else { self.mode })
     }
     fn do_step(&mut self, v: &Values, _: &[f64], t: f64, h: f64, _: f64, _: &mut dyn Log) -> Result<(), StepError> {
+        self.t = t + h;
         match v.real(0) as i32 {
             1 if t + h >= 1.0 => panic!("model bug"),
             2 if t + h > 0.5 => Err(StepError { time: 0.5, message: "solver gave up".into() }),
@@ -296,4 +299,20 @@ fn a_failed_step_is_discarded_at_the_last_good_time() {
     assert_eq!(b, FMI2_TRUE);
     assert_eq!(s.step(0.5, 0.1), ERR, "stepFailed allows no further step");
     assert_eq!(unsafe { api::terminate::<Faulty>(s.c) }, OK);
+}
+
+/// Never a non-finite value after fmi2OK: a step whose outputs are not finite returns fmi2Error
+/// naming the variable, and no later fmi2GetReal hands the NaN out with fmi2OK.
+#[test]
+fn a_non_finite_output_is_an_error_naming_it() {
+    let s = Slave::<Faulty>::initialized("nan", &[(0, 3.0)]);
+    assert_eq!(s.step(0.0, 0.5), OK);
+    assert_eq!(s.step(0.5, 0.5), ERR);
+    let e = s.last_error();
+    assert!(e.contains("fmi2DoStep") && e.contains("y = NaN") && e.contains("t = 1") && e.contains("Error state"), "{e}");
+    let mut y = 0.0;
+    assert_eq!(unsafe { api::get_real::<Faulty>(s.c, &1, 1, &mut y) }, ERR);
+    assert!(s.last_error().contains("y = NaN"), "{}", s.last_error());
+    assert_eq!(s.step(1.0, 0.5), ERR, "the Error state allows no step");
+    assert_eq!(unsafe { api::reset::<Faulty>(s.c) }, OK);
 }

@@ -134,3 +134,70 @@ impl<M: Model> Drop for Slave<M> {
         unsafe { api::free_instance::<M>(self.c) }
     }
 }
+
+/// Overwrites the f64 at byte `at` of a serialised FMU state and recomputes its trailing CRC-32:
+/// a forged state that passes every integrity check.
+pub fn forge(b: &mut [u8], at: usize, x: f64) {
+    b[at..at + 8].copy_from_slice(&x.to_le_bytes());
+    let n = b.len() - 4;
+    let crc = crc32(&b[..n]);
+    b[n..].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320), bit by bit: a second implementation,
+/// so that forged states are not made with the code under test.
+fn crc32(data: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in data {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 { (c >> 1) ^ 0xEDB8_8320 } else { c >> 1 };
+        }
+    }
+    !c
+}
+
+/// Byte offset of the payload of a serialised FMU state (the layout of src/fmi2/fmu_state.rs,
+/// read independently: magic 8, format version 4, GUID length 4 + GUID, payload length 8).
+pub fn payload_offset(b: &[u8]) -> usize {
+    let n = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
+    16 + n + 8
+}
+
+/// Byte offset of the value of the variable at table index `i` in a serialised state of `M`:
+/// after the payload's state code 1, three times 24, two optional times 2 x 9, outputs flag 1 and
+/// the value count 8, each value is a type tag (0 Real: 8 bytes, 1 Integer: 4, 2 Boolean: 1,
+/// 3 String: length 8 + bytes).
+pub fn value_offset<M: Model>(b: &[u8], i: usize) -> usize {
+    let mut at = payload_offset(b) + 1 + 24 + 18 + 1 + 8;
+    for _ in 0..i {
+        at += 1 + match b[at] {
+            0 => 8,
+            1 => 4,
+            2 => 1,
+            _ => 8 + u64::from_le_bytes(b[at + 1..at + 9].try_into().unwrap()) as usize,
+        };
+    }
+    assert!(i < M::VARIABLES.len());
+    at + 1
+}
+
+/// A forged state: the value of the variable at table index `i` replaced by `x`.
+pub fn forge_value<M: Model>(b: &mut [u8], i: usize, x: f64) {
+    let at = value_offset::<M>(b, i);
+    forge(b, at, x);
+}
+
+/// The instance's current state, serialised (fmi2GetFMUstate, size, serialise, free).
+pub fn serialized<M: Model>(s: &Slave<M>) -> Vec<u8> {
+    let mut st: fmi2FMUstate = std::ptr::null_mut();
+    let mut size = 0;
+    unsafe {
+        assert_eq!(api::get_fmu_state::<M>(s.c, &mut st), fmi2Status::OK);
+        assert_eq!(api::serialized_fmu_state_size::<M>(s.c, st, &mut size), fmi2Status::OK);
+        let mut b = vec![0u8; size];
+        assert_eq!(api::serialize_fmu_state::<M>(s.c, st, b.as_mut_ptr() as *mut fmi2Byte, size), fmi2Status::OK);
+        assert_eq!(api::free_fmu_state::<M>(s.c, &mut st), fmi2Status::OK);
+        b
+    }
+}
