@@ -49,7 +49,7 @@ fn instantiate_refuses_bad_arguments_with_a_reason() {
 }
 
 /// FMI 2.0, 2.1.5 and 4.3.1: with canNotUseMemoryManagementFunctions="true" the importer may pass
-/// NULL allocateMemory/freeMemory (fmusim does); boomsim also runs with a NULL logger, silently.
+/// NULL allocateMemory/freeMemory; boomsim also runs with a NULL logger, silently.
 #[test]
 fn instantiate_accepts_null_memory_callbacks_and_a_null_logger() {
     let (n, g) = (CString::new("x").unwrap(), CString::new(guid::<Pfc>()).unwrap());

@@ -112,7 +112,8 @@ pub fn get_version() -> *const c_char {
 }
 
 /// fmi2Instantiate. The memory callbacks may be NULL: the FMU declares
-/// `canNotUseMemoryManagementFunctions="true"` and never calls them (fmusim passes NULL). A NULL
+/// `canNotUseMemoryManagementFunctions="true"` and never calls them (FMI 2.0.4, 2.1.5: an importer
+/// may then pass NULL; hosts built on the FMI Library and some Reference-FMUs tools do). A NULL
 /// logger is accepted too: the instance then runs silently, its statuses still tell every failure
 /// (FMI 2.0 requires a logger; refusing would leave the importer without any reason at all).
 pub unsafe fn instantiate<M: Model>(
