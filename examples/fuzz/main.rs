@@ -1,0 +1,154 @@
+//! Seeded API-sequence fuzzer of the FMI 2.0 Co-Simulation C ABI of the boomsim FMUs.
+//!
+//! ```sh
+//! bash scripts/fuzz [--seconds S] [--seed N] [--lib PATH ...]     # default: 60 s over the four FMUs
+//! bash scripts/fuzz --lib target/release/libHydraulicBoom.so --seed N --replay
+//! ```
+//!
+//! A sequence is one fmi2Instantiate, 20 to 200 calls and fmi2FreeInstance, all drawn from its
+//! seed. Most calls are what a well-behaved importer does, so that the models really simulate (at
+//! most 0.5 s per sequence); the others are any function with arguments an importer can get
+//! wrong, also on a NULL instance. The oracle is checked after every call; a crash (a signal) or a
+//! hang (a sequence still running after 10 s) fails the sequence too. Log messages that report a
+//! panic the FMU caught ("internal error") are counted and the first is shown with its seed, but
+//! they are not failures.
+//!
+//! A failure prints the sequence's seed, the message and the last calls; `--seed N --replay` with
+//! that seed and its `--lib` runs exactly this sequence in-process, without fork, printing every
+//! call and log message. Without `--seed` the master seed comes from the clock; it is printed,
+//! and `--seed N` repeats the run (as far as the same number of sequences fit in the time
+//! budget). Exit status: 0 when nothing failed, 1 on a failure, 2 on a usage or setup error.
+//!
+//! - `fmi2`: the C ABI and the libraries under test; `model_description`: their XML;
+//! - `sequence`: one sequence, of calls (`ops`) from `planner` (an importer's) and `wild`
+//!   (hostile ones), drawn with `rng`;
+//! - `session`: makes the calls and checks the oracle, with `view` (the instance's phase and
+//!   time), `fmu_states` and `callbacks` (the logger);
+//! - `batch`: the forked children, heartbeat and timeout; `report`: their account in shared
+//!   memory, the tallies and the output.
+
+mod batch;
+mod callbacks;
+mod fmi2;
+mod fmu_states;
+mod model_description;
+mod ops;
+mod planner;
+mod report;
+mod rng;
+mod sequence;
+mod session;
+mod view;
+mod wild;
+
+use fmi2::Library;
+use report::Tally;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// The FMUs of this repository, fuzzed when no `--lib` is given.
+const MODELS: [&str; 4] = ["PressureFeedbackController", "HydraulicBoom", "HydraulicCircuit", "BoomMechanics"];
+
+const USAGE: &str = "usage: fuzz [--seconds S] [--seed N] [--lib PATH ...] [--replay]
+  --seconds S   time budget, split evenly over the libraries (default 60)
+  --seed N      master seed (default: from the clock, printed); with --replay, a sequence's seed
+  --lib PATH    FMU shared libraries (default: target/release/lib<Id>.so of the four FMUs);
+                the model description is modelDescription/<Id>.xml of this repository
+  --replay      run the sequence --seed N on the one --lib in-process, printing every call";
+
+fn main() {
+    let code = match parse_args(std::env::args().skip(1)) {
+        Ok(Some(options)) => run(&options).unwrap_or_else(|e| {
+            eprintln!("fuzz: {e}");
+            2
+        }),
+        Ok(None) => {
+            println!("{USAGE}");
+            0
+        }
+        Err(e) => {
+            eprintln!("fuzz: {e}\n{USAGE}");
+            2
+        }
+    };
+    std::process::exit(code)
+}
+
+/// Fuzzes every library for its share of the time, or replays one sequence; the exit status.
+fn run(options: &Options) -> Result<i32, String> {
+    let libraries = options.libs.iter().map(|p| Library::load(p)).collect::<Result<Vec<_>, _>>()?;
+    if options.replay {
+        let [library] = &libraries[..] else {
+            return Err("--replay runs one sequence on one library: give exactly one --lib".into());
+        };
+        let seed = options.seed.ok_or("--replay needs the --seed of the sequence")?;
+        return Ok(sequence::replay(library, seed));
+    }
+    let seed = options.seed.unwrap_or_else(clock_seed);
+    let budget = Duration::from_secs_f64(options.seconds / libraries.len() as f64);
+    println!("fuzz: seed {seed} (repeat with --seed {seed}), {:.1} s per library", budget.as_secs_f64());
+    let started = Instant::now();
+    let mut total = Tally::default();
+    for library in &libraries {
+        let tally = batch::fuzz_library(library, seed, budget)?;
+        println!("fuzz: {}", tally.line(&library.model.identifier));
+        if let Some((seed, message)) = &tally.first_internal_error {
+            println!("fuzz:   first internal error (sequence seed {seed}): {message}");
+        }
+        total.add(tally);
+    }
+    total.elapsed = started.elapsed();
+    println!("fuzz: total {} (seed {seed})", total.line(&format!("{} libraries", libraries.len())));
+    Ok(if total.failures > 0 { 1 } else { 0 })
+}
+
+/// Command-line options.
+struct Options {
+    seconds: f64,
+    seed: Option<u64>,
+    libs: Vec<PathBuf>,
+    replay: bool,
+}
+
+/// Parses the arguments; `None` for `--help`.
+fn parse_args(args: impl Iterator<Item = String>) -> Result<Option<Options>, String> {
+    let mut o = Options { seconds: 60.0, seed: None, libs: Vec::new(), replay: false };
+    let mut args = args.peekable();
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--seconds" => o.seconds = parse_value(args.next(), &arg)?,
+            "--seed" => o.seed = Some(parse_value(args.next(), &arg)?),
+            "--replay" => o.replay = true,
+            "--lib" => {
+                o.libs.push(args.next().ok_or("--lib needs a path")?.into());
+                while let Some(path) = args.next_if(|a| !a.starts_with("--")) {
+                    o.libs.push(path.into());
+                }
+            }
+            "-h" | "--help" => return Ok(None),
+            _ => return Err(format!("unknown argument {arg:?}")),
+        }
+    }
+    if !(o.seconds > 0.0 && o.seconds.is_finite()) {
+        return Err("--seconds must be a positive number".into());
+    }
+    if o.libs.is_empty() {
+        o.libs = MODELS.iter().map(|id| repository().join(format!("target/release/lib{id}.so"))).collect();
+    }
+    Ok(Some(o))
+}
+
+fn parse_value<T: std::str::FromStr>(value: Option<String>, flag: &str) -> Result<T, String> {
+    value.as_deref().and_then(|v| v.parse().ok()).ok_or_else(|| format!("{flag} needs a number"))
+}
+
+/// The repository root, with `modelDescription/` and `target/`.
+fn repository() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A master seed from the clock.
+fn clock_seed() -> u64 {
+    let mut nanos = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
+    rng::splitmix64(&mut nanos)
+}

@@ -1,0 +1,220 @@
+//! What the fuzzer reads from `modelDescription/<Id>.xml`: the GUID, the log categories and every
+//! variable, with the lists the call generators draw from.
+
+use crate::rng::Rng;
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::XmlVersion;
+use std::collections::HashMap;
+use std::os::raw::c_int;
+use std::path::Path;
+
+/// A variable's base type.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Type {
+    Real,
+    Integer,
+    Boolean,
+    String,
+}
+
+/// Every base type, in the order of `Description::by_type`.
+pub const TYPES: [Type; 4] = [Type::Real, Type::Integer, Type::Boolean, Type::String];
+
+/// One ScalarVariable. The range is ±Inf (Real) or the C int range (Integer) when not declared.
+pub struct Variable {
+    pub name: String,
+    pub vr: u32,
+    pub ty: Type,
+    causality: String,
+    variability: String,
+    initial: Option<String>,
+    pub min: f64,
+    pub max: f64,
+    start: Option<f64>,
+}
+
+type Attributes = HashMap<String, String>;
+
+impl Variable {
+    /// From the attributes of a ScalarVariable and of its type element (`Real`, `Integer`, ...).
+    fn new(scalar: &Attributes, tag: &str, typed: &Attributes) -> Result<Self, String> {
+        let name = scalar.get("name").cloned().ok_or("a ScalarVariable without name")?;
+        let vr = scalar
+            .get("valueReference")
+            .and_then(|s| s.parse().ok())
+            .ok_or_else(|| format!("{name}: no valid valueReference"))?;
+        let (ty, lo, hi) = match tag {
+            "Real" => (Type::Real, f64::NEG_INFINITY, f64::INFINITY),
+            "Integer" | "Enumeration" => (Type::Integer, c_int::MIN as f64, c_int::MAX as f64),
+            "Boolean" => (Type::Boolean, 0.0, 1.0),
+            _ => (Type::String, 0.0, 1.0),
+        };
+        let number = |key: &str| typed.get(key).and_then(|s| s.parse::<f64>().ok());
+        let start = match ty {
+            Type::Boolean => typed.get("start").map(|s| f64::from(u8::from(s == "true" || s == "1"))),
+            Type::String => None,
+            _ => number("start"),
+        };
+        let text = |key: &str, default: &str| scalar.get(key).cloned().unwrap_or_else(|| default.into());
+        Ok(Variable {
+            causality: text("causality", "local"),
+            variability: text("variability", "continuous"),
+            initial: scalar.get("initial").cloned(),
+            min: number("min").unwrap_or(lo),
+            max: number("max").unwrap_or(hi),
+            name,
+            vr,
+            ty,
+            start,
+        })
+    }
+
+    /// A finite interval to draw values from: the range, or around the start where unbounded.
+    pub fn span(&self) -> (f64, f64) {
+        let start = self.start.unwrap_or(0.0);
+        let lo = if self.min.is_finite() { self.min } else { start - 1.0 - start.abs() };
+        let hi = if self.max.is_finite() { self.max } else { start + 1.0 + start.abs() };
+        if lo <= hi && (hi - lo).is_finite() {
+            (lo, hi)
+        } else {
+            (start, start)
+        }
+    }
+
+    /// A value inside the range: mostly the start value or near it, sometimes anywhere in the
+    /// range or at a bound (Integer rounded, Boolean 0 or 1).
+    pub fn plausible(&self, rng: &mut Rng) -> f64 {
+        if self.ty == Type::Boolean {
+            return if rng.chance(0.6) { self.start.unwrap_or(0.0) } else { rng.below(2) as f64 };
+        }
+        let (lo, hi) = self.span();
+        let start = self.start.unwrap_or(0.0).clamp(lo, hi);
+        let x = match rng.below(10) {
+            0..=3 => start,
+            4..=6 => start + (hi - lo) * rng.uniform(-0.05, 0.05),
+            7..=8 => rng.uniform(lo, hi),
+            _ if rng.chance(0.5) => lo,
+            _ => hi,
+        }
+        .clamp(lo, hi);
+        if self.ty == Type::Integer {
+            x.round()
+        } else {
+            x
+        }
+    }
+
+    /// A value at a bound of the range, or just across it.
+    pub fn edge(&self, rng: &mut Rng) -> f64 {
+        let bound = if rng.chance(0.5) { self.min } else { self.max };
+        match rng.below(4) {
+            0 => bound,
+            1 => bound.next_up(),
+            2 => bound.next_down(),
+            _ => bound + *rng.pick(&[-1e-6, 1e-6]) * bound.abs().max(1.0),
+        }
+    }
+}
+
+/// The model description, with the lists the generators draw from.
+pub struct Description {
+    pub identifier: String,
+    pub guid: String,
+    pub categories: Vec<String>,
+    pub variables: Vec<Variable>,
+    /// Value references per type, in the order of `TYPES`.
+    by_type: [Vec<u32>; 4],
+    /// Value references of the Real outputs.
+    pub outputs: Vec<u32>,
+    /// Indices of the variables that may be set before initialisation ends (FMI 2.0, 2.2.7:
+    /// inputs and non-calculated parameters), but `boom.flexible`, which the planner sets itself.
+    pub init_settable: Vec<usize>,
+    /// Indices of the variables that may be set between steps: inputs and tunable parameters.
+    pub step_settable: Vec<usize>,
+    /// Indices of the Real inputs (for input derivatives).
+    pub real_inputs: Vec<usize>,
+    /// `boom.flexible`, when the model has it.
+    pub flexible: Option<u32>,
+    pub max_vr: u32,
+    index: HashMap<u32, usize>,
+}
+
+impl Description {
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let xml = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::parse(&xml).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    fn parse(xml: &str) -> Result<Self, String> {
+        let mut reader = quick_xml::Reader::from_str(xml);
+        let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
+        let mut scalar: Option<Attributes> = None;
+        loop {
+            match reader.read_event().map_err(|e| e.to_string())? {
+                Event::Start(e) | Event::Empty(e) => {
+                    let a = attributes(&e)?;
+                    match e.name().0 {
+                        "fmiModelDescription" => guid = a.get("guid").cloned(),
+                        "CoSimulation" => identifier = a.get("modelIdentifier").cloned(),
+                        "Category" => categories.extend(a.get("name").cloned()),
+                        "ScalarVariable" => scalar = Some(a),
+                        tag @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration") => {
+                            if let Some(s) = scalar.take() {
+                                variables.push(Variable::new(&s, tag, &a)?);
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                Event::Eof => break,
+                _ => {}
+            }
+        }
+        if variables.is_empty() {
+            return Err("no ScalarVariable".into());
+        }
+        let indices = |keep: &dyn Fn(&Variable) -> bool| -> Vec<usize> {
+            variables.iter().enumerate().filter(|(_, v)| keep(v)).map(|(i, _)| i).collect()
+        };
+        let input = |v: &Variable| v.causality == "input";
+        let parameter = |v: &Variable| v.causality == "parameter";
+        let flexible = variables.iter().find(|v| v.name == "boom.flexible" && v.ty == Type::Boolean).map(|v| v.vr);
+        Ok(Description {
+            by_type: TYPES.map(|t| variables.iter().filter(|v| v.ty == t).map(|v| v.vr).collect()),
+            outputs: variables.iter().filter(|v| v.ty == Type::Real && v.causality == "output").map(|v| v.vr).collect(),
+            init_settable: indices(&|v| {
+                v.variability != "constant"
+                    && (input(v) || (parameter(v) && v.initial.as_deref() != Some("calculated")))
+                    && Some(v.vr) != flexible
+            }),
+            step_settable: indices(&|v| input(v) || (parameter(v) && v.variability == "tunable")),
+            real_inputs: indices(&|v| input(v) && v.ty == Type::Real),
+            max_vr: variables.iter().map(|v| v.vr).max().unwrap_or(0),
+            index: variables.iter().enumerate().map(|(i, v)| (v.vr, i)).collect(),
+            identifier: identifier.ok_or("no CoSimulation modelIdentifier")?,
+            guid: guid.ok_or("no guid")?,
+            flexible,
+            categories,
+            variables,
+        })
+    }
+
+    pub fn variable(&self, vr: u32) -> Option<&Variable> {
+        self.index.get(&vr).map(|&i| &self.variables[i])
+    }
+
+    pub fn of_type(&self, ty: Type) -> &[u32] {
+        &self.by_type[ty as usize]
+    }
+}
+
+/// An element's attributes, unescaped.
+fn attributes(e: &BytesStart) -> Result<Attributes, String> {
+    e.attributes()
+        .map(|a| {
+            let a = a.map_err(|e| e.to_string())?;
+            let value = a.normalized_value(XmlVersion::Implicit1_0).map_err(|e| e.to_string())?;
+            Ok((a.key.0.to_owned(), value.into_owned()))
+        })
+        .collect()
+}

@@ -1,0 +1,219 @@
+//! The calls of a well-behaved importer, so that the models really simulate: setup,
+//! initialisation with values in range, steps of 0.1 to 10 ms, gets, FMU states, termination,
+//! reset; mostly with the rigid boom (`boom.flexible` = false).
+
+use crate::fmi2::{LAST_SUCCESSFUL_TIME, TERMINATED};
+use crate::model_description::{Description, Type, Variable};
+use crate::ops::{Arr, Op, Slot, Text};
+use crate::rng::Rng;
+use crate::session::Session;
+use crate::view::Phase;
+use crate::wild::blob;
+use std::collections::VecDeque;
+use std::os::raw::c_int;
+use std::ptr::null_mut;
+
+/// Proposes the next legal call from where the instance is.
+pub struct Planner {
+    /// Calls planned ahead, each for the phase it is legal in (dropped when the phase changes).
+    queue: VecDeque<(Phase, Op)>,
+    /// The sequence's usual communication step size.
+    h: f64,
+    /// Set once initialisation failed or the instance broke: plans keep the parameters' start values.
+    tame: bool,
+}
+
+impl Planner {
+    pub fn new(rng: &mut Rng) -> Self {
+        Planner { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false }
+    }
+
+    pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
+        if self.queue.front().is_some_and(|(phase, _)| *phase == s.view.phase) {
+            return self.queue.pop_front().expect("a planned call").1;
+        }
+        self.queue.clear();
+        let m = s.model;
+        let last_successful_time = Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false };
+        match s.view.phase {
+            Phase::Instantiated | Phase::Initialization => {
+                self.plan_initialization(rng, s);
+                self.queue.pop_front().map_or(Op::Reset, |(_, op)| op)
+            }
+            Phase::StepComplete => self.stepping(rng, s),
+            Phase::StepFailed => match rng.below(10) {
+                0..=2 => last_successful_time,
+                3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
+                4..=5 => get_reals(rng, m),
+                6 if !s.states.live.is_empty() => Op::SetFMUstate { state: rng.pick(&s.states.live).ptr },
+                6..=8 => Op::Reset,
+                _ => Op::Terminate,
+            },
+            Phase::Terminated => match rng.below(4) {
+                0 => get_reals(rng, m),
+                1 => state_op(rng, s),
+                _ => Op::Reset,
+            },
+            Phase::Unknown => last_successful_time,
+            Phase::Broken => {
+                self.tame = true;
+                Op::Reset
+            }
+        }
+    }
+
+    /// Queues setup, start values, fmi2EnterInitializationMode, more values and
+    /// fmi2ExitInitializationMode (from where the instance is). `boom.flexible` is set to false
+    /// in most sequences: the flexible boom is slow.
+    fn plan_initialization(&mut self, rng: &mut Rng, s: &Session) {
+        let m = s.model;
+        let tame = self.tame;
+        let sets = |rng: &mut Rng| if tame { 0 } else { rng.below(3) };
+        let mut plan = |phase: Phase, op: Option<Op>| self.queue.extend(op.map(|op| (phase, op)));
+        if s.view.phase == Phase::Instantiated {
+            if rng.chance(0.2) {
+                let categories =
+                    (0..rng.below(3)).filter_map(|_| rng.choose(&m.categories)).map(|c| Text::new(c)).collect();
+                let logging_on = c_int::from(rng.chance(0.5));
+                plan(Phase::Instantiated, Some(Op::SetDebugLogging { logging_on, categories: Arr::Items(categories) }));
+            }
+            if !s.view.set_up {
+                plan(Phase::Instantiated, Some(plausible_setup(rng)));
+            }
+            if let Some(vr) = m.flexible.filter(|_| rng.chance(0.85)) {
+                let values = Arr::Items(vec![0]);
+                plan(Phase::Instantiated, Some(Op::SetBoolean { vr: Arr::Items(vec![vr]), values }));
+            }
+            for _ in 0..sets(rng) {
+                plan(Phase::Instantiated, plausible_set(rng, m, &m.init_settable));
+            }
+            plan(Phase::Instantiated, Some(Op::EnterInitializationMode));
+        }
+        for _ in 0..sets(rng) {
+            plan(Phase::Initialization, plausible_set(rng, m, &m.init_settable));
+        }
+        if rng.chance(0.2) {
+            plan(Phase::Initialization, Some(get_reals(rng, m)));
+        }
+        plan(Phase::Initialization, Some(Op::ExitInitializationMode));
+    }
+
+    /// Between steps: mostly steps, input changes and gets, some FMU state handling; once the
+    /// budget or the stop time is reached, gets and the end of the simulation.
+    fn stepping(&self, rng: &mut Rng, s: &Session) -> Op {
+        let m = s.model;
+        let room = s.view.room(s.budget());
+        if room < 1e-6 {
+            return match rng.below(10) {
+                0..=5 => get_reals(rng, m),
+                6..=8 => Op::Terminate,
+                _ => Op::Reset,
+            };
+        }
+        let h = if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) };
+        match rng.below(100) {
+            0..=44 => Op::DoStep { t: s.view.time, h: h.min(room), no_set_prior: c_int::from(rng.chance(0.9)) },
+            45..=59 => plausible_set(rng, m, &m.step_settable).unwrap_or_else(|| get_reals(rng, m)),
+            60..=64 => plausible_slopes(rng, m).unwrap_or_else(|| get_reals(rng, m)),
+            65..=82 => get_reals(rng, m),
+            83..=84 if rng.chance(0.5) => {
+                Op::GetInteger { vr: Arr::Items(m.of_type(Type::Integer).to_vec()), null_values: false }
+            }
+            83..=84 => Op::GetBoolean { vr: Arr::Items(m.of_type(Type::Boolean).to_vec()), null_values: false },
+            85..=96 => state_op(rng, s),
+            97..=98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
+            _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
+        }
+    }
+}
+
+/// An FMU state call of an importer: get a new one, overwrite, restore, serialize (size first),
+/// deserialize intact bytes (or, now and then, damaged ones), free.
+fn state_op(rng: &mut Rng, s: &Session) -> Op {
+    let live = rng.choose(&s.states.live);
+    match (rng.below(8), live) {
+        (1, Some(l)) => Op::GetFMUstate { state: Slot::Holding(l.ptr) },
+        (2, Some(l)) => Op::SetFMUstate { state: l.ptr },
+        (3..=4, Some(l)) => match l.size {
+            Some(size) => Op::SerializeFMUstate { state: l.ptr, size, null_buffer: false },
+            None => Op::SerializedFMUstateSize { state: l.ptr, null_size: false },
+        },
+        (5, _) if !s.states.saved.is_empty() => {
+            Op::DeSerializeFMUstate { bytes: rng.pick(&s.states.saved).intact(), null_state: false }
+        }
+        (6, _) if !s.states.saved.is_empty() => Op::DeSerializeFMUstate { bytes: blob(rng, s), null_state: false },
+        (7, Some(l)) => Op::FreeFMUstate { state: Slot::Holding(l.ptr) },
+        _ => Op::GetFMUstate { state: Slot::Holding(null_mut()) },
+    }
+}
+
+/// fmi2Set of one to three variables of one type from `candidates` (indices), with values in range.
+fn plausible_set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Op> {
+    let first = &m.variables[*rng.choose(candidates)?];
+    let mut vars = vec![first];
+    for _ in 0..rng.below(3) {
+        let v = &m.variables[*rng.pick(candidates)];
+        if v.ty == first.ty {
+            vars.push(v);
+        }
+    }
+    let values: Vec<f64> = vars.iter().map(|v| v.plausible(rng)).collect();
+    let vr = Arr::Items(vars.iter().map(|v| v.vr).collect());
+    let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
+    Some(match first.ty {
+        Type::Real => Op::SetReal { vr, values: Arr::Items(values) },
+        Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
+        Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
+        Type::String => Op::SetString { vr, values: Arr::Items(vars.iter().map(|_| Text::new("fuzz")).collect()) },
+    })
+}
+
+/// fmi2GetReal of the outputs, of a few Reals, or of every Real.
+fn get_reals(rng: &mut Rng, m: &Description) -> Op {
+    let reals = m.of_type(Type::Real);
+    let vr = match rng.below(10) {
+        0..=2 if !m.outputs.is_empty() => m.outputs.clone(),
+        0..=6 => (0..rng.range(1, 8)).filter_map(|_| rng.choose(reals).copied()).collect(),
+        _ => reals.to_vec(),
+    };
+    Op::GetReal { vr: Arr::Items(vr), null_values: false }
+}
+
+/// First-order derivatives of one or two Real inputs, of a size that keeps them in range for a while.
+fn plausible_slopes(rng: &mut Rng, m: &Description) -> Option<Op> {
+    let vars: Vec<&Variable> =
+        (0..rng.range(1, 2)).filter_map(|_| rng.choose(&m.real_inputs)).map(|&i| &m.variables[i]).collect();
+    if vars.is_empty() {
+        return None;
+    }
+    let values = vars
+        .iter()
+        .map(|v| {
+            let (lo, hi) = v.span();
+            (hi - lo) * rng.uniform(-0.5, 0.5)
+        })
+        .collect();
+    Some(Op::SetRealInputDerivatives {
+        vr: Arr::Items(vars.iter().map(|v| v.vr).collect()),
+        orders: Arr::Items(vec![1; vars.len()]),
+        values: Arr::Items(values),
+    })
+}
+
+/// fmi2SetupExperiment as an importer calls it: start mostly 0 (sometimes far from it, where
+/// the time's resolution is coarse), a tolerance, sometimes a stop time.
+fn plausible_setup(rng: &mut Rng) -> Op {
+    let start = match rng.below(20) {
+        0..=15 => 0.0,
+        16..=17 => rng.uniform(0.0, 100.0),
+        18 => 1e6,
+        _ => 1e9,
+    };
+    Op::SetupExperiment {
+        tolerance_defined: c_int::from(rng.chance(0.5)),
+        tolerance: rng.log_uniform(1e-8, 1e-4),
+        start,
+        stop_defined: c_int::from(rng.chance(0.3)),
+        stop: start + rng.uniform(0.05, 1.0),
+    }
+}

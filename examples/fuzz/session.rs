@@ -1,0 +1,352 @@
+//! One sequence's instance: makes each call through the C ABI, checks the oracle on what it
+//! returned and keeps track of the instance's state. The oracle (a violation fails the sequence):
+//! - every function returns a valid fmi2Status (0..=4), and never fmi2OK or fmi2Warning for a
+//!   NULL instance;
+//! - fmi2GetReal with fmi2OK or fmi2Warning wrote finite numbers only;
+//!   fmi2GetRealStatus(fmi2LastSuccessfulTime) is the end of the last step the fuzzer saw succeed;
+//! - fmi2GetTypesPlatform is "default" and fmi2GetVersion "2.0";
+//! - the logger gets the componentEnvironment given to fmi2Instantiate, a valid status,
+//!   non-NULL strings and the format "%s" (checked in `callbacks`);
+//! - fmi2OK never answers a freed, foreign or NULL FMU state, or a damaged serialized one (CRC
+//!   not recomputed); fmi2GetFMUstate and fmi2DeSerializeFMUstate with fmi2OK return a new
+//!   state, fmi2FreeFMUstate sets the pointer to NULL; fmi2GetString returns non-NULL strings.
+//!
+//! Crashes and hangs are caught by `batch`.
+
+use crate::callbacks::LOG;
+use crate::fmi2::{CallbackFunctions, Component, Fmi2, FmuState, Library, Status, LAST_SUCCESSFUL_TIME, OK, WARNING};
+use crate::fmu_states::FmuStates;
+use crate::model_description::Description;
+use crate::ops::{Arr, Instantiation, Op, Slot, Text};
+use crate::report::Report;
+use crate::view::{Phase, View};
+use std::ffi::CStr;
+use std::os::raw::{c_char, c_int};
+use std::ptr::{null, null_mut};
+
+/// Simulated seconds per sequence at most (the flexible boom runs about 30 times real time).
+const SIMULATION_BUDGET: f64 = 0.5;
+
+/// The instance a call goes to: the sequence's, NULL, or a second one from a wild
+/// fmi2Instantiate, kept until the end of the sequence (its FMU states are foreign to the main one).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    Main,
+    Null,
+    Second,
+}
+
+/// What a call wrote, for the oracle and the bookkeeping.
+enum Output {
+    Nothing,
+    Text(*const c_char),
+    Instance(Component),
+    Reals(Vec<f64>),
+    Strings(Vec<*const c_char>),
+    State(FmuState),
+    Size(usize),
+    Bytes(Vec<u8>),
+    Real(f64),
+}
+
+/// One sequence's instance with the fuzzer's bookkeeping.
+pub struct Session<'a> {
+    fmi: &'a Fmi2,
+    pub model: &'a Description,
+    report: &'a mut Report,
+    pub c: Component,
+    /// The `Target::Second` instance, or NULL.
+    pub second: Component,
+    /// The main fmi2Instantiate has been called.
+    opened: bool,
+    /// Callback structures of the instances, alive until the end of the sequence; boxed, since
+    /// an FMU may keep the pointer and a Vec moves its elements.
+    #[allow(clippy::vec_box)]
+    callbacks: Vec<Box<CallbackFunctions>>,
+    pub view: View,
+    pub states: FmuStates,
+    /// Simulated time so far (an upper bound).
+    simulated: f64,
+}
+
+impl<'a> Session<'a> {
+    pub fn new(library: &'a Library, report: &'a mut Report) -> Self {
+        Session {
+            fmi: &library.fmi,
+            model: &library.model,
+            report,
+            c: null_mut(),
+            second: null_mut(),
+            opened: false,
+            callbacks: Vec::new(),
+            view: View::fresh(),
+            states: FmuStates::default(),
+            simulated: 0.0,
+        }
+    }
+
+    /// Makes one call and checks the oracle.
+    pub fn call(&mut self, op: Op, target: Target) -> Result<(), String> {
+        let (c, on) = match target {
+            Target::Main => (self.c, ""),
+            Target::Null => (null_mut(), " on a NULL instance"),
+            Target::Second => (self.second, " on the second instance"),
+        };
+        self.report.begin(format_args!("fmi2{op:?}{on}"));
+        // SAFETY: every pointer passed is NULL or points to as many elements as announced,
+        // alive for the call (see `invoke`); the instance is one of the session's or NULL.
+        let (status, output) = unsafe { self.invoke(c, &op) };
+        self.report.end(status);
+        if let Some(s) = status.filter(|s| !(0..=4).contains(s)) {
+            return Err(format!("returned {}, which is not an fmi2Status (0..=4)", s as c_int));
+        }
+        if let Some(violation) = LOG.with(|sink| sink.borrow_mut().violation.take()) {
+            return Err(violation);
+        }
+        let ok = matches!(status, Some(OK | WARNING));
+        match (target, output) {
+            (Target::Main, output) => self.observe(op, status, ok, output),
+            (Target::Null, _) if ok => Err("returned fmi2OK or fmi2Warning for a NULL instance".into()),
+            (Target::Second, Output::State(p)) if ok && !p.is_null() => {
+                self.states.foreign.push(p);
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Passes the arguments of `op` through the C ABI; output buffers are temporaries of the call.
+    unsafe fn invoke(&mut self, c: Component, op: &Op) -> (Option<Status>, Output) {
+        let f = self.fmi;
+        let status = |s| (Some(s), Output::Nothing);
+        match op {
+            Op::GetTypesPlatform => (None, Output::Text(f.fmi2GetTypesPlatform())),
+            Op::GetVersion => (None, Output::Text(f.fmi2GetVersion())),
+            Op::SetDebugLogging { logging_on, categories } => {
+                let names = categories.map(Text::ptr);
+                status(f.fmi2SetDebugLogging(c, *logging_on, names.len(), names.ptr()))
+            }
+            Op::Instantiate(spec) => (None, Output::Instance(self.instantiate(spec))),
+            Op::FreeInstance { instance } => {
+                f.fmi2FreeInstance(*instance);
+                (None, Output::Nothing)
+            }
+            Op::SetupExperiment { tolerance_defined, tolerance, start, stop_defined, stop } => {
+                status(f.fmi2SetupExperiment(c, *tolerance_defined, *tolerance, *start, *stop_defined, *stop))
+            }
+            Op::EnterInitializationMode => status(f.fmi2EnterInitializationMode(c)),
+            Op::ExitInitializationMode => status(f.fmi2ExitInitializationMode(c)),
+            Op::Terminate => status(f.fmi2Terminate(c)),
+            Op::Reset => status(f.fmi2Reset(c)),
+            Op::GetReal { vr, null_values } => {
+                // NaN: a value the FMU does not write fails the finiteness check.
+                let mut v = vec![f64::NAN; vr.len()];
+                (Some(f.fmi2GetReal(c, vr.ptr(), vr.len(), out(&mut v, *null_values))), Output::Reals(v))
+            }
+            Op::GetInteger { vr, null_values } => {
+                status(f.fmi2GetInteger(c, vr.ptr(), vr.len(), out(&mut vec![0; vr.len()], *null_values)))
+            }
+            Op::GetBoolean { vr, null_values } => {
+                status(f.fmi2GetBoolean(c, vr.ptr(), vr.len(), out(&mut vec![0; vr.len()], *null_values)))
+            }
+            Op::GetString { vr, null_values } => {
+                let mut v = vec![null(); vr.len()];
+                (Some(f.fmi2GetString(c, vr.ptr(), vr.len(), out(&mut v, *null_values))), Output::Strings(v))
+            }
+            Op::SetReal { vr, values } => status(f.fmi2SetReal(c, vr.ptr(), same_len(vr, values), values.ptr())),
+            Op::SetInteger { vr, values } => status(f.fmi2SetInteger(c, vr.ptr(), same_len(vr, values), values.ptr())),
+            Op::SetBoolean { vr, values } => status(f.fmi2SetBoolean(c, vr.ptr(), same_len(vr, values), values.ptr())),
+            Op::SetString { vr, values } => {
+                let strings = values.map(Text::ptr);
+                status(f.fmi2SetString(c, vr.ptr(), same_len(vr, values), strings.ptr()))
+            }
+            Op::GetFMUstate { state } => with_slot(*state, |p| f.fmi2GetFMUstate(c, p)),
+            Op::SetFMUstate { state } => status(f.fmi2SetFMUstate(c, *state)),
+            Op::FreeFMUstate { state } => with_slot(*state, |p| f.fmi2FreeFMUstate(c, p)),
+            Op::SerializedFMUstateSize { state, null_size } => {
+                let mut size = [0];
+                (Some(f.fmi2SerializedFMUstateSize(c, *state, out(&mut size, *null_size))), Output::Size(size[0]))
+            }
+            Op::SerializeFMUstate { state, size, null_buffer } => {
+                let mut bytes = vec![0u8; if *null_buffer { 0 } else { *size }];
+                let p = out(&mut bytes, *null_buffer);
+                (Some(f.fmi2SerializeFMUstate(c, *state, p.cast(), *size)), Output::Bytes(bytes))
+            }
+            Op::DeSerializeFMUstate { bytes, null_state } => {
+                let (data, mut state) = (&bytes.bytes, [null_mut()]);
+                let s = f.fmi2DeSerializeFMUstate(c, data.ptr().cast(), data.len(), out(&mut state, *null_state));
+                (Some(s), Output::State(state[0]))
+            }
+            Op::GetDirectionalDerivative { unknowns: u, knowns: k, dv_known, null_dv_unknown } => {
+                let (n, mut dv) = (same_len(k, dv_known), vec![0.0; u.len()]);
+                let dv = out(&mut dv, *null_dv_unknown);
+                status(f.fmi2GetDirectionalDerivative(c, u.ptr(), u.len(), k.ptr(), n, dv_known.ptr(), dv))
+            }
+            Op::SetRealInputDerivatives { vr, orders, values } => {
+                same_len(vr, orders);
+                status(f.fmi2SetRealInputDerivatives(c, vr.ptr(), same_len(vr, values), orders.ptr(), values.ptr()))
+            }
+            Op::GetRealOutputDerivatives { vr, orders, null_values } => {
+                let (n, mut v) = (same_len(vr, orders), vec![0.0; vr.len()]);
+                status(f.fmi2GetRealOutputDerivatives(c, vr.ptr(), n, orders.ptr(), out(&mut v, *null_values)))
+            }
+            Op::DoStep { t, h, no_set_prior } => status(f.fmi2DoStep(c, *t, *h, *no_set_prior)),
+            Op::CancelStep => status(f.fmi2CancelStep(c)),
+            Op::GetStatus { kind, null_value } => status(f.fmi2GetStatus(c, *kind as u32, out(&mut [0], *null_value))),
+            Op::GetRealStatus { kind, null_value } => {
+                let mut v = [f64::NAN];
+                (Some(f.fmi2GetRealStatus(c, *kind as u32, out(&mut v, *null_value))), Output::Real(v[0]))
+            }
+            Op::GetIntegerStatus { kind, null_value } => {
+                status(f.fmi2GetIntegerStatus(c, *kind as u32, out(&mut [0], *null_value)))
+            }
+            Op::GetBooleanStatus { kind, null_value } => {
+                status(f.fmi2GetBooleanStatus(c, *kind as u32, out(&mut [0], *null_value)))
+            }
+            Op::GetStringStatus { kind, null_value } => {
+                status(f.fmi2GetStringStatus(c, *kind as u32, out(&mut [null()], *null_value)))
+            }
+        }
+    }
+
+    /// fmi2Instantiate; the callback structure stays alive until the end of the sequence.
+    unsafe fn instantiate(&mut self, s: &Instantiation) -> Component {
+        let functions = s.callbacks.map(|cb| Box::new(cb.functions()));
+        let p = functions.as_deref().map_or(null(), |f| f as *const CallbackFunctions);
+        let Instantiation { name, fmu_type, guid, resources, visible, logging_on, .. } = s;
+        let c = self.fmi.fmi2Instantiate(
+            name.ptr(),
+            *fmu_type as u32,
+            guid.ptr(),
+            resources.ptr(),
+            p,
+            *visible,
+            *logging_on,
+        );
+        self.callbacks.extend(functions);
+        c
+    }
+
+    /// The oracle on what a call to the main instance returned, and the bookkeeping of its state.
+    fn observe(&mut self, op: Op, status: Option<Status>, ok: bool, output: Output) -> Result<(), String> {
+        let phase = self.view.phase;
+        match (op, output) {
+            (Op::GetTypesPlatform, Output::Text(p)) => expect_text(p, "default", "fmi2GetTypesPlatform")?,
+            (Op::GetVersion, Output::Text(p)) => expect_text(p, "2.0", "fmi2GetVersion")?,
+            (Op::Instantiate(_), Output::Instance(c)) => self.instantiated(c)?,
+            (Op::FreeInstance { instance }, _) if instance == self.c => {
+                self.c = null_mut();
+                self.states.live.clear();
+                self.states.stale.clear();
+            }
+            (Op::FreeInstance { instance }, _) if instance == self.second => {
+                self.second = null_mut();
+                self.states.foreign.clear();
+            }
+            (Op::SetupExperiment { start, stop_defined, stop, .. }, _) if ok => {
+                let v = &mut self.view;
+                (v.time, v.stop, v.set_up) = (start, (stop_defined != 0).then_some(stop), true);
+            }
+            (Op::EnterInitializationMode, _) if ok => self.view.phase = Phase::Initialization,
+            (Op::ExitInitializationMode, _) if ok => self.view.phase = Phase::StepComplete,
+            (Op::ExitInitializationMode, _) if phase == Phase::Initialization => self.view.phase = Phase::Broken,
+            (Op::Terminate, _) if ok => self.view.phase = Phase::Terminated,
+            (Op::Reset, _) if ok => self.view = View::fresh(),
+            (Op::GetReal { vr, .. }, Output::Reals(values)) if ok => self.check_reals(&vr, &values)?,
+            (Op::GetString { .. }, Output::Strings(p)) if ok && p.iter().any(|s| s.is_null()) => {
+                return Err("fmi2GetString returned fmi2OK with a NULL string".into());
+            }
+            (Op::GetFMUstate { state }, Output::State(p)) if ok => self.states.got(state, p, self.view)?,
+            (Op::SetFMUstate { state }, _) if ok => self.view = self.states.live_mut(state, "fmi2SetFMUstate")?.view,
+            (Op::FreeFMUstate { state: Slot::Holding(p) }, Output::State(after)) if ok => {
+                self.states.freed(p, after)?
+            }
+            (Op::SerializedFMUstateSize { state, .. }, Output::Size(n)) if ok => {
+                self.states.live_mut(state, "fmi2SerializedFMUstateSize")?.size = Some(n);
+            }
+            (Op::SerializeFMUstate { state, .. }, Output::Bytes(bytes)) if ok => {
+                self.states.serialized(state, bytes)?
+            }
+            (Op::DeSerializeFMUstate { bytes, .. }, Output::State(p)) if ok => self.states.deserialized(&bytes, p)?,
+            (Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, .. }, Output::Real(t)) if ok => {
+                self.view.synchronised(t)?
+            }
+            (Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, .. }, _) if phase == Phase::Unknown => {
+                self.view.phase = Phase::Broken;
+            }
+            (Op::DoStep { t, h, .. }, _) => self.simulated += self.view.stepped(t, h, status),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The main instance; else the second one, with an FMU state of it; else one to free right away.
+    fn instantiated(&mut self, c: Component) -> Result<(), String> {
+        if !self.opened {
+            self.opened = true;
+            self.c = c;
+            Ok(())
+        } else if c.is_null() {
+            Ok(())
+        } else if self.second.is_null() {
+            self.second = c;
+            self.call(Op::GetFMUstate { state: Slot::Holding(null_mut()) }, Target::Second)
+        } else {
+            self.call(Op::FreeInstance { instance: c }, Target::Main)
+        }
+    }
+
+    /// fmi2GetReal said fmi2OK or fmi2Warning: every value must be finite.
+    fn check_reals(&self, vr: &Arr<u32>, values: &[f64]) -> Result<(), String> {
+        let Some(i) = values.iter().position(|x| !x.is_finite()) else { return Ok(()) };
+        let name = match vr {
+            Arr::Items(v) => {
+                self.model.variable(v[i]).map_or(format!("vr {}", v[i]), |var| format!("{} (vr {})", var.name, v[i]))
+            }
+            Arr::Null(_) => "a value for a NULL vr array".into(),
+        };
+        Err(format!("fmi2GetReal returned fmi2OK or fmi2Warning, but {name} = {}", values[i]))
+    }
+
+    /// Simulated seconds left for the sequence.
+    pub fn budget(&self) -> f64 {
+        SIMULATION_BUDGET - self.simulated
+    }
+}
+
+/// An output pointer to `buffer`, or NULL.
+fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
+    if null {
+        null_mut()
+    } else {
+        buffer.as_mut_ptr()
+    }
+}
+
+/// The length of paired C arrays, which the fuzzer always makes announce the same.
+fn same_len<A, B>(a: &Arr<A>, b: &Arr<B>) -> usize {
+    assert_eq!(a.len(), b.len(), "fuzzer bug: paired arrays of different lengths");
+    a.len()
+}
+
+/// Calls `f` with the FMUstate* of a slot; the status and what the variable holds after.
+unsafe fn with_slot(slot: Slot, f: impl FnOnce(*mut FmuState) -> Status) -> (Option<Status>, Output) {
+    let (s, held) = match slot {
+        Slot::Null => (f(null_mut()), null_mut()),
+        Slot::Holding(mut p) => (f(&mut p), p),
+    };
+    (Some(s), Output::State(held))
+}
+
+/// Checks a string a function returned.
+fn expect_text(p: *const c_char, expected: &str, function: &str) -> Result<(), String> {
+    if p.is_null() {
+        return Err(format!("{function} returned NULL"));
+    }
+    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string (FMI 2.0, 2.1.4).
+    let text = unsafe { CStr::from_ptr(p) };
+    if text.to_bytes() != expected.as_bytes() {
+        return Err(format!("{function} returned {text:?}, not {expected:?}"));
+    }
+    Ok(())
+}
