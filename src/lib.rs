@@ -5,6 +5,8 @@
 //! [`models`] composes it into FMU models; [`fmi2`] exposes any model through the C ABI.
 
 pub mod analysis;
+/// Timing through dlopen: Unix only (the library itself builds for every platform).
+#[cfg(unix)]
 pub mod bench;
 pub mod control;
 pub mod fmi2;
@@ -12,5 +14,6 @@ pub mod hydraulics;
 pub mod mechanics;
 pub mod models;
 pub mod params;
+pub mod platform;
 pub mod solver;
 pub mod units;

@@ -2,9 +2,10 @@
 //! analyse the linearised stability.
 
 use boomsim::models;
+use boomsim::platform::Platform;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::ExitCode;
 
 #[derive(Parser)]
 #[command(
@@ -24,6 +25,11 @@ enum Cmd {
         /// Output directory.
         #[arg(long, default_value = "target/fmu")]
         out: PathBuf,
+        /// Binary platforms, comma-separated: linux64 (the host), win64, aarch64-linux, or all.
+        /// The cross builds need scripts/setup-cross; the first one builds the standard library
+        /// for its target (about a minute each on 2 cores).
+        #[arg(long, default_value = "linux64")]
+        platforms: String,
     },
     /// Time the lowering scenarios U and B in-process and through the C ABI (1 ms steps, rtol 1e-6).
     Bench {
@@ -69,37 +75,38 @@ fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root().join("target"))
 }
 
-/// Builds every FMU crate in release mode.
-fn build_fmus() -> Result<(), String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut build = Command::new(cargo);
-    build.current_dir(root()).args(["build", "--release", "--quiet"]);
-    for f in models::all() {
-        build.args(["-p", f.package]);
-    }
+/// Builds every FMU crate in release mode for `platform`.
+fn build_fmus(platform: &Platform) -> Result<(), String> {
+    let packages: Vec<&str> = models::all().iter().map(|f| f.package).collect();
+    let mut build = platform.build_command(root(), &target_dir(), &packages)?;
     let status = build.status().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
-        return Err(format!("cargo build failed ({status})"));
+        return Err(format!("cargo build for {} failed ({status})", platform.name));
     }
     Ok(())
 }
 
-fn pack(out: &Path) -> Result<(), String> {
-    build_fmus()?;
-    let fmus = models::all();
+fn pack(out: &Path, platforms: &str) -> Result<(), String> {
+    let platforms = Platform::parse_list(platforms)?;
+    for (k, p) in platforms.iter().enumerate() {
+        let start = std::time::Instant::now();
+        eprintln!("pack: building the FMU libraries for {} ({} of {})", p.name, k + 1, platforms.len());
+        build_fmus(p)?;
+        eprintln!("pack: {} built in {:.0} s", p.name, start.elapsed().as_secs_f64());
+    }
     let out = if out.is_absolute() { out.to_path_buf() } else { root().join(out) };
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    for f in &fmus {
-        let lib = target_dir().join("release").join(format!("lib{}.so", f.identifier));
+    for f in &models::all() {
+        let libs: Vec<_> = platforms.iter().map(|p| (*p, p.library(&target_dir(), f.identifier))).collect();
         let fmu = out.join(format!("{}.fmu", f.identifier));
-        f.write(&lib, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
+        f.write(&libs, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
         println!("{}", fmu.display());
     }
     Ok(())
 }
 
 fn bench(json: bool, duration: f64) -> Result<(), String> {
-    build_fmus()?;
+    build_fmus(&boomsim::platform::PLATFORMS[0])?;
     let libs = target_dir().join("release");
     let results = boomsim::bench::run_all(&libs, duration)?;
     let cycle_in = boomsim::bench::controller_cycle(
@@ -211,7 +218,7 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let result = match Cli::parse().command {
-        Cmd::Pack { out } => pack(&out),
+        Cmd::Pack { out, platforms } => pack(&out, &platforms),
         Cmd::Bench { json, duration } => bench(json, duration),
         Cmd::Eigen { json, count } => eigen(json, count),
         Cmd::Xml { check } => xml(check),

@@ -1,11 +1,13 @@
-//! The .fmu archive: modelDescription.xml at the root, the shared library under
-//! `binaries/linux64/<modelIdentifier>.so`, and `documentation/index.html`.
+//! The .fmu archive: modelDescription.xml at the root, the shared library of every platform
+//! under `binaries/<platform>/<modelIdentifier>.<so|dll>` ([`crate::platform`]), and
+//! `documentation/index.html`.
 
 use super::model::Model;
 use super::variables::{Kind, Variable};
 use super::xml::{model_description, num};
+use crate::platform::Platform;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 
 /// One FMU the project ships: its model and the cdylib package that exports it.
@@ -29,16 +31,17 @@ impl Fmu {
         }
     }
 
-    /// Writes the .fmu from the built shared library. Entries carry a fixed timestamp, so the
-    /// archive is reproducible.
-    pub fn write(&self, library: &Path, out: &Path) -> zip::result::ZipResult<()> {
-        let so = std::fs::read(library)?;
+    /// Writes the .fmu from the built shared library of each platform. Entries carry a fixed
+    /// timestamp, so the archive is reproducible.
+    pub fn write(&self, libraries: &[(Platform, PathBuf)], out: &Path) -> zip::result::ZipResult<()> {
         let mut zip = zip::ZipWriter::new(std::fs::File::create(out)?);
         let deflate = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         zip.start_file("modelDescription.xml", deflate)?;
         zip.write_all((self.model_description)().as_bytes())?;
-        zip.start_file(format!("binaries/linux64/{}.so", self.identifier), deflate.unix_permissions(0o755))?;
-        zip.write_all(&so)?;
+        for (platform, library) in libraries {
+            zip.start_file(platform.entry(self.identifier), deflate.unix_permissions(0o755))?;
+            zip.write_all(&std::fs::read(library)?)?;
+        }
         zip.start_file("documentation/index.html", deflate)?;
         zip.write_all((self.documentation)().as_bytes())?;
         zip.finish()?;

@@ -1,0 +1,169 @@
+"""Every FMU carries linux64, win64 and aarch64-linux binaries, and each runs: the C host of
+tests/host/fmu_host.c, compiled with gcc, MinGW-w64 and aarch64 gcc, loads the library natively,
+under wine64 and under qemu-aarch64, and the numbers must agree with linux64.
+
+Needs `boomsim pack --platforms all` (scripts/test does it) and scripts/setup-cross.
+
+What agrees how well, and why:
+- the controller's outputs to 1e-12 relative: a closed-form filter (exp, arithmetic), identical
+  code; only libm's exp may differ, by an ulp;
+- the plants' outputs, at rtol 1e-6, to 1e-5 of each output's largest magnitude over the run: the
+  same code, but the platforms' libm (glibc on x86-64 and aarch64, msvcrt on Windows) differs in
+  the last bit of exp, pow, tanh, sin/cos/acos, and the adaptive Radau IIA integrator turns such
+  differences into different step sequences: two integrations of the same ODE, each with its
+  global error a small multiple of rtol, so they may differ by a few rtol (10 rtol allowed). A real
+  defect (a wrong ABI, a mis-linked math function, a truncated constant) is far larger. The
+  largest differences are printed (pytest -s) and quoted in the README."""
+
+import os
+import pathlib
+import shutil
+import subprocess
+import xml.etree.ElementTree as ET
+import zipfile
+
+import fmpy
+from fmpy.validation import validate_fmu
+import pytest
+
+from conftest import fmu_path
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HOST_SOURCE = ROOT / "tests" / "host" / "fmu_host.c"
+PLATFORMS = ("linux64", "win64", "aarch64-linux")
+IDS = ("PressureFeedbackController", "HydraulicBoom", "HydraulicCircuit", "BoomMechanics")
+WINE = "/usr/lib/wine/wine64"
+QEMU = ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
+SUFFIX = {"linux64": ".so", "win64": ".dll", "aarch64-linux": ".so"}
+#: The libraries a binary may import: what every Windows 10 and every glibc Linux has.
+ALLOWED_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "userenv.dll", "ws2_32.dll", "bcryptprimitives.dll"}
+ALLOWED_SO = {"libc.so.6", "libm.so.6", "libgcc_s.so.1", "ld-linux-aarch64.so.1", "ld-linux-x86-64.so.2"}
+#: The 34 functions of FMI 2.0 CS (25 common + 9 co-simulation).
+FMI2_CS = """GetTypesPlatform GetVersion SetDebugLogging Instantiate FreeInstance SetupExperiment
+EnterInitializationMode ExitInitializationMode Terminate Reset GetReal GetInteger GetBoolean GetString
+SetReal SetInteger SetBoolean SetString GetFMUstate SetFMUstate FreeFMUstate SerializedFMUstateSize
+SerializeFMUstate DeSerializeFMUstate GetDirectionalDerivative SetRealInputDerivatives
+GetRealOutputDerivatives DoStep CancelStep GetStatus GetRealStatus GetIntegerStatus GetBooleanStatus
+GetStringStatus""".split()
+
+@pytest.fixture(scope="module")
+def unpacked(tmp_path_factory):
+    """Every FMU unzipped, with its GUID."""
+    out = {}
+    for ident in IDS:
+        d = tmp_path_factory.mktemp(ident)
+        with zipfile.ZipFile(fmu_path(ident)) as z:
+            z.extractall(d)
+        out[ident] = (d, ET.parse(d / "modelDescription.xml").getroot().get("guid"))
+    return out
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory):
+    """The C host for each platform and the command prefix that runs it."""
+    d = tmp_path_factory.mktemp("host")
+    compilers = {  # compiler, executable, libraries, runner
+        "linux64": ("gcc", "fmu_host", ["-ldl"], []),
+        "win64": ("x86_64-w64-mingw32-gcc", "fmu_host.exe", [], [WINE]),
+        "aarch64-linux": ("aarch64-linux-gnu-gcc", "fmu_host_aarch64", ["-ldl"], QEMU),
+    }
+    out = {}
+    for platform, (cc, name, libs, runner) in compilers.items():
+        exe = d / name
+        subprocess.run([cc, "-O2", "-std=c99", "-Wall", "-Werror", "-o", str(exe), str(HOST_SOURCE)] + libs, check=True)
+        out[platform] = runner + [str(exe)]
+    return out
+
+
+def run(hosts, unpacked, platform, steps, fmus, ops):
+    """fmu_host's printed rows (lists of floats) for the FMUs `fmus` on `platform`."""
+    args = [str(steps), "0.001"]
+    for ident in fmus:
+        d, guid = unpacked[ident]
+        args += [str(d / "binaries" / platform / (ident + SUFFIX[platform])), guid]
+    env = dict(os.environ, WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
+    r = subprocess.run(hosts[platform] + args + ["--"] + ops, capture_output=True, text=True, env=env, timeout=600)
+    assert r.returncode == 0, f"{platform}: {r.stderr}"
+    return [[float(x) for x in line.split()] for line in r.stdout.splitlines()]
+
+
+#: Scenarios: (name, FMUs, steps, ops, relative tolerance). Value references are the stable ones
+#: of the README (plant: valve.u_ref 0, p1..p4 1-4, Q1..Q4 8-11, cylinder.x 12, v 13, F 14,
+#: boom.theta 16, tip deflection 40, boom.flexible 31; controller: u_ref 0, p 1, u 2, u_comp 3,
+#: filter.p_lp 10).
+PLANT_OUT = [f"print:0:{vr}" for vr in (1, 2, 3, 4, 8, 10, 11, 12, 13, 14)]
+SCENARIOS = [
+    ("controller, pressure ramp", ["PressureFeedbackController"], 500,
+     ["real:0:1=4e6", "ramp:0:1=4e6,2e7", "real:0:0=-0.05", "print:0:2", "print:0:3", "print:0:10"], 1e-12),
+    ("HydraulicBoom U, flexible, 2 s", ["HydraulicBoom"], 2000,
+     ["real:0:0=-0.05", "tol:1e-6"] + PLANT_OUT + ["print:0:16", "print:0:40"], 1e-5),
+    ("HydraulicBoom B with the controller, flexible, 2 s", ["HydraulicBoom", "PressureFeedbackController"], 2000,
+     ["real:1:0=-0.05", "link:0:0=1:2", "link:1:1=0:4", "tol:1e-6"] + PLANT_OUT + ["print:1:2", "print:1:3"], 1e-5),
+    ("HydraulicCircuit, plain port, lowering at 10 mm/s", ["HydraulicCircuit"], 1000,
+     ["real:0:0=-0.05", "real:0:13=-0.01", "ramp:0:12=0.48,-0.01"] + PLANT_OUT[:7] + ["print:0:14"], 1e-5),
+    ("BoomMechanics, rigid, held near its start force", ["BoomMechanics"], 1000,
+     ["bool:0:31=0", "real:0:14=23000", "print:0:12", "print:0:13", "print:0:16", "print:0:18", "print:0:19"], 1e-5),
+]
+
+
+@pytest.mark.parametrize("ident", IDS)
+def test_every_platform_is_in_the_fmu(ident):
+    """FMI 2.0 section 2.1: binaries/<platform>/<modelIdentifier>.<so|dll> for each platform, and
+    fmpy sees them."""
+    with zipfile.ZipFile(fmu_path(ident)) as z:
+        names = set(z.namelist())
+    for p in PLATFORMS:
+        assert f"binaries/{p}/{ident}{SUFFIX[p]}" in names, f"{ident}: no {p} binary (boomsim pack --platforms all)"
+    # fmpy 0.3.32 names only the FMI 2.0 platforms (its FMI 2.0 loader on aarch64 looks in linux64).
+    assert set(fmpy.supported_platforms(str(fmu_path(ident)))) >= {"linux64", "win64"}
+    assert validate_fmu(str(fmu_path(ident))) == []
+
+
+def exports_and_imports(platform, lib):
+    """(exported fmi2 symbols, imported libraries) of a binary, read with the platform's binutils."""
+    if platform == "win64":
+        text = subprocess.run(["x86_64-w64-mingw32-objdump", "-p", str(lib)], capture_output=True, text=True).stdout
+        exports = {w for w in text.split() if w.startswith("fmi2")}
+        imports = {line.split(":")[1].strip().lower() for line in text.splitlines() if "DLL Name:" in line}
+        return exports, imports
+    prefix = "aarch64-linux-gnu-" if platform == "aarch64-linux" else ""
+    nm = subprocess.run([prefix + "nm", "-D", "--defined-only", str(lib)], capture_output=True, text=True).stdout
+    exports = {line.split()[-1] for line in nm.splitlines() if line.split()[-1].startswith("fmi2")}
+    dyn = subprocess.run([prefix + "readelf", "-d", str(lib)], capture_output=True, text=True).stdout
+    imports = {line.split("[")[1].rstrip("]") for line in dyn.splitlines() if "(NEEDED)" in line}
+    return exports, imports
+
+
+@pytest.mark.parametrize("ident", IDS)
+@pytest.mark.parametrize("platform", PLATFORMS)
+def test_exports_and_dependencies(unpacked, ident, platform):
+    """fmpy loads all 34 functions: each binary exports exactly them, and imports nothing a plain
+    Windows 10 or glibc Linux lacks (no libgcc_s_seh, libwinpthread, libstdc++)."""
+    lib = unpacked[ident][0] / "binaries" / platform / (ident + SUFFIX[platform])
+    exports, imports = exports_and_imports(platform, lib)
+    assert exports == {"fmi2" + f for f in FMI2_CS}
+    allowed = ALLOWED_DLLS if platform == "win64" else ALLOWED_SO
+    extra = {i for i in imports if i not in allowed and not i.startswith("api-ms-win-core-")}
+    assert not extra, f"{ident} on {platform} imports {sorted(extra)}"
+
+
+@pytest.mark.parametrize("name,fmus,steps,ops,rtol", SCENARIOS, ids=[s[0] for s in SCENARIOS])
+def test_every_platform_computes_the_same(hosts, unpacked, name, fmus, steps, ops, rtol):
+    """The same scenario on linux64 (native), win64 (wine64) and aarch64-linux (qemu-aarch64)."""
+    reference = run(hosts, unpacked, "linux64", steps, fmus, ops)
+    assert len(reference) == steps // 100 and all(len(r) == len(reference[0]) for r in reference)
+    for platform in PLATFORMS[1:]:
+        rows = run(hosts, unpacked, platform, steps, fmus, ops)
+        assert len(rows) == len(reference)
+        # Relative to each output's largest magnitude over the run (a flow crossing zero has no
+        # relative error of its own).
+        scale = [max(abs(r[j]) for r in reference) or 1.0 for j in range(len(reference[0]))]
+        worst = max(abs(a - b) / s for a_row, b_row in zip(reference, rows) for a, b, s in zip(a_row, b_row, scale))
+        print(f"{name} on {platform}: largest relative difference to linux64 {worst:.3g}")
+        assert worst <= rtol, f"{name} on {platform}: {worst:.3g} > {rtol:g}"
+
+
+def test_tools_are_installed():
+    """The cross tools of scripts/setup-cross (a missing one fails here with its name)."""
+    for tool in ["gcc", "x86_64-w64-mingw32-gcc", "aarch64-linux-gnu-gcc", "qemu-aarch64", WINE]:
+        assert shutil.which(tool) or pathlib.Path(tool).exists(), f"{tool} missing: run scripts/setup-cross"
