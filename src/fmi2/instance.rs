@@ -325,7 +325,8 @@ impl<M: Model> Instance<M> {
         if end <= start {
             return Err(format!("communicationStepSize = {} does not advance the instance time {}", num(h), num(start)));
         }
-        let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, end - start);
+        let inputs = M::INFO.interpolated_inputs;
+        let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
         let result = model.do_step(&c.values, &slopes, start, end - start, tolerance, &mut ModelLog(&self.log));
         c.outputs_current = false;
         if let Err(e) = result {
@@ -337,9 +338,10 @@ impl<M: Model> Instance<M> {
         }
         // Inputs with a derivative follow their ramp to the new communication point (only
         // interpolated inputs accept derivatives).
-        for (i, &d) in slopes.iter().enumerate() {
-            if let (Value::Real(x), true) = (c.values.at(i), d != 0.0) {
-                c.values.put(i, Value::Real(x + d * (end - start)));
+        for &r in inputs {
+            let Some(i) = c.values.position(r) else { continue };
+            if let (Value::Real(x), true) = (c.values.at(i), slopes[i] != 0.0) {
+                c.values.put(i, Value::Real(x + slopes[i] * (end - start)));
             }
         }
         c.time = end;
@@ -347,14 +349,12 @@ impl<M: Model> Instance<M> {
         // Every Real the importer can read is finite after a good step, or the step is an error.
         model.outputs(&mut c.values);
         c.outputs_current = true;
-        if let Some((v, x)) = M::VARIABLES.iter().zip(c.values.all()).find_map(|(v, x)| match x {
-            Value::Real(x) if !x.is_finite() => Some((v, *x)),
-            _ => None,
-        }) {
+        if let Some(i) = c.values.non_finite() {
             c.state = State::Error;
+            let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
             return Err(format!(
                 "{} = {} at t = {}: the model left its valid range; the instance is now in the Error state (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
-                v.name,
+                M::VARIABLES[i].name,
                 num(x),
                 num(end)
             ));
@@ -372,17 +372,17 @@ pub enum Step {
     Discarded(String),
 }
 
-/// The input slopes a step of length `h` uses: a slope that would carry an input out of its
-/// declared range within the step is reduced so that the input reaches the bound at the step end
-/// (it is linear in between), with a warning naming it. The master's slopes stay as set.
-pub fn bounded_slopes<'a>(values: &Values, slopes: &'a [f64], h: f64) -> (Cow<'a, [f64]>, Warning) {
+/// The slopes of the interpolated `inputs` (value references) a step of length `h` uses: a slope
+/// that would carry an input out of its declared range within the step is reduced so that the
+/// input reaches the bound at the step end (it is linear in between), with a warning naming it.
+/// The master's slopes stay as set.
+pub fn bounded_slopes<'a>(values: &Values, slopes: &'a [f64], inputs: &[u32], h: f64) -> (Cow<'a, [f64]>, Warning) {
     let mut out = Cow::Borrowed(slopes);
     let mut warnings = Vec::new();
-    for (i, &d) in slopes.iter().enumerate() {
-        if d == 0.0 {
-            continue;
-        }
-        let (Kind::Real { min, max, unit, .. }, Value::Real(x)) = (values.table()[i].kind, values.at(i)) else {
+    for i in inputs.iter().filter_map(|&r| values.position(r)) {
+        let d = slopes[i];
+        let (Kind::Real { min, max, unit, .. }, Value::Real(x), true) = (values.table()[i].kind, values.at(i), d != 0.0)
+        else {
             continue;
         };
         let bounded = bounded_slope(*x, d, h, (min, max));
@@ -447,12 +447,12 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
 pub(crate) fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
     match (v.kind, value) {
         (Kind::Real { min, max, unit, .. }, Value::Real(x)) => {
-            let (lo, hi) = (num(min), num(max));
+            let range = || format!("[{}, {}] {unit}", num(min), num(max));
             if !x.is_finite() {
-                return Err(format!("{} = {x} is not a finite number; valid range [{lo}, {hi}] {unit}", v.name));
+                return Err(format!("{} = {x} is not a finite number; valid range {}", v.name, range()));
             }
             if *x < min || *x > max {
-                return Err(format!("{} = {} is outside its valid range [{lo}, {hi}] {unit}", v.name, num(*x)));
+                return Err(format!("{} = {} is outside its valid range {}", v.name, num(*x), range()));
             }
         }
         (Kind::Integer { min, max, .. }, Value::Integer(x)) => {

@@ -235,6 +235,9 @@ pub struct Values {
     /// Table index by value reference ([`NONE`](Self::NONE) where there is no variable): the
     /// references are small and dense, so a direct table makes every get and set O(1).
     slot: Vec<u32>,
+    /// The first variable the model set to a non-finite number, if any (so that the FMI layer
+    /// finds one without scanning the table after every step).
+    non_finite: Option<usize>,
 }
 
 impl Values {
@@ -246,7 +249,7 @@ impl Values {
         for (i, v) in table.iter().enumerate() {
             slot[v.vr as usize] = i as u32;
         }
-        Values { table, values: table.iter().map(Variable::start_value).collect(), slot }
+        Values { table, values: table.iter().map(Variable::start_value).collect(), slot, non_finite: None }
     }
 
     /// The variable table.
@@ -306,6 +309,14 @@ impl Values {
     /// Sets a Real computed by the model (outputs, locals).
     pub fn set_real(&mut self, vr: u32, x: f64) {
         let i = self.position(vr).unwrap_or_else(|| panic!("no variable with value reference {vr}"));
+        if !x.is_finite() && self.non_finite.is_none() {
+            self.non_finite = Some(i);
+        }
         self.values[i] = Value::Real(x);
+    }
+
+    /// The table index of the first non-finite number the model set, if any.
+    pub fn non_finite(&self) -> Option<usize> {
+        self.non_finite
     }
 }
