@@ -347,9 +347,10 @@ impl<M: Model> Instance<M> {
         c.time = end;
         c.last_successful_time = end;
         // Every Real the importer can read is finite after a good step, or the step is an error.
+        c.values.take_non_finite();
         model.outputs(&mut c.values);
         c.outputs_current = true;
-        if let Some(i) = c.values.non_finite() {
+        if let Some(i) = c.values.take_non_finite() {
             c.state = State::Error;
             let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
             return Err(format!(

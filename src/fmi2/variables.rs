@@ -315,8 +315,8 @@ impl Values {
         self.values[i] = Value::Real(x);
     }
 
-    /// The table index of the first non-finite number the model set, if any.
-    pub fn non_finite(&self) -> Option<usize> {
-        self.non_finite
+    /// The table index of the first non-finite number the model set since the last call, if any.
+    pub fn take_non_finite(&mut self) -> Option<usize> {
+        self.non_finite.take()
     }
 }
