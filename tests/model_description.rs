@@ -41,3 +41,17 @@ fn variable_tables_obey_fmi_rules() {
     check_table("PressureFeedbackController", models::PressureFeedbackController::VARIABLES);
     check_table("HydraulicBoom", models::HydraulicBoom::VARIABLES);
 }
+
+/// The page inside the FMU states the default boom (it once said "the rigid boom with eight
+/// states" while the default was the flexible arm): it follows `boom.flexible`'s start value.
+#[test]
+fn the_documentation_names_the_default_boom() {
+    use boomsim::fmi2::Model;
+    use boomsim::models::HydraulicBoom;
+    let flexible = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "boom.flexible").unwrap();
+    let Kind::Boolean { start } = flexible.kind else { panic!("boom.flexible is a Boolean") };
+    let doc = boomsim::fmi2::pack::documentation::<HydraulicBoom>();
+    let says = if start { "by default the lumped flexible" } else { "by default the rigid" };
+    assert!(doc.contains(says), "the documentation does not say \"{says}\"");
+    assert!(!doc.contains("eight states"));
+}

@@ -56,9 +56,13 @@ const TABLE: [Variable; N_VARS] =
 const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
 PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48), counterbalance valve with check valve and
 piloted load-holding valve (eq. 2.55-2.59), asymmetric cylinder with end stops and friction (eq. 2.60-2.65), line
-volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving the rigid boom of sections 2.1.1-2.1.2
-(kinematics eq. 2.1-2.15, kinetics eq. 2.16-2.19) as one degree of freedom in the cylinder stroke. A stiff Radau IIA
-(order 5) integrator advances the eight states inside fmi2DoStep with the tolerance of fmi2SetupExperiment.</p>
+volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving the boom, by default the lumped flexible
+arm of sections 2.1.4 and 3.1.2 (<code>boom.n2</code> + <code>boom.n3</code> sections, eq. 2.34-2.39), or with
+<code>boom.flexible</code> = false the rigid boom of sections 2.1.1-2.1.2 (kinematics eq. 2.1-2.15, kinetics eq.
+2.16-2.19) as one degree of freedom in the cylinder stroke. A stiff Radau IIA (order 5) integrator advances the
+circuit's six states and the boom's coordinates and velocities (rigid: the stroke; flexible: one angle per section)
+inside fmi2DoStep with the tolerance of fmi2SetupExperiment; the flexible arm costs about ten times the rigid
+boom's time (see the README's speed table).</p>
 <p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
 spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>"#;
