@@ -70,10 +70,10 @@ pub const PARAMS: &[Param] = &[
         "Pa",
         "bar",
         [10.0 * BAR, 400.0 * BAR],
-        "Supply pressure (ideal source)",
+        "Supply pressure (ideal source), gauge",
         "3.2.2 simulation model: 200 bar (parameter list: 155 bar for the rig)"
     ),
-    param!("supply.p_t", supply.p_t, 0.0, "Pa", "bar", [0.0, 20.0 * BAR], "Tank pressure", "parameter list"),
+    param!("supply.p_t", supply.p_t, 0.0, "Pa", "bar", [0.0, 20.0 * BAR], "Tank pressure, gauge", "parameter list"),
     param!(
         "pcv.p_spring",
         pcv.p_spring,

@@ -79,10 +79,10 @@ pub(crate) const U_REF_INPUT: Variable = Variable::real_input(
 /// The circuit's outputs p1..Q4 (value references 1-11).
 #[rustfmt::skip]
 pub(crate) const CIRCUIT_OUTPUTS: [Variable; 11] = [
-    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1)"),
-    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV"),
-    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3)"),
-    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot)"),
+    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1), gauge"),
+    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV, gauge"),
+    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3), gauge"),
+    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot), gauge"),
     out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
     out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
     out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
@@ -97,7 +97,7 @@ pub(crate) const CIRCUIT_OUTPUTS: [Variable; 11] = [
 pub(crate) const CIRCUIT_LOCALS: [Variable; 3] = [
     Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
     Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
-    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x"),
+    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x, gauge"),
 ];
 
 /// The integrator's counters.

@@ -44,7 +44,7 @@ const VARIABLES: &[Variable] = &[
         (-1.0, 1.0),
         "Operator's spool reference; < 0 lowers the load",
     ),
-    Variable::real_input("p", vr::P, 0.0, "Pa", "bar", P_RANGE, "Fed-back pressure (p4, rod side / CBV pilot)"),
+    Variable::real_input("p", vr::P, 0.0, "Pa", "bar", P_RANGE, "Fed-back pressure (p4, rod side / CBV pilot), gauge"),
     // The filter starts at rest at the initial p (u_comp = 0): in Initialization Mode u depends
     // on u_ref only.
     Variable::real_output("u", vr::U, "1", "%", "Spool command u = clamp(u_ref + u_comp, u_min, u_max)")
