@@ -55,3 +55,14 @@ fn the_documentation_names_the_default_boom() {
     assert!(doc.contains(says), "the documentation does not say \"{says}\"");
     assert!(!doc.contains("eight states"));
 }
+
+/// One project version in every FMU (the workspace version; `scripts/bump-version` sets it).
+#[test]
+fn every_fmu_carries_the_project_version() {
+    for f in models::all() {
+        let xml = (f.model_description)();
+        let version = format!("version=\"{}\"", env!("CARGO_PKG_VERSION"));
+        assert!(xml.contains(&version), "{} lacks {version}", f.identifier);
+        assert!((f.documentation)().contains(&format!("{} {}", f.identifier, env!("CARGO_PKG_VERSION"))));
+    }
+}

@@ -468,7 +468,7 @@ pub(crate) fn advance<S: OdeSystem>(
 pub(crate) const PLANT_INFO: crate::fmi2::ModelInfo = crate::fmi2::ModelInfo {
     identifier: "",
     description: "",
-    version: "0.1.0",
+    version: env!("CARGO_PKG_VERSION"),
     start_time: 0.0,
     stop_time: 15.0,
     step_size: 1e-3,

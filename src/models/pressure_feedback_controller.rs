@@ -200,7 +200,7 @@ impl Model for PressureFeedbackController {
     const INFO: ModelInfo = ModelInfo {
         identifier: "PressureFeedbackController",
         description: "High-pass filtered pressure feedback for a pressure-compensated valve with counterbalance valve (thesis section 6.1)",
-        version: "1.0.0",
+        version: env!("CARGO_PKG_VERSION"),
         start_time: 0.0,
         stop_time: 15.0,
         step_size: 1e-3,
