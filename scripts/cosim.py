@@ -57,6 +57,16 @@ class Skip(Exception):
     """A scenario variant that cannot run with the FMUs at hand (reason in the message)."""
 
 
+class UsageError(Exception):
+    """A wrong argument or a missing file: one line for the user, naming the value and the fix."""
+
+
+def scenario_ids() -> list[str]:
+    """The scenario ids of scripts/scenarios/, in the catalogue's order."""
+    order = {"U": 0, "A": 1, "S": 2, "B": 3}
+    return sorted((p.stem for p in SCENARIO_DIR.glob("*.toml")), key=lambda s: (order.get(s, 4), s))
+
+
 # --------------------------------------------------------------------------- scenarios
 
 
@@ -64,6 +74,8 @@ def load_scenario(path) -> dict:
     path = pathlib.Path(path)
     if not path.exists() and (SCENARIO_DIR / f"{path}.toml").exists():
         path = SCENARIO_DIR / f"{path}.toml"  # a scenario id
+    if not path.exists():
+        raise UsageError(f"unknown scenario \"{path}\": give an id ({', '.join(scenario_ids())}) or a .toml file")
     with open(path, "rb") as f:
         sc = tomllib.load(f)
     sc.setdefault("id", path.stem)
@@ -87,9 +99,7 @@ def load_scenario(path) -> dict:
 
 
 def all_scenarios() -> list[dict]:
-    order = {"U": 0, "A": 1, "S": 2, "B": 3}
-    paths = sorted(SCENARIO_DIR.glob("*.toml"), key=lambda p: (order.get(p.stem, 4), p.stem))
-    return [load_scenario(p) for p in paths]
+    return [load_scenario(SCENARIO_DIR / f"{s}.toml") for s in scenario_ids()]
 
 
 def reference(table: np.ndarray, t: float) -> float:
@@ -118,7 +128,7 @@ class FmuFile:
 
         self.path = str(pathlib.Path(fmu_dir) / f"{identifier}.fmu")
         if not pathlib.Path(self.path).exists():
-            raise FileNotFoundError(f"{self.path} is missing: run `cargo build --release && target/release/boomsim pack`")
+            raise UsageError(f"{self.path} is missing: run `cargo build --release && target/release/boomsim pack`")
         self.md = read_model_description(self.path)
         self.dir = extract(self.path)
         self.vars = {v.name: v for v in self.md.modelVariables}
@@ -354,7 +364,8 @@ def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("scenario", help="scenario file or id (e.g. B or scripts/scenarios/B.toml)")
-    ap.add_argument("--boom", default=None, help="rigid or flexible (default: every boom of the scenario)")
+    ap.add_argument("--boom", default=None, choices=("rigid", "flexible"),
+                    help="rigid or flexible (default: every boom of the scenario)")
     ap.add_argument("--step", type=float, default=None,
                     help="communication step [s] (default: the scenario's `step`, else 1e-3)")
     ap.add_argument("--stop-time", type=float, default=None)
@@ -363,10 +374,16 @@ def main(argv=None):
                     help="only this feedback start (default: every start listed by the scenario)")
     ap.add_argument("--out", default=str(ROOT / "out" / "cosim"))
     args = ap.parse_args(argv)
+    for name, value in (("--step", args.step), ("--stop-time", args.stop_time)):
+        if value is not None and not (0 < value < float("inf")):
+            ap.error(f"{name} {value} must be a positive number of seconds (e.g. 1e-3)")
     sys.path.insert(0, str(pathlib.Path(__file__).parent))
     from metrics import compute
 
-    sc = load_scenario(args.scenario)
+    try:
+        sc = load_scenario(args.scenario)
+    except UsageError as e:
+        ap.error(str(e))
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     variants = [(b, f) for b in ([args.boom] if args.boom else sc["booms"])
@@ -374,6 +391,8 @@ def main(argv=None):
     for boom, fb in variants:
         try:
             res = run(sc, boom, args.step, args.stop_time, not args.hold, feedback_start=fb)
+        except UsageError as e:
+            ap.error(str(e))
         except Skip as e:
             print(f"{variant_name(sc, boom, fb)}: skipped: {e}")
             continue

@@ -134,6 +134,12 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(OUT))
     args = ap.parse_args(argv)
     only = {s for s in args.only.split(",") if s}
+    unknown = sorted(only - set(cosim.scenario_ids()))
+    if unknown:  # a filter that matches nothing must not pass (nor overwrite the report)
+        ap.error(f"--only {args.only}: unknown scenario {', '.join(unknown)}; "
+                 f"the scenarios are {', '.join(cosim.scenario_ids())}")
+    if args.step_sweep and args.step_sweep not in cosim.scenario_ids():
+        ap.error(f"--step-sweep {args.step_sweep}: unknown scenario; the scenarios are {', '.join(cosim.scenario_ids())}")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tol = load_tolerances()
@@ -141,13 +147,19 @@ def main(argv=None) -> int:
 
     results, failures, skipped, lines = {}, [], [], []
     t_start = time.time()
-    for sc, boom, fb in variants(only):
+    todo = list(variants(only))
+    for k, (sc, boom, fb) in enumerate(todo, 1):
         name = cosim.variant_name(sc, boom, fb)
+
+        def progress():
+            """n of N and the elapsed time, for the line of a finished variant."""
+            return f"[{k:2d}/{len(todo)} {time.time() - t_start:5.0f} s]"
+
         try:
             res = cosim.run(sc, boom, feedback_start=fb)
         except cosim.Skip as e:
             skipped.append(f"{name}: {e}")
-            print(f"{name:18s} skipped: {e}")
+            print(f"{progress()} {name:18s} skipped: {e}")
             continue
         m = mx.compute(res)
         results[name] = m
@@ -166,12 +178,13 @@ def main(argv=None) -> int:
             bad = compare(name, m, json.loads(base_file.read_text())["metrics"], tol)
             failures += bad
             verdict = "ok" if not bad else "REGRESSION"
-        print(f"{name:18s} {verdict:10s} " + " ".join(f"{k}={fmt(m[k])}" for k in
+        print(f"{progress()} {name:18s} {verdict:10s} " + " ".join(f"{k}={fmt(m[k])}" for k in
                                                      ("p3_pp_max", "t_motion", "t_settle", "v_steady", "u_comp_rms")))
         lines.append((name, sc, res, m, verdict))
 
     sweep = []
     if args.step_sweep:
+        print(f"step sweep of {args.step_sweep} (10 steps from 0.1 to 20 ms, two feedback starts)", flush=True)
         for fb in ("t0", "cbv_open"):
             steps = [1e-4, 1e-3, 2e-3, 3e-3, 4e-3, 5e-3, 6e-3, 8e-3, 1e-2, 2e-2]
             sweep.append((fb, step_sweep(args.step_sweep, steps, fb)))

@@ -1,0 +1,41 @@
+"""The scripts' wrong-argument paths: one line naming the value, the valid choices and the fix,
+and exit status 2 (argparse's), never a traceback or a silent pass."""
+
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+import cosim  # noqa: E402
+
+
+def run(script, *args):
+    r = subprocess.run([sys.executable, str(ROOT / "scripts" / script), *args], capture_output=True, text=True)
+    return r.returncode, r.stderr.strip().splitlines()[-1] if r.stderr.strip() else ""
+
+
+@pytest.mark.parametrize("args,says", [
+    (["Q"], ['unknown scenario "Q"', "U, A, S, B", ".toml"]),
+    (["B", "--step", "0"], ["--step 0.0 must be a positive number"]),
+    (["B", "--stop-time", "-1"], ["--stop-time -1.0 must be a positive number"]),
+    (["B", "--boom", "wobbly"], ["invalid choice: 'wobbly'", "rigid", "flexible"]),
+])
+def test_cosim_refuses_bad_arguments_in_one_line(args, says):
+    code, last = run("cosim.py", *args)
+    assert code == 2 and all(s in last for s in says), last
+    assert "Traceback" not in last
+
+
+def test_regress_refuses_a_filter_that_matches_nothing(tmp_path):
+    """`--only Q` used to pass with "all 0 variants within tolerance" and overwrite the report."""
+    code, last = run("regress.py", "--only", "Q", "--out", str(tmp_path))
+    assert code == 2 and "unknown scenario Q" in last and "U, A, S, B" in last, last
+    assert not (tmp_path / "report.md").exists()
+
+
+def test_a_missing_fmu_names_the_command_that_builds_it(tmp_path):
+    with pytest.raises(cosim.UsageError, match="boomsim pack"):
+        cosim.FmuFile("HydraulicBoom", fmu_dir=tmp_path)
