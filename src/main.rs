@@ -36,8 +36,8 @@ enum Cmd {
         /// Print a JSON list of {case, boom, via, simulated_s, wall_s, rtf, steps, rhs_evals, jac_evals}.
         #[arg(long)]
         json: bool,
-        /// Simulated time per case [s].
-        #[arg(long, default_value_t = 10.0)]
+        /// Simulated time per case [s], > 0.
+        #[arg(long, default_value_t = 10.0, value_parser = positive)]
         duration: f64,
     },
     /// Modes of the HydraulicBoom linearised at rest with the boom horizontal (full payload,
@@ -63,7 +63,17 @@ enum Cmd {
         json: bool,
     },
     /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
+    #[command(allow_negative_numbers = true)]
     Analyze(Box<boomsim::analysis::cli::AnalyzeArgs>),
+}
+
+/// A finite number > 0 (clap value parser).
+fn positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("{x} is not a positive number of seconds")),
+        Err(e) => Err(format!("{s:?} is not a number: {e}")),
+    }
 }
 
 /// The workspace root (this package's manifest directory).

@@ -139,14 +139,15 @@ pub struct Linearised {
 }
 
 /// Why an operating point has no steady lowering state.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum SteadyStateError {
     /// `mu_p p4 + p3 <= p_set`: the load-holding valve is closed, nothing flows.
     CbvClosed { u_cbv: f64 },
     /// `u_cbv > 1`: the valve would have to open beyond fully open.
     CbvSaturated { u_cbv: f64 },
-    /// Stroke outside `[0, s_c]` or non-positive capacitance, mass or pressure.
-    Invalid(&'static str),
+    /// Stroke outside `[0, s_c]` or non-positive capacitance, mass or pressure (which, with
+    /// its value and the valid range).
+    Invalid(String),
 }
 
 impl std::fmt::Display for SteadyStateError {
@@ -174,15 +175,25 @@ impl OperatingPoint {
 
     /// Steady state and linearised coefficients (eq. 2.73, 2.79, 2.80, 2.85).
     pub fn linearise(&self) -> Result<Linearised, SteadyStateError> {
+        let invalid = |s: String| Err(SteadyStateError::Invalid(s));
         if !(0.0..=self.stroke).contains(&self.x_c) {
-            return Err(SteadyStateError::Invalid("x_c outside [0, s_c]"));
+            return invalid(format!("x_c = {} mm is outside the stroke [0, {}] mm", self.x_c * 1e3, self.stroke * 1e3));
         }
-        if !(self.mass > 0.0 && self.beta > 0.0 && self.p4 >= 0.0 && self.c1_extra >= 0.0 && self.c2_extra >= 0.0) {
-            return Err(SteadyStateError::Invalid("mass, beta must be > 0; p4 and extra capacitances >= 0"));
+        for (name, x, unit, scale) in [("mass", self.mass, "kg", 1.0), ("beta", self.beta, "MPa", 1e-6)] {
+            if !(x > 0.0) {
+                return invalid(format!("{name} = {} {unit} must be > 0", x * scale));
+            }
+        }
+        for (name, x, unit, scale) in
+            [("p4", self.p4, "bar", 1e-5), ("c1_extra", self.c1_extra, "cm^3/bar", 1e11), ("c2_extra", self.c2_extra, "cm^3/bar", 1e11)]
+        {
+            if !(x >= 0.0) {
+                return invalid(format!("{name} = {} {unit} must be >= 0", x * scale));
+            }
         }
         let (c1, c2) = (self.c1_at(self.x_c), self.c2_at(self.x_c));
         if !(c1 > 0.0 && c2 > 0.0) {
-            return Err(SteadyStateError::Invalid("C1 and C2 must be > 0 (add capacitance at the stroke ends)"));
+            return invalid(format!("C1 = {c1:e} and C2 = {c2:e} m^3/Pa must be > 0 (add capacitance at the stroke ends)"));
         }
         let p3 = self.mu_c * self.p4 + self.load / self.area;
         let u_cbv = (self.mu_p * self.p4 + p3 - self.p_set) / self.p_fo;

@@ -448,7 +448,8 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
 pub(crate) fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
     match (v.kind, value) {
         (Kind::Real { min, max, unit, .. }, Value::Real(x)) => {
-            let range = || format!("[{}, {}] {unit}", num(min), num(max));
+            // Formatted only for an error; the dimensionless unit "1" is not written.
+            let range = || format!("[{}, {}]{}", num(min), num(max), if unit == "1" { String::new() } else { format!(" {unit}") });
             if !x.is_finite() {
                 return Err(format!("{} = {x} is not a finite number; valid range {}", v.name, range()));
             }
