@@ -125,11 +125,12 @@ fn c_string(s: &str) -> CString {
     CString::new(s.replace('\0', " ")).unwrap_or_default()
 }
 
-/// A number as a reader wants it in a message: the shortest text that reads back to the same
-/// f64, in exponent form when very small or large (`1e-20`, not 20 zeros).
+/// A number as a reader wants it, in messages, modelDescription.xml and the documentation: the
+/// shortest text that reads back to the same f64, in exponent form when very small or large
+/// (`1e-20`, not 20 zeros; `1e8`).
 pub fn num(x: f64) -> String {
     let a = x.abs();
-    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+    if a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
         format!("{x}")
     } else {
         format!("{x:e}")
@@ -140,7 +141,7 @@ pub fn num(x: f64) -> String {
 mod tests {
     use super::num;
 
-    /// Round trip (Rust's shortest representation) and the exponent form outside [1e-4, 1e15).
+    /// Round trip (Rust's shortest representation) and the exponent form outside [1e-4, 1e7).
     #[test]
     fn numbers_read_as_written() {
         assert_eq!(num(1e-20), "1e-20");

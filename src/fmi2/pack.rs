@@ -4,7 +4,8 @@
 
 use super::model::Model;
 use super::variables::{Kind, Variable};
-use super::xml::{model_description, num};
+use super::log::num;
+use super::xml::model_description;
 use crate::platform::Platform;
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! modelDescription.xml, generated with quick-xml from the model's variable table.
 
 use super::guid::guid;
-use super::log::GENERIC_CATEGORIES;
+use super::log::{num, GENERIC_CATEGORIES};
 use super::model::Model;
 use super::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
 use crate::units::{self, BASE_NAMES};
@@ -9,17 +9,6 @@ use quick_xml::Writer;
 use std::io;
 
 type Attrs = Vec<(&'static str, String)>;
-
-/// Formats a number so that it reads back to the same f64: plain for moderate magnitudes,
-/// scientific otherwise.
-pub fn num(x: f64) -> String {
-    let a = x.abs();
-    if x == 0.0 || (1e-4..1e7).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
 
 fn element(w: &mut Writer<Vec<u8>>, name: &str, attrs: &Attrs) -> io::Result<()> {
     w.create_element(name).with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str()))).write_empty()?;
