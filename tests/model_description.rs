@@ -50,7 +50,7 @@ fn the_documentation_names_the_default_boom() {
     use boomsim::models::HydraulicBoom;
     let flexible = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "boom.flexible").unwrap();
     let Kind::Boolean { start } = flexible.kind else { panic!("boom.flexible is a Boolean") };
-    let doc = boomsim::fmi2::pack::documentation::<HydraulicBoom>();
+    let doc = boomsim::fmi2::pack::documentation::<HydraulicBoom>(&boomsim::platform::PLATFORMS);
     let says = if start { "by default the lumped flexible" } else { "by default the rigid" };
     assert!(doc.contains(says), "the documentation does not say \"{says}\"");
     assert!(!doc.contains("eight states"));
@@ -63,6 +63,22 @@ fn every_fmu_carries_the_project_version() {
         let xml = (f.model_description)();
         let version = format!("version=\"{}\"", env!("CARGO_PKG_VERSION"));
         assert!(xml.contains(&version), "{} lacks {version}", f.identifier);
-        assert!((f.documentation)().contains(&format!("{} {}", f.identifier, env!("CARGO_PKG_VERSION"))));
+        assert!((f.documentation)(&[]).contains(&format!("{} {}", f.identifier, env!("CARGO_PKG_VERSION"))));
     }
+}
+
+/// The page's facts come from the model and the pack: the GUID of the XML, the platforms packed,
+/// and start values also in their display unit (the controller's Q_rated: 25 l/min of the
+/// thesis' valve, not only 0.0004166666666666667 m3/s).
+#[test]
+fn the_page_states_generated_facts() {
+    use boomsim::fmi2::{guid::guid, Model};
+    use boomsim::models::PressureFeedbackController as Pfc;
+    let platforms = &boomsim::platform::PLATFORMS[..2];
+    let page = boomsim::fmi2::pack::documentation::<Pfc>(platforms);
+    assert!(page.contains(&guid::<Pfc>()));
+    assert!(page.contains("<td>linux64, win64</td>"), "platforms");
+    assert!(page.contains("(25 l/min)"), "Q_rated in l/min");
+    let i = Pfc::INFO;
+    assert!(page.contains(&format!("{} to {} s", i.start_time, i.stop_time)));
 }

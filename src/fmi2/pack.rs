@@ -4,7 +4,8 @@
 
 use super::model::Model;
 use super::variables::{Kind, Variable};
-use super::log::num;
+use super::guid::guid;
+use super::log::{num, GENERIC_CATEGORIES};
 use super::xml::model_description;
 use crate::platform::Platform;
 use std::io::Write;
@@ -18,7 +19,8 @@ pub struct Fmu {
     /// Cargo package of the cdylib crate under `fmu/<identifier>/`.
     pub package: &'static str,
     pub model_description: fn() -> String,
-    pub documentation: fn() -> String,
+    /// documentation/index.html for the platforms packed.
+    pub documentation: fn(&[Platform]) -> String,
 }
 
 impl Fmu {
@@ -44,7 +46,8 @@ impl Fmu {
             zip.write_all(&std::fs::read(library)?)?;
         }
         zip.start_file("documentation/index.html", deflate)?;
-        zip.write_all((self.documentation)().as_bytes())?;
+        let platforms: Vec<Platform> = libraries.iter().map(|(p, _)| *p).collect();
+        zip.write_all((self.documentation)(&platforms).as_bytes())?;
         zip.finish()?;
         Ok(())
     }
@@ -57,9 +60,13 @@ fn html_escape(s: &str) -> String {
 fn row(v: &Variable) -> String {
     let (ty, start, unit, range) = match v.kind {
         Kind::Real { start, unit, display_unit, min, max } => {
+            let shown = |x: f64| match in_display_unit(x, unit, display_unit) {
+                Some(d) => format!("{} ({d})", num(x)),
+                None => num(x),
+            };
             let unit = if display_unit.is_empty() { unit.to_owned() } else { format!("{unit} ({display_unit})") };
             let range = format!("[{}, {}]", num(min), num(max));
-            ("Real", num(start), unit, range)
+            ("Real", shown(start), unit, range)
         }
         Kind::Integer { start, min, max } => ("Integer", start.to_string(), String::new(), format!("[{min}, {max}]")),
         Kind::Boolean { start } => ("Boolean", start.to_string(), String::new(), String::new()),
@@ -77,15 +84,66 @@ fn row(v: &Variable) -> String {
     )
 }
 
-/// documentation/index.html: the model's equations and notes, and every variable.
-pub fn documentation<M: Model>() -> String {
+/// `x` in the display unit, as "25 l/min" (None without a display unit other than the unit).
+fn in_display_unit(x: f64, unit: &str, display_unit: &str) -> Option<String> {
+    let d = crate::units::unit(unit)?.display.iter().find(|d| d.name == display_unit && d.name != unit)?;
+    let y = d.factor * x + d.offset;
+    // Rounded to 6 significant digits: the SI value beside it is exact.
+    let y: f64 = format!("{y:.5e}").parse().unwrap_or(y);
+    Some(format!("{} {display_unit}", num(y)))
+}
+
+/// The facts of the FMU, generated so that they cannot go stale: interface, version, GUID,
+/// default experiment, interpolated inputs, log categories, platforms.
+fn facts<M: Model>(platforms: &[Platform]) -> String {
+    let i = &M::INFO;
+    let name = |r: &u32| M::VARIABLES.iter().find(|v| v.vr == *r).map_or("?", |v| v.name);
+    let interpolated: Vec<&str> = i.interpolated_inputs.iter().map(name).collect();
+    let categories: Vec<&str> = GENERIC_CATEGORIES.iter().chain(i.log_categories).map(|c| c.0).collect();
+    let platforms: Vec<&str> = platforms.iter().map(|p| p.name).collect();
+    let rows = [
+        ("Interface", "FMI 2.0 Co-Simulation".to_owned()),
+        ("Model identifier", i.identifier.to_owned()),
+        ("Version", i.version.to_owned()),
+        ("GUID", guid::<M>()),
+        ("Platforms", platforms.join(", ")),
+        (
+            "Default experiment",
+            format!(
+                "{} to {} s, communication step {} s, relative tolerance {}",
+                num(i.start_time),
+                num(i.stop_time),
+                num(i.step_size),
+                num(i.default_tolerance)
+            ),
+        ),
+        (
+            "Inputs linear over a step (fmi2SetRealInputDerivatives)",
+            if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") },
+        ),
+        ("Log categories", categories.join(", ")),
+        ("Variables", M::VARIABLES.len().to_string()),
+    ];
+    let rows: String =
+        rows.iter().map(|(k, v)| format!("<tr><th>{k}</th><td>{}</td></tr>\n", html_escape(v))).collect();
+    format!("<table class=\"facts\">\n{rows}</table>\n")
+}
+
+/// A small stylesheet: readable tables in any browser an importer opens the page in.
+const STYLE: &str = "body{font-family:sans-serif;max-width:70em;margin:2em auto;padding:0 1em;line-height:1.4}\
+table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #bbb;padding:0.2em 0.5em;text-align:left;\
+vertical-align:top}th{background:#eee}code{font-size:95%}table.facts th{width:18em}";
+
+/// documentation/index.html: the model's facts, equations and notes, and every variable.
+pub fn documentation<M: Model>(platforms: &[Platform]) -> String {
     let i = &M::INFO;
     let rows: String = M::VARIABLES.iter().map(row).collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{id}</title></head><body>\n<h1>{id} {version}</h1>\n<p>{desc}</p>\n<h2>Model</h2>\n{doc}\n<h2>Variables</h2>\n<p>All values are SI; the display unit is given in brackets.</p>\n<table border=\"1\">\n<tr><th>Name</th><th>VR</th><th>Causality</th><th>Variability</th><th>Type</th><th>Start</th><th>Unit</th><th>Range</th><th>Description</th></tr>\n{rows}</table>\n</body></html>\n",
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{id}</title><style>{STYLE}</style></head><body>\n<h1>{id} {version}</h1>\n<p>{desc}</p>\n<p>From the master's thesis <i>Stabilization of hydraulically actuated boom using pressure feedback</i> (University of Agder), exported by boomsim.</p>\n{facts}<h2>Model</h2>\n{doc}\n<h2>Variables</h2>\n<p>All values are SI; the display unit is given in brackets, and start values in it too.</p>\n<table>\n<tr><th>Name</th><th>VR</th><th>Causality</th><th>Variability</th><th>Type</th><th>Start</th><th>Unit</th><th>Range</th><th>Description</th></tr>\n{rows}</table>\n</body></html>\n",
         id = i.identifier,
         version = i.version,
         desc = html_escape(i.description),
+        facts = facts::<M>(platforms),
         doc = i.documentation,
     )
 }
