@@ -20,6 +20,15 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 FMU_DIR = ROOT / "target" / "fmu"
 
 
+#: The 34 functions of FMI 2.0 Co-Simulation (25 common + 9 co-simulation), without "fmi2".
+FMI2_CS_FUNCTIONS = """GetTypesPlatform GetVersion SetDebugLogging Instantiate FreeInstance SetupExperiment
+EnterInitializationMode ExitInitializationMode Terminate Reset GetReal GetInteger GetBoolean GetString
+SetReal SetInteger SetBoolean SetString GetFMUstate SetFMUstate FreeFMUstate SerializedFMUstateSize
+SerializeFMUstate DeSerializeFMUstate GetDirectionalDerivative SetRealInputDerivatives
+GetRealOutputDerivatives DoStep CancelStep GetStatus GetRealStatus GetIntegerStatus GetBooleanStatus
+GetStringStatus""".split()
+
+
 def fmu_path(identifier):
     path = FMU_DIR / f"{identifier}.fmu"
     assert path.exists(), f"{path} is missing: run target/release/boomsim pack"

@@ -12,15 +12,11 @@ from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 from fmpy.fmi1 import FMICallException
 
+from conftest import FMI2_CS_FUNCTIONS
+
 ID = "PressureFeedbackController"
 # Experiment B defaults (Table 7.2) and the rated flow per unit opening (section 2.2.1).
 K_F, OMEGA_F, Q_RATED = 1.24e-11, 35.8, 25e-3 / 60
-FMI_FUNCTIONS = """GetTypesPlatform GetVersion SetDebugLogging Instantiate FreeInstance SetupExperiment
-EnterInitializationMode ExitInitializationMode Terminate Reset GetReal GetInteger GetBoolean GetString
-SetReal SetInteger SetBoolean SetString GetFMUstate SetFMUstate FreeFMUstate SerializedFMUstateSize
-SerializeFMUstate DeSerializeFMUstate GetDirectionalDerivative SetRealInputDerivatives
-GetRealOutputDerivatives DoStep CancelStep GetStatus GetRealStatus GetIntegerStatus GetBooleanStatus
-GetStringStatus""".split()
 
 
 def g_f(omega, k_f=K_F, omega_f=OMEGA_F):
@@ -43,7 +39,7 @@ def test_archive_layout_symbols_and_dependencies(controller, tmp_path):
     so = tmp_path / "binaries" / "linux64" / f"{ID}.so"
     nm = subprocess.run(["nm", "-D", "--defined-only", so], capture_output=True, text=True, check=True)
     exported = {line.split()[-1] for line in nm.stdout.splitlines()}
-    assert exported == {"fmi2" + f for f in FMI_FUNCTIONS}, "exactly the 34 FMI 2.0 CS functions"
+    assert exported == {"fmi2" + f for f in FMI2_CS_FUNCTIONS}, "exactly the 34 FMI 2.0 CS functions"
     ldd = subprocess.run(["ldd", so], capture_output=True, text=True, check=True)
     libs = {line.split()[0] for line in ldd.stdout.splitlines()}
     allowed = ("linux-vdso", "libc.so", "libm.so", "libgcc_s.so", "/lib64/ld-linux", "ld-linux")

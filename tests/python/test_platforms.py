@@ -26,7 +26,7 @@ import fmpy
 from fmpy.validation import validate_fmu
 import pytest
 
-from conftest import fmu_path
+from conftest import FMI2_CS_FUNCTIONS, fmu_path
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HOST_SOURCE = ROOT / "tests" / "host" / "fmu_host.c"
@@ -38,13 +38,6 @@ SUFFIX = {"linux64": ".so", "win64": ".dll", "aarch64-linux": ".so"}
 #: The libraries a binary may import: what every Windows 10 and every glibc Linux has.
 ALLOWED_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "userenv.dll", "ws2_32.dll", "bcryptprimitives.dll"}
 ALLOWED_SO = {"libc.so.6", "libm.so.6", "libgcc_s.so.1", "ld-linux-aarch64.so.1", "ld-linux-x86-64.so.2"}
-#: The 34 functions of FMI 2.0 CS (25 common + 9 co-simulation).
-FMI2_CS = """GetTypesPlatform GetVersion SetDebugLogging Instantiate FreeInstance SetupExperiment
-EnterInitializationMode ExitInitializationMode Terminate Reset GetReal GetInteger GetBoolean GetString
-SetReal SetInteger SetBoolean SetString GetFMUstate SetFMUstate FreeFMUstate SerializedFMUstateSize
-SerializeFMUstate DeSerializeFMUstate GetDirectionalDerivative SetRealInputDerivatives
-GetRealOutputDerivatives DoStep CancelStep GetStatus GetRealStatus GetIntegerStatus GetBooleanStatus
-GetStringStatus""".split()
 
 @pytest.fixture(scope="module")
 def unpacked(tmp_path_factory):
@@ -141,7 +134,7 @@ def test_exports_and_dependencies(unpacked, ident, platform):
     Windows 10 or glibc Linux lacks (no libgcc_s_seh, libwinpthread, libstdc++)."""
     lib = unpacked[ident][0] / "binaries" / platform / (ident + SUFFIX[platform])
     exports, imports = exports_and_imports(platform, lib)
-    assert exports == {"fmi2" + f for f in FMI2_CS}
+    assert exports == {"fmi2" + f for f in FMI2_CS_FUNCTIONS}
     allowed = ALLOWED_DLLS if platform == "win64" else ALLOWED_SO
     extra = {i for i in imports if i not in allowed and not i.startswith("api-ms-win-core-")}
     assert not extra, f"{ident} on {platform} imports {sorted(extra)}"
