@@ -304,10 +304,29 @@ def write_csv(res: Result, path):
     np.savetxt(path, arr, delimiter=",", header=header, comments="", fmt="%.9g")
 
 
+def series(res: Result) -> list[tuple[int, str, np.ndarray]]:
+    """What the plot draws: (panel, legend label, values). The signs are the FMUs' and the
+    CSVs' (lowering: v < 0, u < 0), the same as the title's u_ref; the thesis' figures show
+    lowering as positive (its simulation tool's sign), which the axis labels say is not done here."""
+    d, sc = res.data, res.scenario
+    q_rated = 25e-3 / 60
+    a_rod = math.pi / 4 * (0.065**2 - 0.035**2)
+    v_expected = q_rated * sc["reference"][-1, 1] / a_rod * 1e3  # steady velocity, sign of u_ref
+    return [
+        (0, "p3 piston side", d["p3"] / BAR),
+        (0, "p4 rod side (fed back)", d["p4"] / BAR),
+        (0, "p2 CBV back pressure", d["p2"] / BAR),
+        (1, "v_c", d["cylinder.v"] * 1e3),
+        (1, "Q_rated u_ref / A_rod", np.full_like(d["time"], v_expected)),
+        (2, "u_ref (operator)", d["u_ref"]),
+        (2, "u_comp (feedback)", d["u_comp"]),
+        (2, "u (main spool opening)", d["valve.u"]),
+    ]
+
+
 def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
     """p3/p4, cylinder velocity and spool openings over time, like thesis Fig. 6.7-6.12
-    (simulation) and 7.1-7.6 (rig); the sign is flipped so lowering shows as a positive
-    opening, as in the thesis' simulation tool."""
+    (simulation) and 7.1-7.6 (rig), in the FMUs' signs ([`series`]: lowering < 0)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -318,25 +337,16 @@ def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
     sc = res.scenario
     fig, axes = plt.subplots(3, 2, sharex="col", figsize=(13, 9), constrained_layout=True,
                              gridspec_kw={"width_ratios": [3, 2]})
-    q_rated = 25e-3 / 60
-    a_rod = math.pi / 4 * (0.065**2 - 0.035**2)
-    u_ss = abs(sc["reference"][-1, 1])
+    drawn = series(res)
     for col, t_max in ((0, t[-1]), (1, min(zoom, t[-1]))):
         ax = axes[:, col]
-        a = ax[0]
-        a.plot(t, d["p3"] / BAR, label="p3 piston side")
-        a.plot(t, d["p4"] / BAR, label="p4 rod side (fed back)")
-        a.plot(t, d["p2"] / BAR, label="p2 CBV back pressure", lw=0.8, alpha=0.7)
-        a.set_ylabel("pressure [bar]")
-        a = ax[1]
-        a.plot(t, -d["cylinder.v"] * 1e3, label="v_c (lowering > 0)")
-        a.axhline(q_rated * u_ss / a_rod * 1e3, color="k", ls=":", lw=1, label="Q_rated |u_ref| / A_rod")
-        a.set_ylabel("lowering velocity [mm/s]")
+        for panel, label, y in drawn:
+            style = {"color": "k", "ls": ":", "lw": 1} if label.startswith("Q_rated") else {}
+            ax[panel].plot(t, y, label=label, **style)
+        ax[0].set_ylabel("pressure (gauge) [bar]")
+        ax[1].set_ylabel("cylinder velocity, lowering < 0 [mm/s]")
+        ax[2].set_ylabel("spool opening, lowering < 0 [-]")
         a = ax[2]
-        a.plot(t, -d["u_ref"], label="u_ref (operator)")
-        a.plot(t, -d["u_comp"], label="u_comp (feedback)")
-        a.plot(t, -d["valve.u"], label="u (main spool opening)")
-        a.set_ylabel("spool opening, lowering > 0 [-]")
         a.set_xlabel("time [s]")
         a.set_xlim(0, t_max)
         for a in ax:

@@ -39,3 +39,16 @@ def test_regress_refuses_a_filter_that_matches_nothing(tmp_path):
 def test_a_missing_fmu_names_the_command_that_builds_it(tmp_path):
     with pytest.raises(cosim.UsageError, match="boomsim pack"):
         cosim.FmuFile("HydraulicBoom", fmu_dir=tmp_path)
+
+
+def test_plots_use_the_signs_of_the_csv_and_the_title():
+    """One sign convention in a figure and its CSV: lowering is negative in the FMU variables, the
+    CSV columns and the title's u_ref, so the plotted velocity, openings and reference line are
+    too (they were flipped to the thesis tool's lowering-positive)."""
+    sc = cosim.load_scenario("B")
+    res = cosim.run(sc, "rigid", stop_time=0.5)
+    drawn = {label: y for _, label, y in cosim.series(res)}
+    assert (drawn["v_c"] == res.data["cylinder.v"] * 1e3).all()
+    assert (drawn["u_ref (operator)"] == res.data["u_ref"]).all()
+    u_title = sc["reference"][-1, 1]
+    assert u_title < 0 and (drawn["Q_rated u_ref / A_rod"] < 0).all() and (drawn["u_ref (operator)"] < 0).all()
