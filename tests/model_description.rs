@@ -82,3 +82,13 @@ fn the_page_states_generated_facts() {
     let i = Pfc::INFO;
     assert!(page.contains(&format!("{} to {} s", i.start_time, i.stop_time)));
 }
+
+/// The two halves of the cut carry the same coupling recipe (start.F, Z_c, step order, end stops).
+#[test]
+fn the_split_models_pages_carry_the_coupling_recipe() {
+    use boomsim::fmi2::pack::documentation;
+    use boomsim::models::{BoomMechanics, HydraulicCircuit};
+    for page in [documentation::<HydraulicCircuit>(&[]), documentation::<BoomMechanics>(&[])] {
+        assert!(page.contains("<h2>Coupling recipe</h2>") && page.contains("start.F") && page.contains("port.Z_c"));
+    }
+}

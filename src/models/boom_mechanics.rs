@@ -68,7 +68,8 @@ const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .hydraulics(PARAMS, C_STOP, C_STOP + 1)
     .build();
 
-const DOCUMENTATION: &str = r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
+const DOCUMENTATION: &str = concat!(
+    r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
 flexible (2.1.4, 3.1.2), with the same parameters, names and value references, the rod and piston included. It
 starts at rest at <code>start.x</code>; <code>start.F</code> is the cylinder force that holds it there.
 <code>port.coupling</code> selects the port, as in HydraulicCircuit: <b>0, plain</b>: input <code>cylinder.F</code>
@@ -77,7 +78,9 @@ F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub> and emits c<sub
 Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). The cylinder's end stops act here
 (<code>cylinder.k_stop</code>, <code>cylinder.c_stop</code>; HydraulicCircuit's port force has none): with no force
 the boom comes to rest on the bottom stop. Outputs: stroke, velocity, boom angle, payload position, tip deflection
-and section angles.</p>"#;
+and section angles.</p>"#,
+    port::coupling_recipe!()
+);
 
 /// The boom driven through the port, as one ODE over a step.
 #[derive(Debug, Clone)]

@@ -88,7 +88,8 @@ const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
 const N_VARS: usize = OWN.len() + PARAMS.len();
 const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN).hydraulics(PARAMS, 0, PARAMS.len()).build();
 
-const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8 (valves, cylinder, lines; the same parameters, names and value
+const DOCUMENTATION: &str = concat!(
+    r#"<p>The circuit of thesis Fig. 2.8 (valves, cylinder, lines; the same parameters, names and value
 references as HydraulicBoom) with a mechanical port instead of the boom, advanced inside fmi2DoStep by the Radau IIA
 integrator. <code>port.coupling</code> selects the port:</p>
 <ul><li><b>0, plain</b>: inputs <code>cylinder.x</code>, <code>cylinder.v</code> (set the slope of v with
@@ -104,7 +105,9 @@ Z<sub>c</sub>/h and a mass Z<sub>c</sub>h at the pin.</li></ul>
 <p>The cylinder's end stops are not in the port force: they are the contact of piston and barrel, and belong to
 the mechanics (BoomMechanics has them; mechanics of your own keeps the stroke within [0, <code>cylinder.stroke</code>]).
 The circuit starts in the static equilibrium that holds <code>start.F</code> with the CBV closed (set it to the
-mechanics' static cylinder force at the start).</p>"#;
+mechanics' static cylinder force at the start).</p>"#,
+    port::coupling_recipe!()
+);
 
 /// The circuit with its port, as one ODE over a step.
 #[derive(Debug, Clone)]

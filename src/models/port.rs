@@ -54,6 +54,31 @@ impl Coupling {
     }
 }
 
+/// How to couple HydraulicCircuit with BoomMechanics or mechanics of one's own: the section both
+/// FMUs' pages carry (the README's "Coupling your own mechanics" has the derivations). A macro,
+/// so that `concat!` appends it to each page at compile time.
+macro_rules! coupling_recipe {
+    () => {
+        r#"<h2>Coupling recipe</h2>
+<ol><li><b>Start at rest.</b> Set HydraulicCircuit's <code>start.F</code> to the mechanics' static cylinder force at
+<code>start.x</code> (BoomMechanics: its <code>start.F</code> output after initialisation), and the same
+<code>start.x</code> in both.</li>
+<li><b>TLM (<code>port.coupling</code> = 1, recommended)</b> for flexible or light mechanics at the pin and for Jacobi
+masters: the same <code>port.Z_c</code> in both, about sqrt(k m<sub>eff</sub>) with k the oil column's stiffness at the
+pin and m<sub>eff</sub> the mechanics' effective mass in its lowest coupled mode (the default suits the thesis' boom at
+480 mm); connect <code>port.c_h</code> to the mechanics and <code>port.c_m</code> back, in any order;
+<code>port.alpha</code> = 0.1 with a Jacobi master. Mechanics of your own apply F = c<sub>h</sub> &minus;
+Z<sub>c</sub>v to the pin inside their integrator and return c<sub>m</sub> = F &minus; Z<sub>c</sub>v.</li>
+<li><b>Plain (<code>port.coupling</code> = 0)</b> for heavy, rigid mechanics that take a force and return motion: step
+the mechanics first, pass <code>cylinder.x</code>, <code>cylinder.v</code> (with the slope of v) to the circuit and
+<code>cylinder.F</code> back; keep the communication step small against the oil column's stiffest mode (2 ms or less
+for the thesis' rigid boom).</li>
+<li>The end stops act in the mechanics (BoomMechanics has them; mechanics of your own keep the stroke within
+[0, <code>cylinder.stroke</code>]).</li></ol>"#
+    };
+}
+pub(crate) use coupling_recipe;
+
 /// `port.coupling`: 0 plain, 1 TLM.
 pub const COUPLING: Variable = Variable::int_param(
     "port.coupling",
