@@ -61,6 +61,16 @@ class UsageError(Exception):
     """A wrong argument or a missing file: one line for the user, naming the value and the fix."""
 
 
+def cli(main) -> int:
+    """Runs a script's `main()`; a UsageError (a missing FMU, an unknown scenario) becomes one
+    line on stderr and exit status 2 instead of a traceback."""
+    try:
+        return main() or 0
+    except UsageError as e:
+        print(f"{pathlib.Path(sys.argv[0]).name}: error: {e}", file=sys.stderr)
+        return 2
+
+
 def scenario_ids() -> list[str]:
     """The scenario ids of scripts/scenarios/, in the catalogue's order."""
     order = {"U": 0, "A": 1, "S": 2, "B": 3}

@@ -258,4 +258,4 @@ def regress_fmt(x) -> str:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cosim.cli(main))

@@ -52,3 +52,9 @@ def test_plots_use_the_signs_of_the_csv_and_the_title():
     assert (drawn["u_ref (operator)"] == res.data["u_ref"]).all()
     u_title = sc["reference"][-1, 1]
     assert u_title < 0 and (drawn["Q_rated u_ref / A_rod"] < 0).all() and (drawn["u_ref (operator)"] < 0).all()
+
+
+@pytest.mark.parametrize("args", [["split.py", "Q"], ["ssp.py", "--scenario", "Q", "--no-run"]])
+def test_the_other_runners_refuse_an_unknown_scenario_in_one_line(args):
+    code, last = run(*args)
+    assert code == 2 and 'unknown scenario "Q"' in last, last
