@@ -5,7 +5,7 @@
 //! failures through the logger with the instance name (ARCHITECTURE.md, principle 4).
 #![allow(clippy::missing_safety_doc)]
 
-use super::fmu_state::{self, FmuState};
+use super::fmu_state;
 use super::guid::guid;
 use super::instance::{Core, Instance, Step, Warning};
 use super::log::{Logger, LOG_FMI_CALLS};
@@ -341,7 +341,7 @@ pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate
         } else {
             // FMI 2.0, 2.1.8: a non-NULL *FMUstate is a state of this instance, to overwrite.
             let core = inst.core.clone();
-            own_fmu_state(inst, *out)?.core = core;
+            *own_fmu_state(inst, *out)? = core;
         }
         Ok(fmi2Status::OK)
     })
@@ -349,15 +349,15 @@ pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate
 
 /// A new FMU state of `inst` holding `core`, registered so that fmi2FreeInstance frees it.
 fn new_fmu_state<M: Model>(inst: &mut Instance<M>, core: Core<M>) -> fmi2FMUstate {
-    let s = Box::into_raw(Box::new(FmuState { core }));
+    let s = Box::into_raw(Box::new(core));
     inst.fmu_states.push(s);
     s as fmi2FMUstate
 }
 
 /// The FMU state behind a pointer if this instance allocated it and it was not freed: found in
 /// the instance's list, so no pointer the importer passes is dereferenced unless it is ours.
-fn own_fmu_state<'a, M: Model>(inst: &Instance<M>, s: fmi2FMUstate) -> Result<&'a mut FmuState<M>, String> {
-    let p = s as *mut FmuState<M>;
+fn own_fmu_state<'a, M: Model>(inst: &Instance<M>, s: fmi2FMUstate) -> Result<&'a mut Core<M>, String> {
+    let p = s as *mut Core<M>;
     if s.is_null() || !inst.fmu_states.contains(&p) {
         return Err(format!(
             "FMUstate {s:p} is NULL, freed, or not a state of this instance of {} (fmi2GetFMUstate or fmi2DeSerializeFMUstate of this instance make one)",
@@ -370,7 +370,7 @@ fn own_fmu_state<'a, M: Model>(inst: &Instance<M>, s: fmi2FMUstate) -> Result<&'
 
 pub unsafe fn set_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
     call::<M>(c, "fmi2SetFMUstate", allowed::FMU_STATE, |inst| {
-        inst.core = own_fmu_state(inst, state)?.core.clone();
+        inst.core = own_fmu_state(inst, state)?.clone();
         Ok(fmi2Status::OK)
     })
 }
@@ -381,7 +381,7 @@ pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstat
         if p.is_null() {
             return Ok(fmi2Status::OK);
         }
-        let s = own_fmu_state(inst, *p)? as *mut FmuState<M>;
+        let s = own_fmu_state(inst, *p)? as *mut Core<M>;
         inst.fmu_states.retain(|&x| x != s);
         drop(Box::from_raw(s));
         *p = std::ptr::null_mut();
@@ -396,7 +396,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
 ) -> fmi2Status {
     call::<M>(c, "fmi2SerializedFMUstateSize", allowed::FMU_STATE, |inst| {
         let out = size.as_mut().ok_or("size is NULL")?;
-        *out = fmu_state::serialize(&own_fmu_state(inst, state)?.core, &inst.guid).len();
+        *out = fmu_state::serialize(own_fmu_state(inst, state)?, &inst.guid).len();
         Ok(fmi2Status::OK)
     })
 }
@@ -408,7 +408,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     size: usize,
 ) -> fmi2Status {
     call::<M>(c, "fmi2SerializeFMUstate", allowed::FMU_STATE, |inst| {
-        let data = fmu_state::serialize(&own_fmu_state(inst, state)?.core, &inst.guid);
+        let data = fmu_state::serialize(own_fmu_state(inst, state)?, &inst.guid);
         if data.len() != size {
             return Err(format!(
                 "size = {size} bytes, but the state needs {} (fmi2SerializedFMUstateSize)",

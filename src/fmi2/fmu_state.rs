@@ -1,4 +1,5 @@
-//! FMU states: deep copies for fmi2GetFMUstate/SetFMUstate and their checked byte format for
+//! FMU states: deep copies of the instance's [`Core`] (boxed; the instance keeps the list of
+//! its own) for fmi2GetFMUstate/SetFMUstate and their checked byte format for
 //! fmi2SerializeFMUstate/DeSerializeFMUstate.
 //!
 //! Byte format, little endian: magic `BOOMSIM\0`, format version (u32), GUID (u32 length +
@@ -14,11 +15,6 @@ use super::log::num;
 use super::model::Model;
 use super::state::State;
 use super::variables::{Value, Values};
-
-/// An FMU state: the instance's core, owned by the instance that made it (its list of states).
-pub struct FmuState<M: Model> {
-    pub core: Core<M>,
-}
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.

@@ -1,7 +1,6 @@
 //! One FMU instance: variable values, model, time and state machine, in safe Rust.
 //! [`super::api`] wraps these methods in the C ABI.
 
-use super::fmu_state::FmuState;
 use super::log::{num, Logger};
 use super::model::{Log, Model};
 use super::state::State;
@@ -34,7 +33,7 @@ pub struct Instance<M: Model> {
     pub guid: String,
     /// The FMU states this instance allocated and the importer has not freed yet; freed with the
     /// instance (FMI 2.0, 2.1.5: fmi2FreeInstance frees all memory the instance allocated).
-    pub(crate) fmu_states: Vec<*mut FmuState<M>>,
+    pub(crate) fmu_states: Vec<*mut Core<M>>,
 }
 
 /// Everything an FMU state captures: the instance less its name and logger.

@@ -137,11 +137,7 @@ impl PortedCircuit {
     /// The circuit's evaluation and the line force at `t`, state `s`.
     fn evaluate(&self, t: f64, s: &[f64]) -> (circuit::Eval, f64) {
         let (x, v) = self.motion(t, s);
-        let mut e = self.circuit.evaluate(s[..N_CIRCUIT].try_into().expect("circuit slice"), self.u_ref.at(t), x, v);
-        // The end stops are the piston's contact with the barrel: mechanics, on the other side of
-        // the cut (BoomMechanics applies them). The port force is pressure forces - friction.
-        e.force -= e.f_stop;
-        e.f_stop = 0.0;
+        let e = self.circuit.evaluate(s[..N_CIRCUIT].try_into().expect("circuit slice"), self.u_ref.at(t), x, v);
         let f_line = match self.coupling {
             Coupling::Plain => e.force,
             Coupling::Tlm { z_c, .. } => self.c_m.at(t) + z_c * v,
@@ -192,7 +188,10 @@ impl HydraulicCircuit {
     /// The model at time `t` with the received wave `c_m`, the emitted `c_h` and the given state
     /// (the equilibrium holding start.F if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [c_m, c_h]: [f64; 2]) -> Result<Self, String> {
-        let circuit = parts::circuit_from_values(values)?;
+        let mut circuit = parts::circuit_from_values(values)?;
+        // The end stops are the piston's contact with the barrel: mechanics, on the other side of
+        // the cut (BoomMechanics applies them), so the port force is pressure forces - friction.
+        (circuit.cylinder.k_stop, circuit.cylinder.c_stop) = (0.0, 0.0);
         let x0 = values.real(vr::X0);
         let stroke = circuit.cylinder.stroke;
         let sys = PortedCircuit {
