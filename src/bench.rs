@@ -7,6 +7,7 @@
 
 use crate::fmi2::instance::{Instance, Step};
 use crate::fmi2::log::Logger;
+use crate::fmi2::state::Interface;
 use crate::fmi2::types::*;
 use crate::fmi2::variables::BaseType;
 use crate::fmi2::{guid::guid, Model, Value};
@@ -32,7 +33,7 @@ impl<M: Model> InProcess<M> {
     /// Instantiated, set up with `rtol`, initialised with the given Real and Boolean values.
     pub fn new(rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
         let log = Logger::new(None, std::ptr::null_mut(), "bench", &[], false);
-        let mut i = Instance::<M>::new(log, guid::<M>());
+        let mut i = Instance::<M>::new(log, guid::<M>(), Interface::CoSimulation);
         i.setup_experiment(Some(rtol), 0.0, None)?;
         i.enter_initialization_mode();
         for (r, x) in start {

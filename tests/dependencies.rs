@@ -8,6 +8,7 @@
 
 use boomsim::fmi2::instance::Instance;
 use boomsim::fmi2::log::Logger;
+use boomsim::fmi2::state::Interface;
 use boomsim::fmi2::variables::BaseType;
 use boomsim::fmi2::xml::initial_dependencies;
 use boomsim::fmi2::{Causality, Initial, Kind, Model, Value};
@@ -19,7 +20,7 @@ type Deps = BTreeMap<&'static str, BTreeSet<&'static str>>;
 
 fn instance<M: Model>(setup: &[(u32, Value)]) -> Instance<M> {
     let log = Logger::new(None, std::ptr::null_mut(), "deps", &[], false);
-    let mut i = Instance::<M>::new(log, boomsim::fmi2::guid::guid::<M>());
+    let mut i = Instance::<M>::new(log, boomsim::fmi2::guid::guid::<M>(), Interface::CoSimulation);
     i.setup_experiment(None, 0.0, None).unwrap();
     i.enter_initialization_mode();
     for (r, x) in setup {
@@ -100,7 +101,12 @@ fn check<M: Model>(configurations: &[&[(u32, Value)]]) {
             probe::<M>(setup, steps, &mut found);
         }
         let what = if initial { "InitialUnknowns" } else { "Outputs" };
-        assert_eq!(found, declared::<M>(initial), "{}: {what} dependencies on inputs (found, declared)", M::INFO.identifier);
+        assert_eq!(
+            found,
+            declared::<M>(initial),
+            "{}: {what} dependencies on inputs (found, declared)",
+            M::INFO.identifier
+        );
     }
 }
 

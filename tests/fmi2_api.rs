@@ -6,7 +6,7 @@ mod common;
 use boomsim::fmi2::api;
 use boomsim::fmi2::guid::guid;
 use boomsim::fmi2::types::*;
-use boomsim::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use boomsim::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::PressureFeedbackController as Pfc;
 use common::Slave;
@@ -39,8 +39,9 @@ fn illegal_calls_are_refused_and_the_instance_stays_usable() {
 fn instantiate_refuses_bad_arguments_with_a_reason() {
     let e = Slave::<Pfc>::try_new("x", "{00000000-0000-0000-0000-000000000000}", FMI2_COSIMULATION).err().unwrap();
     assert!(e[0].contains("GUID"), "{e:?}");
-    let e = Slave::<Pfc>::try_new("x", &guid::<Pfc>(), FMI2_MODEL_EXCHANGE).err().unwrap();
-    assert!(e[0].contains("fmuType"), "{e:?}");
+    let e = Slave::<Pfc>::try_new("x", &guid::<Pfc>(), 2).err().unwrap();
+    assert!(e[0].contains("fmuType = 2"), "{e:?}");
+    assert!(Slave::<Pfc>::try_new("x", &guid::<Pfc>(), FMI2_MODEL_EXCHANGE).is_ok(), "both interfaces");
     let e = Slave::<Pfc>::try_new("", &guid::<Pfc>(), FMI2_COSIMULATION).err().unwrap();
     assert!(e[0].contains("instanceName"), "{e:?}");
     let (n, g) = (CString::new("x").unwrap(), CString::new(guid::<Pfc>()).unwrap());
@@ -250,6 +251,7 @@ impl Model for Faulty {
         Variable::real_input("mode", 0, 0.0, "1", "", (0.0, 3.0), "failure mode"),
         Variable::real_output("y", 1, "1", "", ""),
     ];
+    const STATES: &'static [ContinuousState] = &[];
     fn initialize(values: &Values) -> Result<Self, String> {
         Ok(Faulty { mode: values.real(0), t: 0.0 })
     }
@@ -267,6 +269,11 @@ impl Model for Faulty {
             _ => Ok(()),
         }
     }
+    fn continuous_states(&self, _: &mut [f64]) {}
+    fn set_continuous_states(&mut self, _: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+    fn derivatives(&self, _: &Values, _: &mut [f64]) {}
     fn save(&self) -> Vec<f64> {
         vec![]
     }
@@ -310,7 +317,10 @@ fn a_non_finite_output_is_an_error_naming_it() {
     assert_eq!(s.step(0.0, 0.5), OK);
     assert_eq!(s.step(0.5, 0.5), ERR);
     let e = s.last_error();
-    assert!(e.contains("fmi2DoStep") && e.contains("y = NaN") && e.contains("t = 1") && e.contains("Error state"), "{e}");
+    assert!(
+        e.contains("fmi2DoStep") && e.contains("y = NaN") && e.contains("t = 1") && e.contains("Error state"),
+        "{e}"
+    );
     let mut y = 0.0;
     assert_eq!(unsafe { api::get_real::<Faulty>(s.c, &1, 1, &mut y) }, ERR);
     assert!(s.last_error().contains("y = NaN"), "{}", s.last_error());

@@ -80,6 +80,11 @@ impl HighPassFeedback {
     }
 
     /// Spool compensation u_comp = Q_f / Q_rated [-].
+    /// The filter state's derivative x' = omega_f (p - x) (the realisation of eq. 6.2 above).
+    pub fn state_derivative(&self, p: f64, x: f64) -> f64 {
+        self.omega_f * (p - x)
+    }
+
     pub fn u_comp(&self, p: f64, x: f64) -> f64 {
         self.flow(p, x) / self.q_rated
     }

@@ -1,4 +1,5 @@
-//! The 34 FMI 2.0 Co-Simulation functions, generic over the model. The export macro
+//! The 44 FMI 2.0 functions (25 common, 9 Co-Simulation, 10 Model Exchange), generic over the
+//! model. The export macro
 //! ([`crate::export_fmu`]) forwards each `#[no_mangle] extern "C"` symbol here.
 //!
 //! Every function checks its pointers and the state machine, catches panics, and reports
@@ -10,7 +11,7 @@ use super::guid::guid;
 use super::instance::{Core, Instance, Step, Warning};
 use super::log::{Logger, LOG_FMI_CALLS};
 use super::model::Model;
-use super::state::{allowed, describe, Mask, State};
+use super::state::{allowed, describe, Interface, Rule, State};
 use super::types::*;
 use super::variables::{BaseType, Value};
 use std::ffi::{CStr, CString};
@@ -31,7 +32,7 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
 fn call<M: Model>(
     c: fmi2Component,
     function: &str,
-    mask: Mask,
+    rule: Rule,
     body: impl FnOnce(&mut Instance<M>) -> Result<fmi2Status, String>,
 ) -> fmi2Status {
     // SAFETY: FMI requires `c` to be a pointer returned by fmi2Instantiate; a null or foreign
@@ -43,9 +44,15 @@ fn call<M: Model>(
         if inst.log.is_enabled(LOG_FMI_CALLS) {
             inst.log.info("logFmiCalls", function);
         }
+        if let Some(interface) = rule.interface.filter(|&i| i != inst.interface) {
+            return Err(format!(
+                "a {interface:?} function, but this instance was instantiated for {:?}",
+                inst.interface
+            ));
+        }
         let state = inst.core.state;
-        if mask & state.bit() == 0 {
-            return Err(format!("illegal call in state {state:?}; it is allowed in: {}", describe(mask)));
+        if rule.states & state.bit() == 0 {
+            return Err(format!("illegal call in state {state:?}; it is allowed in: {}", describe(rule.states)));
         }
         body(inst)
     }));
@@ -137,12 +144,15 @@ pub unsafe fn instantiate<M: Model>(
         if instance_name.is_empty() {
             return fail("instanceName must be a non-empty UTF-8 string".into());
         }
-        if fmu_type != FMI2_COSIMULATION {
-            return fail(format!(
-                "fmuType = {fmu_type} is not supported: {} is a Co-Simulation FMU (fmi2CoSimulation = 1)",
-                M::INFO.identifier
-            ));
-        }
+        let interface = match fmu_type {
+            FMI2_MODEL_EXCHANGE => Interface::ModelExchange,
+            FMI2_COSIMULATION => Interface::CoSimulation,
+            _ => {
+                return fail(format!(
+                    "fmuType = {fmu_type} is outside its valid range: fmi2ModelExchange (0) or fmi2CoSimulation (1)"
+                ))
+            }
+        };
         match text(fmu_guid) {
             Some(g) if g == expected => {}
             g => {
@@ -151,7 +161,7 @@ pub unsafe fn instantiate<M: Model>(
                 ))
             }
         }
-        Some(Box::into_raw(Box::new(Instance::<M>::new(logger, expected))) as fmi2Component)
+        Some(Box::into_raw(Box::new(Instance::<M>::new(logger, expected, interface))) as fmi2Component)
     })
     .ok()
     .flatten()
@@ -303,7 +313,8 @@ unsafe fn set<M: Model, T: Copy>(
     value: *const T,
     convert: impl Fn(T) -> Result<Value, String>,
 ) -> fmi2Status {
-    call::<M>(c, function, allowed::SET, |inst| {
+    let rule = if function == "fmi2SetReal" { allowed::SET_REAL } else { allowed::SET_DISCRETE };
+    call::<M>(c, function, rule, |inst| {
         let vrs = slice(vr, n, "vr")?;
         let values = slice(value, n, "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
         inst.set(vrs, values)?;
@@ -430,14 +441,20 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
         let data = slice(bytes as *const u8, size, "serializedState")?;
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
         let core = fmu_state::deserialize::<M>(data, &inst.guid)?;
+        if let Some(other) = core.state.interface().filter(|&i| i != inst.interface) {
+            return Err(format!(
+                "the state was saved by a {other:?} instance (state {:?}); this instance is {:?}",
+                core.state, inst.interface
+            ));
+        }
         *out = new_fmu_state(inst, core);
         Ok(fmi2Status::OK)
     })
 }
 
 /// Shared body of the functions boomsim does not provide.
-fn unsupported<M: Model>(c: fmi2Component, function: &str, mask: Mask, why: &str) -> fmi2Status {
-    call::<M>(c, function, mask, |_| Err(format!("not supported: {why}")))
+fn unsupported<M: Model>(c: fmi2Component, function: &str, rule: Rule, why: &str) -> fmi2Status {
+    call::<M>(c, function, rule, |_| Err(format!("not supported: {why}")))
 }
 
 pub unsafe fn get_directional_derivative<M: Model>(c: fmi2Component) -> fmi2Status {
@@ -524,6 +541,105 @@ pub unsafe fn get_boolean_status<M: Model>(c: fmi2Component, kind: c_int, value:
         }
         // The slave asks to end the simulation only once a step has failed.
         *value.as_mut().ok_or("value is NULL")? = (inst.core.state == State::StepFailed) as fmi2Boolean;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> fmi2Status {
+    call::<M>(c, "fmi2EnterEventMode", allowed::ENTER_EVENT_MODE, |inst| {
+        inst.core.state = State::EventMode;
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// fmi2NewDiscreteStates. The models have no discrete states, time events or state events:
+/// nothing changes at an event, so the event iteration ends at once.
+pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status {
+    call::<M>(c, "fmi2NewDiscreteStates", allowed::NEW_DISCRETE_STATES, |_| {
+        *info.as_mut().ok_or("fmi2EventInfo is NULL")? = fmi2EventInfo::default();
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi2Component) -> fmi2Status {
+    call::<M>(c, "fmi2EnterContinuousTimeMode", allowed::ENTER_CONTINUOUS_TIME_MODE, |inst| {
+        inst.core.state = State::ContinuousTimeMode;
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// fmi2CompletedIntegratorStep: no step events (`completedIntegratorStepNotNeeded="true"`).
+pub unsafe fn completed_integrator_step<M: Model>(
+    c: fmi2Component,
+    _no_set_prior: fmi2Boolean,
+    enter_event_mode: *mut fmi2Boolean,
+    terminate: *mut fmi2Boolean,
+) -> fmi2Status {
+    call::<M>(c, "fmi2CompletedIntegratorStep", allowed::COMPLETED_INTEGRATOR_STEP, |inst| {
+        let enter = enter_event_mode.as_mut().ok_or("enterEventMode is NULL")?;
+        let term = terminate.as_mut().ok_or("terminateSimulation is NULL")?;
+        (*enter, *term) = (FMI2_FALSE, FMI2_FALSE);
+        inst.core.last_successful_time = inst.core.time;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn set_time<M: Model>(c: fmi2Component, time: f64) -> fmi2Status {
+    call::<M>(c, "fmi2SetTime", allowed::SET_TIME, |inst| {
+        inst.set_time(time)?;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn set_continuous_states<M: Model>(c: fmi2Component, x: *const f64, nx: usize) -> fmi2Status {
+    call::<M>(c, "fmi2SetContinuousStates", allowed::SET_CONTINUOUS_STATES, |inst| {
+        inst.set_continuous_states(slice(x, nx, "x")?)?;
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn get_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
+    call::<M>(c, "fmi2GetContinuousStates", allowed::GET_CONTINUOUS_STATES, |inst| {
+        inst.continuous_states(slice_mut(x, nx, "x")?)?;
+        Ok(fmi2Status::OK)
+    })
+}
+
+/// fmi2GetDerivatives; fmi2Discard (FMI 2.0, 2.1.3: retry with a smaller step) where the
+/// states are outside the model's domain.
+pub unsafe fn get_derivatives<M: Model>(c: fmi2Component, dx: *mut f64, nx: usize) -> fmi2Status {
+    call::<M>(c, "fmi2GetDerivatives", allowed::GET_DERIVATIVES, |inst| {
+        match inst.derivatives(slice_mut(dx, nx, "derivatives")?)? {
+            None => Ok(fmi2Status::OK),
+            Some(why) => {
+                inst.log.status(fmi2Status::Discard, &format!("fmi2GetDerivatives: {why}"));
+                Ok(fmi2Status::Discard)
+            }
+        }
+    })
+}
+
+/// fmi2GetEventIndicators: the models declare none (`numberOfEventIndicators="0"`).
+pub unsafe fn get_event_indicators<M: Model>(c: fmi2Component, _z: *mut f64, ni: usize) -> fmi2Status {
+    call::<M>(c, "fmi2GetEventIndicators", allowed::GET_EVENT_INDICATORS, |_| {
+        if ni != 0 {
+            return Err(format!("ni = {ni}, but {} has 0 event indicators (modelDescription.xml)", M::INFO.identifier));
+        }
+        Ok(fmi2Status::OK)
+    })
+}
+
+pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
+    call::<M>(c, "fmi2GetNominalsOfContinuousStates", allowed::GET_NOMINALS, |_| {
+        let out = slice_mut(x, nx, "x_nominal")?;
+        if nx != M::STATES.len() {
+            return Err(format!(
+                "nx = {nx}, but {} has {} (modelDescription.xml)",
+                M::INFO.identifier,
+                M::STATES.len()
+            ));
+        }
+        out.iter_mut().zip(M::STATES).for_each(|(o, s)| *o = s.nominal);
         Ok(fmi2Status::OK)
     })
 }

@@ -1,7 +1,7 @@
-//! `export_fmu!`: emits the 34 FMI 2.0 Co-Simulation symbols for one model. A cdylib crate under
+//! `export_fmu!`: emits the 44 FMI 2.0 symbols (Model Exchange and Co-Simulation) for one model. A cdylib crate under
 //! `fmu/<ModelIdentifier>/` consists of this one invocation.
 
-/// Exports the FMI 2.0 C ABI (25 common + 9 co-simulation functions) for a [`Model`](crate::fmi2::Model).
+/// Exports the FMI 2.0 C ABI (25 common + 9 Co-Simulation + 10 Model Exchange functions) for a [`Model`](crate::fmi2::Model).
 #[macro_export]
 macro_rules! export_fmu {
     ($model:ty) => {
@@ -253,6 +253,55 @@ macro_rules! export_fmu {
                 _v: *mut fmi2String,
             ) -> fmi2Status {
                 api::get_string_status::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
+                api::enter_event_mode::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2NewDiscreteStates(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status {
+                api::new_discrete_states::<M>(c, info)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
+                api::enter_continuous_time_mode::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
+                c: fmi2Component,
+                no_prior: fmi2Boolean,
+                enter_event_mode: *mut fmi2Boolean,
+                terminate: *mut fmi2Boolean,
+            ) -> fmi2Status {
+                api::completed_integrator_step::<M>(c, no_prior, enter_event_mode, terminate)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: f64) -> fmi2Status {
+                api::set_time::<M>(c, time)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetContinuousStates(c: fmi2Component, x: *const f64, nx: usize) -> fmi2Status {
+                api::set_continuous_states::<M>(c, x, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetDerivatives(c: fmi2Component, dx: *mut f64, nx: usize) -> fmi2Status {
+                api::get_derivatives::<M>(c, dx, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetEventIndicators(c: fmi2Component, z: *mut f64, ni: usize) -> fmi2Status {
+                api::get_event_indicators::<M>(c, z, ni)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetContinuousStates(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
+                api::get_continuous_states::<M>(c, x, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
+                c: fmi2Component,
+                x: *mut f64,
+                nx: usize,
+            ) -> fmi2Status {
+                api::get_nominals_of_continuous_states::<M>(c, x, nx)
             }
         }
     };

@@ -3,7 +3,7 @@
 
 use super::log::{num, Logger};
 use super::model::{Log, Model};
-use super::state::State;
+use super::state::{Interface, State};
 use super::types::fmi2Status;
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use std::borrow::Cow;
@@ -26,6 +26,8 @@ pub type Warning = Option<String>;
 pub struct Instance<M: Model> {
     pub(crate) magic: u64,
     pub log: Logger,
+    /// Model Exchange or Co-Simulation, as instantiated.
+    pub interface: Interface,
     pub core: Core<M>,
     /// Storage behind the pointers the last fmi2GetString returned.
     pub(crate) strings: Vec<std::ffi::CString>,
@@ -110,12 +112,25 @@ impl<M: Model> Instance<M> {
     pub const MAGIC: u64 = fnv1a(M::INFO.identifier.as_bytes(), 0x1157);
 
     /// A freshly instantiated slave.
-    pub fn new(log: Logger, guid: String) -> Self {
-        Instance { magic: Self::MAGIC, log, core: Core::new(), strings: Vec::new(), guid, fmu_states: Vec::new() }
+    pub fn new(log: Logger, guid: String, interface: Interface) -> Self {
+        Instance {
+            magic: Self::MAGIC,
+            log,
+            interface,
+            core: Core::new(),
+            strings: Vec::new(),
+            guid,
+            fmu_states: Vec::new(),
+        }
     }
 
     /// fmi2SetupExperiment. A tolerance outside [`TOLERANCE_RANGE`] is clamped into it (warning).
-    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> Result<Warning, String> {
+    pub fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start: f64,
+        stop: Option<f64>,
+    ) -> Result<Warning, String> {
         if !start.is_finite() {
             return Err(format!("startTime = {} must be finite", num(start)));
         }
@@ -158,16 +173,95 @@ impl<M: Model> Instance<M> {
         self.core.outputs_current = false;
     }
 
-    /// fmi2ExitInitializationMode: builds the model from the final parameters and inputs.
+    /// fmi2ExitInitializationMode: builds the model from the final parameters and inputs; then
+    /// Co-Simulation steps, Model Exchange is in Event Mode.
     pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
         let c = &mut self.core;
+        if self.interface == Interface::ModelExchange {
+            M::model_exchange_check(&c.values)?;
+        }
         let model = M::initialize(&c.values)?;
-        model.outputs(&mut c.values);
+        write_outputs(&model, &mut c.values);
         c.model = Some(model);
         c.outputs_current = true;
         c.last_successful_time = c.time;
-        c.state = State::StepComplete;
+        c.state = match self.interface {
+            Interface::CoSimulation => State::StepComplete,
+            Interface::ModelExchange => State::EventMode,
+        };
         Ok(())
+    }
+
+    /// The model, built when initialisation ended.
+    fn model(&mut self) -> Result<&mut M, String> {
+        self.core.model.as_mut().ok_or_else(|| "the model is not initialised".to_string())
+    }
+
+    /// fmi2SetTime: the time of the next states and derivatives. A time past the stop time is
+    /// accepted: variable-step integrators (CVode in fmpy) evaluate beyond their last output time
+    /// and interpolate back, and the models are autonomous (time enters only through the
+    /// inputs), so their equations hold at any time.
+    pub fn set_time(&mut self, t: f64) -> Result<(), String> {
+        if !t.is_finite() {
+            return Err(format!("time = {} must be finite", num(t)));
+        }
+        self.core.time = t;
+        self.core.outputs_current = false;
+        Ok(())
+    }
+
+    /// The number of continuous states checked against the importer's `nx`.
+    fn check_count(what: &str, n: usize, expected: usize) -> Result<(), String> {
+        if n == expected {
+            return Ok(());
+        }
+        Err(format!("{what} = {n}, but {} has {expected} (modelDescription.xml)", M::INFO.identifier))
+    }
+
+    /// fmi2SetContinuousStates: all or nothing.
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        Self::check_count("nx", x.len(), M::STATES.len())?;
+        if let Some(k) = x.iter().position(|x| !x.is_finite()) {
+            return Err(format!("{} = {} is not a finite number", self.state_name(k), num(x[k])));
+        }
+        let model = self.model()?;
+        let before = model.clone();
+        if let Err(e) = model.set_continuous_states(x) {
+            *model = before;
+            return Err(e);
+        }
+        self.core.outputs_current = false;
+        Ok(())
+    }
+
+    /// fmi2GetContinuousStates (in Initialization Mode: those the values set so far give).
+    pub fn continuous_states(&mut self, x: &mut [f64]) -> Result<(), String> {
+        Self::check_count("nx", x.len(), M::STATES.len())?;
+        match &self.core.model {
+            Some(model) if self.core.state != State::InitializationMode => model.continuous_states(x),
+            _ => M::initialize(&self.core.values)?.continuous_states(x),
+        }
+        Ok(())
+    }
+
+    /// fmi2GetDerivatives. `Ok(Some(why))`: not finite at these states (fmi2Discard).
+    pub fn derivatives(&mut self, dx: &mut [f64]) -> Result<Warning, String> {
+        Self::check_count("nx", dx.len(), M::STATES.len())?;
+        let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
+        model.derivatives(&self.core.values, dx);
+        Ok(dx.iter().position(|d| !d.is_finite()).map(|k| {
+            format!(
+                "der({}) = {} at t = {}: the states are outside the model's valid range; retry with a smaller step",
+                self.state_name(k),
+                num(dx[k]),
+                num(self.core.time)
+            )
+        }))
+    }
+
+    /// The name of the `k`-th continuous state.
+    fn state_name(&self, k: usize) -> &'static str {
+        self.name(M::STATES[k].state).unwrap_or("?")
     }
 
     /// Brings outputs up to date before a get.
@@ -178,9 +272,9 @@ impl<M: Model> Instance<M> {
         }
         if c.state == State::InitializationMode {
             // Initial outputs follow from the values set so far.
-            M::initialize(&c.values)?.outputs(&mut c.values);
+            write_outputs(&M::initialize(&c.values)?, &mut c.values);
         } else if let Some(model) = &c.model {
-            model.outputs(&mut c.values);
+            write_outputs(model, &mut c.values);
         }
         c.outputs_current = true;
         Ok(())
@@ -215,7 +309,12 @@ impl<M: Model> Instance<M> {
             if let Value::Real(x) = value {
                 // Never a non-finite value with fmi2OK (a model evaluated outside its range).
                 if !x.is_finite() {
-                    return Err(format!("{} = {} at t = {} is not a finite number", v.name, num(*x), num(self.core.time)));
+                    return Err(format!(
+                        "{} = {} at t = {} is not a finite number",
+                        v.name,
+                        num(*x),
+                        num(self.core.time)
+                    ));
                 }
             }
             out[k] = read(value);
@@ -233,7 +332,7 @@ impl<M: Model> Instance<M> {
             in_range(v, &value)?;
             checked.push((i, value));
         }
-        let tunes = self.core.state == State::StepComplete
+        let tunes = matches!(self.core.state, State::StepComplete | State::EventMode)
             && checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
         let before = tunes.then(|| self.core.values.clone());
         for (i, value) in checked {
@@ -322,7 +421,11 @@ impl<M: Model> Instance<M> {
         // still continues exactly where the last step ended, so results do not depend on it.
         let (start, end) = (c.time, t + h);
         if end <= start {
-            return Err(format!("communicationStepSize = {} does not advance the instance time {}", num(h), num(start)));
+            return Err(format!(
+                "communicationStepSize = {} does not advance the instance time {}",
+                num(h),
+                num(start)
+            ));
         }
         let inputs = M::INFO.interpolated_inputs;
         let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
@@ -332,7 +435,8 @@ impl<M: Model> Instance<M> {
             c.time = e.time;
             c.last_successful_time = e.time;
             c.state = State::StepFailed;
-            let why = format!("step from t = {} with h = {} stopped at t = {}: {}", num(t), num(h), num(e.time), e.message);
+            let why =
+                format!("step from t = {} with h = {} stopped at t = {}: {}", num(t), num(h), num(e.time), e.message);
             return Ok(Step::Discarded(why));
         }
         // Inputs with a derivative follow their ramp to the new communication point (only
@@ -347,7 +451,7 @@ impl<M: Model> Instance<M> {
         c.last_successful_time = end;
         // Every Real the importer can read is finite after a good step, or the step is an error.
         c.values.take_non_finite();
-        model.outputs(&mut c.values);
+        write_outputs(model, &mut c.values);
         c.outputs_current = true;
         if let Some(i) = c.values.take_non_finite() {
             c.state = State::Error;
@@ -360,6 +464,16 @@ impl<M: Model> Instance<M> {
             ));
         }
         Ok(Step::Done(warning))
+    }
+}
+
+/// Writes the model's outputs and locals and the `der()` variables of its continuous states.
+fn write_outputs<M: Model>(model: &M, values: &mut Values) {
+    model.outputs(values);
+    let mut dx = vec![0.0; M::STATES.len()];
+    model.derivatives(values, &mut dx);
+    for (s, d) in M::STATES.iter().zip(dx) {
+        values.set_real(s.derivative, d);
     }
 }
 
@@ -381,7 +495,8 @@ pub fn bounded_slopes<'a>(values: &Values, slopes: &'a [f64], inputs: &[u32], h:
     let mut warnings = Vec::new();
     for i in inputs.iter().filter_map(|&r| values.position(r)) {
         let d = slopes[i];
-        let (Kind::Real { min, max, unit, .. }, Value::Real(x), true) = (values.table()[i].kind, values.at(i), d != 0.0)
+        let (Kind::Real { min, max, unit, .. }, Value::Real(x), true) =
+            (values.table()[i].kind, values.at(i), d != 0.0)
         else {
             continue;
         };
@@ -422,16 +537,18 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
         && match state {
             State::Instantiated => v.initial != Initial::Calculated || input,
             State::InitializationMode => v.initial == Initial::Exact || input,
-            State::StepComplete => {
+            State::StepComplete | State::EventMode => {
                 input || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
             }
+            State::ContinuousTimeMode => input && v.variability == Variability::Continuous,
             _ => false,
         };
     if ok {
         return Ok(());
     }
     let rule = match state {
-        State::StepComplete => "after initialisation only inputs and tunable parameters may be set",
+        State::StepComplete | State::EventMode => "after initialisation only inputs and tunable parameters may be set",
+        State::ContinuousTimeMode => "in Continuous-Time Mode only continuous inputs may be set",
         State::Instantiated | State::InitializationMode => "only parameters and inputs may be set",
         _ => "no variable may be set in this state",
     };
@@ -448,7 +565,9 @@ pub(crate) fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
     match (v.kind, value) {
         (Kind::Real { min, max, unit, .. }, Value::Real(x)) => {
             // Formatted only for an error; the dimensionless unit "1" is not written.
-            let range = || format!("[{}, {}]{}", num(min), num(max), if unit == "1" { String::new() } else { format!(" {unit}") });
+            let range = || {
+                format!("[{}, {}]{}", num(min), num(max), if unit == "1" { String::new() } else { format!(" {unit}") })
+            };
             if !x.is_finite() {
                 return Err(format!("{} = {x} is not a finite number; valid range {}", v.name, range()));
             }

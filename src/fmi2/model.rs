@@ -1,6 +1,8 @@
-//! The model trait: what a physics model provides so that [`crate::fmi2`] can export it.
+//! The model contract: what a physics model provides so that [`crate::fmi2`] can export it as
+//! Model Exchange (its continuous states, their derivatives, its outputs) and as Co-Simulation
+//! (a step of its own, with the internal solver).
 
-use super::variables::{Values, Variable};
+use super::variables::{Value, Values, Variable};
 
 /// Static facts about a model, written to modelDescription.xml.
 #[derive(Debug, Clone, Copy)]
@@ -32,6 +34,16 @@ impl ModelInfo {
     }
 }
 
+/// A continuous state of Model Exchange: the value references of the state variable and of its
+/// derivative (`der(...)`, a local Real), and the state's nominal value (its typical magnitude:
+/// fmi2GetNominalsOfContinuousStates; importers scale absolute tolerances with it).
+#[derive(Debug, Clone, Copy)]
+pub struct ContinuousState {
+    pub state: u32,
+    pub derivative: u32,
+    pub nominal: f64,
+}
+
 /// A failed step: how far the model got and why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepError {
@@ -50,14 +62,31 @@ pub trait Log {
     fn warning(&mut self, message: &str);
 }
 
-/// A model exported as an FMI 2.0 Co-Simulation slave.
+/// A model exported as an FMI 2.0 Model Exchange and Co-Simulation FMU.
 ///
 /// The FMI layer owns the variable values (`Values`) and the state machine; the model holds its
-/// internal continuous state and reads parameters and inputs from `Values`.
+/// continuous state and reads parameters and inputs from `Values`. Model Exchange hands
+/// [`Model::STATES`] and [`Model::derivatives`] to the importer's integrator; Co-Simulation calls
+/// [`Model::do_step`], where a model integrates the same equations with [`crate::solver`].
 pub trait Model: Clone + Send + Sized + 'static {
     const INFO: ModelInfo;
     /// The variable table (unique value references across all types).
     const VARIABLES: &'static [Variable];
+    /// The continuous states in the order of fmi2GetContinuousStates. FMI 2.0 fixes their number
+    /// in modelDescription.xml, so it is the same for every parameter value.
+    const STATES: &'static [ContinuousState];
+
+    /// Parameter settings that change the model's equations (rigid/flexible, port couplings):
+    /// ModelStructure's dependencies hold in each. Default: the start values only.
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        vec![vec![]]
+    }
+
+    /// Refuses parameter values Model Exchange cannot run (a co-simulation-only coupling), with
+    /// the reason. Default: all can.
+    fn model_exchange_check(_values: &Values) -> Result<(), String> {
+        Ok(())
+    }
 
     /// Builds the model from final parameter and input values at the end of initialisation
     /// (and, in initialisation mode, to compute initial outputs). Returns a message naming the
@@ -69,6 +98,17 @@ pub trait Model: Clone + Send + Sized + 'static {
 
     /// Writes outputs and locals from the current state and inputs.
     fn outputs(&self, values: &mut Values);
+
+    /// Writes the continuous states ([`Model::STATES`] order).
+    fn continuous_states(&self, x: &mut [f64]);
+
+    /// Takes new continuous states (fmi2SetContinuousStates, all finite); refuses states outside
+    /// the model's domain, naming the state, its value and its valid range.
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
+
+    /// Writes the states' time derivatives at the current states with the inputs of `values`.
+    /// A non-finite value tells the importer to retry with a smaller step (fmi2Discard).
+    fn derivatives(&self, values: &Values, dx: &mut [f64]);
 
     /// The master set the variables `vrs` between two steps (inputs and tunable parameters,
     /// after [`Model::retune`]): a model that extrapolates an input takes a new value as a sample

@@ -56,3 +56,15 @@ pub struct fmi2CallbackFunctions {
     pub stepFinished: fmi2StepFinished,
     pub componentEnvironment: fmi2ComponentEnvironment,
 }
+
+/// fmi2EventInfo, filled by fmi2NewDiscreteStates.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct fmi2EventInfo {
+    pub newDiscreteStatesNeeded: fmi2Boolean,
+    pub terminateSimulation: fmi2Boolean,
+    pub nominalsOfContinuousStatesChanged: fmi2Boolean,
+    pub valuesOfContinuousStatesChanged: fmi2Boolean,
+    pub nextEventTimeDefined: fmi2Boolean,
+    pub nextEventTime: fmi2Real,
+}

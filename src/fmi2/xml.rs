@@ -3,6 +3,7 @@
 use super::guid::guid;
 use super::log::{num, GENERIC_CATEGORIES};
 use super::model::Model;
+use super::structure::{probe, Structure};
 use super::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
 use crate::units::{self, BASE_NAMES};
 use quick_xml::Writer;
@@ -91,6 +92,46 @@ pub fn initial_dependencies<M: Model>(v: &Variable) -> Vec<u32> {
     v.initial_depends_on.unwrap_or(v.depends_on).iter().copied().chain(parameters).collect()
 }
 
+/// The knowns of the unknown `vr` after initialisation: for an output its declared inputs and
+/// the states it depends on; for a `der()` variable the states and inputs.
+fn dependencies<M: Model>(structure: &Structure, vr: u32, declared: &[u32]) -> Vec<u32> {
+    let is_state = |r: &u32| M::STATES.iter().any(|s| s.state == *r);
+    let probed = structure.after.get(&vr).into_iter().flatten();
+    if M::STATES.iter().any(|s| s.derivative == vr) {
+        probed.copied().collect()
+    } else {
+        declared.iter().copied().chain(probed.copied().filter(is_state)).collect()
+    }
+}
+
+/// FMI 2.0 section 2.2.8: the initial unknowns in index order with their dependencies on the
+/// knowns of Initialization Mode: outputs with initial approx/calculated, calculated parameters,
+/// and the continuous states with initial approx/calculated and every `der()` variable (on the
+/// inputs their probe found, and every parameter, since the start state is computed from them).
+fn initial_unknowns<M: Model>(structure: &Structure) -> Vec<(u32, Vec<u32>)> {
+    let parameters = || M::VARIABLES.iter().filter(|p| p.causality == Causality::Parameter).map(|p| p.vr);
+    let mut rows: Vec<(usize, u32, Vec<u32>)> = M::VARIABLES
+        .iter()
+        .enumerate()
+        .filter_map(|(i, v)| {
+            let state = M::STATES.iter().any(|s| s.state == v.vr && v.initial != Initial::Exact);
+            let derivative = M::STATES.iter().any(|s| s.derivative == v.vr);
+            let deps = if derivative || (state && v.causality != Causality::Output) {
+                structure.initial.get(&v.vr).into_iter().flatten().copied().chain(parameters()).collect()
+            } else if (v.causality == Causality::Output && v.initial != Initial::Exact)
+                || v.causality == Causality::CalculatedParameter
+            {
+                initial_dependencies::<M>(v)
+            } else {
+                return None;
+            };
+            Some((i, v.vr, deps))
+        })
+        .collect();
+    rows.sort_by_key(|r| r.0);
+    rows.into_iter().map(|(_, vr, deps)| (vr, deps)).collect()
+}
+
 /// The complete modelDescription.xml of model `M`.
 pub fn model_description<M: Model>() -> String {
     write::<M>().expect("writing XML to memory cannot fail")
@@ -116,6 +157,17 @@ fn write<M: Model>() -> io::Result<String> {
         .with_attributes(root.iter().map(|(k, v)| (*k, v.as_str())))
         .write_inner_content(|w| {
             let flag = |b: bool| b.to_string();
+            let me: Attrs = vec![
+                ("modelIdentifier", info.identifier.into()),
+                ("needsExecutionTool", flag(false)),
+                ("completedIntegratorStepNotNeeded", flag(true)),
+                ("canBeInstantiatedOnlyOncePerProcess", flag(false)),
+                ("canNotUseMemoryManagementFunctions", flag(true)),
+                ("canGetAndSetFMUstate", flag(true)),
+                ("canSerializeFMUstate", flag(true)),
+                ("providesDirectionalDerivative", flag(false)),
+            ];
+            element(w, "ModelExchange", &me)?;
             let cs: Attrs = vec![
                 ("modelIdentifier", info.identifier.into()),
                 ("needsExecutionTool", flag(false)),
@@ -171,39 +223,44 @@ fn write<M: Model>() -> io::Result<String> {
                     w.create_element("ScalarVariable")
                         .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
                         .write_inner_content(|w| {
-                            let (ty, a) = type_attrs(v);
+                            let (ty, mut a) = type_attrs(v);
+                            if let Some(s) = M::STATES.iter().find(|s| s.derivative == v.vr) {
+                                a.push(("derivative", indices::<M>(&[s.state])));
+                            }
                             element(w, ty, &a)
                         })?;
                 }
                 Ok(())
             })?;
+            let structure = probe::<M>();
             w.create_element("ModelStructure").write_inner_content(|w| {
+                let unknown = |w: &mut Writer<Vec<u8>>, vr: u32, deps: &[u32]| {
+                    element(w, "Unknown", &vec![("index", indices::<M>(&[vr])), ("dependencies", indices::<M>(deps))])
+                };
                 let outputs: Vec<&Variable> =
                     M::VARIABLES.iter().filter(|v| v.causality == Causality::Output).collect();
                 if !outputs.is_empty() {
                     w.create_element("Outputs").write_inner_content(|w| {
                         for v in &outputs {
-                            let a: Attrs =
-                                vec![("index", indices::<M>(&[v.vr])), ("dependencies", indices::<M>(v.depends_on))];
-                            element(w, "Unknown", &a)?;
+                            unknown(w, v.vr, &dependencies::<M>(&structure, v.vr, v.depends_on))?;
                         }
                         Ok(())
                     })?;
                 }
-                // FMI 2.0 section 2.2.8: outputs with initial approx/calculated and calculated
-                // parameters, with their dependencies on the knowns of Initialization Mode.
-                let initial: Vec<&Variable> = M::VARIABLES
-                    .iter()
-                    .filter(|v| {
-                        (v.causality == Causality::Output && v.initial != Initial::Exact)
-                            || v.causality == Causality::CalculatedParameter
-                    })
-                    .collect();
+                if !M::STATES.is_empty() {
+                    // The order of the state vector (fmi2GetContinuousStates).
+                    w.create_element("Derivatives").write_inner_content(|w| {
+                        for s in M::STATES {
+                            unknown(w, s.derivative, &dependencies::<M>(&structure, s.derivative, &[]))?;
+                        }
+                        Ok(())
+                    })?;
+                }
+                let initial = initial_unknowns::<M>(&structure);
                 if !initial.is_empty() {
                     w.create_element("InitialUnknowns").write_inner_content(|w| {
-                        for v in &initial {
-                            let deps = indices::<M>(&initial_dependencies::<M>(v));
-                            element(w, "Unknown", &vec![("index", indices::<M>(&[v.vr])), ("dependencies", deps)])?;
+                        for (vr, deps) in &initial {
+                            unknown(w, *vr, deps)?;
                         }
                         Ok(())
                     })?;

@@ -69,6 +69,20 @@ impl Triangle {
         law_of_cosines(self.w1, self.w2, l_cyl) - self.phi1 + self.phi2
     }
 
+    /// The cylinder length at boom angle `theta2`, the inverse of [`Self::theta2`] by the law of
+    /// cosines (eq. 2.3): l^2 = w1^2 + w2^2 - 2 w1 w2 cos beta with beta = theta2 + phi1 - phi2.
+    /// `None` unless 0 < beta < pi, where the triangle closes.
+    pub fn l_cyl(&self, theta2: f64) -> Option<f64> {
+        let beta = theta2 + self.phi1 - self.phi2;
+        (beta > 0.0 && beta < std::f64::consts::PI)
+            .then(|| (self.w1 * self.w1 + self.w2 * self.w2 - 2.0 * self.w1 * self.w2 * beta.cos()).sqrt())
+    }
+
+    /// The boom angles in which the triangle closes, (phi2 - phi1, pi + phi2 - phi1).
+    pub fn theta2_range(&self) -> (f64, f64) {
+        (self.phi2 - self.phi1, std::f64::consts::PI + self.phi2 - self.phi1)
+    }
+
     /// theta2 and its first two derivatives with respect to l_cyl, from [`Self::theta2`]:
     /// dtheta2/dl = l / (w1 w2 sin beta) (the inverse of the cylinder's moment arm about B,
     /// w1 sin(theta1 - theta2 + phi2) of eq. 2.18) and

@@ -13,7 +13,8 @@ use super::parts::{
     self, out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION,
 };
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
-use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use super::states::{BOOM_DERIVATIVES, BOOM_STATES};
+use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
@@ -58,7 +59,7 @@ const OWN: [Variable; 17] = [
     port::PORT_F.depends(&[vr::F]),
 ];
 
-const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 3 + N_BOOM_ROWS;
+const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 3 + N_BOOM_ROWS + BOOM_DERIVATIVES.len();
 const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .vars(&SOLVER_LOCALS)
     .sections()
@@ -66,6 +67,7 @@ const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .boom_params()
     .hydraulics(PARAMS, K_STOP, K_STOP + 1)
     .hydraulics(PARAMS, C_STOP, C_STOP + 1)
+    .vars(&BOOM_DERIVATIVES)
     .build();
 
 const DOCUMENTATION: &str = concat!(
@@ -183,6 +185,38 @@ impl Model for BoomMechanics {
         ..parts::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
+    const STATES: &'static [ContinuousState] = &BOOM_STATES;
+
+    /// Rigid and flexible boom, each with the plain and the TLM port.
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        let ports = port::configurations();
+        parts::boom_configurations().iter().flat_map(|b| ports.iter().map(move |p| [&b[..], p].concat())).collect()
+    }
+
+    fn model_exchange_check(values: &Values) -> Result<(), String> {
+        port::model_exchange_check(values)
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) {
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        self.sys.boom.me_states(q, qd, x);
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let dof = self.sys.boom.mechanics().dof();
+        let (q, qd) = self.state.split_at_mut(dof);
+        self.sys.boom.read_me_states(x, q, qd)
+    }
+
+    /// The plain port: pushed by the input cylinder.F and the end stops.
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        let b = self.sys.boom.mechanics();
+        let (q, qd) = self.state.split_at(b.dof());
+        let f = values.real(vr::F);
+        let mut qdd = vec![0.0; b.dof()];
+        b.accelerations(q, qd, &mut |x, v| f + self.sys.cylinder.end_stop_force(x, v), &mut qdd);
+        self.sys.boom.me_derivatives(q, qd, &qdd, dx);
+    }
 
     /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).
     fn initialize(values: &Values) -> Result<Self, String> {

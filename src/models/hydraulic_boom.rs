@@ -14,7 +14,8 @@ use super::parts::{
     SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
 };
 use super::port::Ramp;
-use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use super::states::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
+use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
@@ -46,12 +47,17 @@ const OWN: [Variable; 30] = TableBuilder::new(&[U_REF_INPUT])
     ])
     .build();
 
-const N_VARS: usize = OWN.len() + PARAMS.len() + N_BOOM_ROWS;
+const N_VARS: usize = OWN.len() + PARAMS.len() + N_BOOM_ROWS + PLANT_STATES.len();
 
-/// The table: own variables, the section angles, then every hydraulic, boom and beam parameter
-/// (fixed: set them before initialisation ends).
-const TABLE: [Variable; N_VARS] =
-    TableBuilder::new(&OWN).sections().hydraulics(PARAMS, 0, PARAMS.len()).boom_params().build();
+/// The table: own variables, the section angles and rates, every hydraulic, boom and beam
+/// parameter (fixed: set them before initialisation ends), the states' derivatives.
+const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
+    .sections()
+    .hydraulics(PARAMS, 0, PARAMS.len())
+    .boom_params()
+    .vars(&CIRCUIT_DERIVATIVES)
+    .vars(&BOOM_DERIVATIVES)
+    .build();
 
 const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
 PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48), counterbalance valve with check valve and
@@ -82,19 +88,7 @@ impl OdeSystem for Plant {
     }
 
     fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
-        let b = self.boom.mechanics();
-        let (c, boom) = s.split_at(N_CIRCUIT);
-        let (q, qd) = boom.split_at(b.dof());
-        let c: &circuit::State = c.try_into().expect("circuit slice");
-        let (dc, dboom) = dx.split_at_mut(N_CIRCUIT);
-        let (dq, dqd) = dboom.split_at_mut(b.dof());
-        dq.copy_from_slice(qd);
-        let mut force = |x, v| {
-            let e = self.circuit.evaluate(c, self.u_ref.at(t), x, v);
-            dc.copy_from_slice(&e.dx);
-            e.force
-        };
-        b.accelerations(q, qd, &mut force, dqd);
+        self.rhs_with(self.u_ref.at(t), s, dx);
     }
 
     /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
@@ -105,6 +99,23 @@ impl OdeSystem for Plant {
 }
 
 impl Plant {
+    /// The right-hand side with the operator's reference `u_ref`.
+    fn rhs_with(&self, u_ref: f64, s: &[f64], dx: &mut [f64]) {
+        let b = self.boom.mechanics();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(b.dof());
+        let c: &circuit::State = c.try_into().expect("circuit slice");
+        let (dc, dboom) = dx.split_at_mut(N_CIRCUIT);
+        let (dq, dqd) = dboom.split_at_mut(b.dof());
+        dq.copy_from_slice(qd);
+        let mut force = |x, v| {
+            let e = self.circuit.evaluate(c, u_ref, x, v);
+            dc.copy_from_slice(&e.dx);
+            e.force
+        };
+        b.accelerations(q, qd, &mut force, dqd);
+    }
+
     /// The plant from the FMU's parameter values; refuses inconsistent combinations.
     pub fn from_values(values: &Values) -> Result<Self, String> {
         let circuit = parts::circuit_from_values(values)?;
@@ -166,9 +177,38 @@ impl Model for HydraulicBoom {
         ..parts::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
+    const STATES: &'static [ContinuousState] = &PLANT_STATES;
+
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        parts::boom_configurations()
+    }
 
     fn initialize(values: &Values) -> Result<Self, String> {
         Self::with_state(values, None)
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) {
+        let (c, boom) = self.state.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(self.plant.boom.mechanics().dof());
+        x[..N_CIRCUIT].copy_from_slice(c);
+        self.plant.boom.me_states(q, qd, &mut x[N_CIRCUIT..]);
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let dof = self.plant.boom.mechanics().dof();
+        let (c, boom) = self.state.split_at_mut(N_CIRCUIT);
+        let (q, qd) = boom.split_at_mut(dof);
+        c.copy_from_slice(&x[..N_CIRCUIT]);
+        self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)
+    }
+
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        let mut ds = vec![0.0; self.state.len()];
+        self.plant.rhs_with(values.real(vr::U_REF), &self.state, &mut ds);
+        let dof = self.plant.boom.mechanics().dof();
+        let (q, qd) = self.state[N_CIRCUIT..].split_at(dof);
+        dx[..N_CIRCUIT].copy_from_slice(&ds[..N_CIRCUIT]);
+        self.plant.boom.me_derivatives(q, qd, &ds[N_CIRCUIT + dof..], &mut dx[N_CIRCUIT..]);
     }
 
     fn retune(&mut self, _values: &Values) -> Result<(), String> {

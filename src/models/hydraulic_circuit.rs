@@ -11,7 +11,8 @@ use super::parts::{
     self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, SOLVER_LOCALS, START_STROKE, U_REF_INPUT,
 };
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
-use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use super::states::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
+use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
@@ -85,8 +86,9 @@ const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
     ])
     .build();
 
-const N_VARS: usize = OWN.len() + PARAMS.len();
-const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN).hydraulics(PARAMS, 0, PARAMS.len()).build();
+const N_VARS: usize = OWN.len() + PARAMS.len() + CIRCUIT_DERIVATIVES.len();
+const TABLE: [Variable; N_VARS] =
+    TableBuilder::new(&OWN).hydraulics(PARAMS, 0, PARAMS.len()).vars(&CIRCUIT_DERIVATIVES).build();
 
 const DOCUMENTATION: &str = concat!(
     r#"<p>The circuit of thesis Fig. 2.8 (valves, cylinder, lines; the same parameters, names and value
@@ -235,10 +237,35 @@ impl Model for HydraulicCircuit {
         ..parts::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
+    const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
+
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        port::configurations()
+    }
+
+    fn model_exchange_check(values: &Values) -> Result<(), String> {
+        port::model_exchange_check(values)
+    }
 
     fn initialize(values: &Values) -> Result<Self, String> {
         let f = values.real(vr::START_F);
         Self::with_state(values, None, 0.0, [f, f])
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) {
+        x.copy_from_slice(&self.state[..N_CIRCUIT]);
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        self.state[..N_CIRCUIT].copy_from_slice(x);
+        Ok(())
+    }
+
+    /// The plain port's circuit at the stroke and velocity inputs.
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        let c = self.state[..N_CIRCUIT].try_into().expect("circuit slice");
+        let e = self.sys.circuit.evaluate(c, values.real(vr::U_REF), values.real(vr::X), values.real(vr::V));
+        dx.copy_from_slice(&e.dx);
     }
 
     fn retune(&mut self, _values: &Values) -> Result<(), String> {

@@ -6,6 +6,7 @@ pub mod hydraulic_circuit;
 pub mod parts;
 pub mod port;
 pub mod pressure_feedback_controller;
+pub mod states;
 
 pub use boom_mechanics::BoomMechanics;
 pub use hydraulic_boom::HydraulicBoom;

@@ -2,7 +2,8 @@
 //! tables (the physical parameters with the same names and value references in every model), the
 //! circuit and boom built from parameter values, the boom's outputs and the tolerance scales.
 
-use crate::fmi2::{Log, StepError, Values, Variable};
+use crate::fmi2::log::num;
+use crate::fmi2::{Log, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::Param;
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
@@ -46,6 +47,11 @@ pub mod vr {
     pub const TIP_DEFLECTION: u32 = 40;
     /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
     pub const SECTIONS: u32 = 41;
+    /// Section rates: `SECTION_RATES + i` is `boom.section[i + 1].omega`.
+    pub const SECTION_RATES: u32 = 300;
+    /// Derivatives of the continuous states: `DERIVATIVES + k` is der() of state k of
+    /// HydraulicBoom's layout ([`crate::models::states`]).
+    pub const DERIVATIVES: u32 = 400;
     /// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
     pub const HYDRAULICS: u32 = 100;
     /// Boom parameters: `BOOM + index` in [`crate::mechanics::params::SPECS`].
@@ -277,7 +283,7 @@ impl<const N: usize> TableBuilder<N> {
         self.params(vr::BOOM, BOOM_SPECS).params(vr::BEAM, BEAM_SPECS)
     }
 
-    /// Appends the section-angle outputs.
+    /// Appends the section-angle and section-rate outputs.
     pub(crate) const fn sections(mut self) -> Self {
         let mut k = 0;
         while k < MAX_SECTIONS {
@@ -290,7 +296,7 @@ impl<const N: usize> TableBuilder<N> {
             );
             (self.len, k) = (self.len + 1, k + 1);
         }
-        self
+        self.vars(&super::states::SECTION_RATES)
     }
 
     /// The finished table; fails to compile unless every row is filled.
@@ -300,8 +306,8 @@ impl<const N: usize> TableBuilder<N> {
     }
 }
 
-/// Number of boom parameters, flexible-beam parameters and section outputs (table rows).
-pub(crate) const N_BOOM_ROWS: usize = BOOM_SPECS.len() + BEAM_SPECS.len() + MAX_SECTIONS;
+/// Number of boom parameters, flexible-beam parameters and section angles and rates (table rows).
+pub(crate) const N_BOOM_ROWS: usize = BOOM_SPECS.len() + BEAM_SPECS.len() + 2 * MAX_SECTIONS;
 
 /// The circuit from the parameter values at [`vr::HYDRAULICS`]; refuses inconsistent combinations.
 pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
@@ -317,6 +323,17 @@ pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
         return Err(format!("valve.x_db = {} must be less than valve.x_max = {}", circuit.dcv.x_db, circuit.dcv.x_max));
     }
     Ok(circuit)
+}
+
+/// The parameter settings that change a boom model's equations: rigid, the default flexible
+/// arm (4 + 5 sections), and the most sections (16 + 16, every Model Exchange slot live).
+pub(crate) fn boom_configurations() -> Vec<Vec<(u32, Value)>> {
+    let beam = |name| vr::BEAM + BEAM_SPECS.iter().position(|s| s.name == name).expect("beam parameter") as u32;
+    vec![
+        vec![(vr::FLEXIBLE, Value::Boolean(false))],
+        vec![],
+        vec![(beam("boom.n2"), Value::Integer(16)), (beam("boom.n3"), Value::Integer(16))],
+    ]
 }
 
 /// The boom the cylinder drives.
@@ -366,6 +383,75 @@ impl Boom {
         std::iter::repeat_n(q, dof).chain(std::iter::repeat_n(qd, dof))
     }
 
+    /// The boom's Model Exchange states ([`crate::models::states`]) at coordinates `q`,
+    /// velocities `qd`: the section angles and rates, the slots beyond the last section the last
+    /// one's. Rigid: the boom angle theta2(l_cyl) and its rate theta2' v (eq. 2.7 in closed form,
+    /// [`crate::mechanics::kinematics::Triangle::theta2_derivatives`]) in every slot.
+    pub(crate) fn me_states(&self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let (phi, omega) = out.split_at_mut(MAX_SECTIONS);
+        match self {
+            Boom::Rigid(b) => {
+                let (theta, d1, _) = b.kinematics().triangle().theta2_derivatives(b.l_cyl(q[0]));
+                phi.fill(theta);
+                omega.fill(d1 * qd[0]);
+            }
+            Boom::Flexible(_) => {
+                for k in 0..MAX_SECTIONS {
+                    let i = k.min(q.len() - 1);
+                    (phi[k], omega[k]) = (q[i], qd[i]);
+                }
+            }
+        }
+    }
+
+    /// Coordinates `q` and velocities `qd` from the boom's Model Exchange states `x` (the slots
+    /// of the sections the boom has; the others are the importer's copies of the last one).
+    pub(crate) fn read_me_states(&self, x: &[f64], q: &mut [f64], qd: &mut [f64]) -> Result<(), String> {
+        let (phi, omega) = x.split_at(MAX_SECTIONS);
+        match self {
+            Boom::Rigid(b) => {
+                let t = b.kinematics().triangle();
+                let l = t.l_cyl(phi[0]).ok_or_else(|| {
+                    let (lo, hi) = t.theta2_range();
+                    format!(
+                        "boom.section[1].phi = {} rad is outside ({}, {}) rad, where the cylinder triangle closes (rigid boom)",
+                        num(phi[0]),
+                        num(lo),
+                        num(hi)
+                    )
+                })?;
+                let (_, d1, _) = t.theta2_derivatives(l);
+                (q[0], qd[0]) = (l - b.l_cyl(0.0), omega[0] / d1);
+            }
+            Boom::Flexible(_) => {
+                let n = q.len();
+                q.copy_from_slice(&phi[..n]);
+                qd.copy_from_slice(&omega[..n]);
+            }
+        }
+        Ok(())
+    }
+
+    /// The derivatives of the Model Exchange states from the velocities `qd` and accelerations
+    /// `qdd` at `q`. Rigid: dtheta2/dt = theta2' v, domega/dt = theta2'' v^2 + theta2' a.
+    pub(crate) fn me_derivatives(&self, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let (dphi, domega) = out.split_at_mut(MAX_SECTIONS);
+        match self {
+            Boom::Rigid(b) => {
+                let (_, d1, d2) = b.kinematics().triangle().theta2_derivatives(b.l_cyl(q[0]));
+                let v = qd[0];
+                dphi.fill(d1 * v);
+                domega.fill(d2 * v * v + d1 * qdd[0]);
+            }
+            Boom::Flexible(_) => {
+                for k in 0..MAX_SECTIONS {
+                    let i = k.min(q.len() - 1);
+                    (dphi[k], domega[k]) = (qd[i], qdd[i]);
+                }
+            }
+        }
+    }
+
     /// Writes the boom outputs (angle, angular velocity, payload, tip deflection, section angles)
     /// at coordinates `q`, velocities `qd`; `theta`, `omega` and the payload use the value
     /// references `r = [theta, omega, payload.x, payload.y]` of the model.
@@ -383,9 +469,11 @@ impl Boom {
             values.set_real(r, x);
         }
         values.set_real(vr::TIP_DEFLECTION, tip);
-        for k in 0..MAX_SECTIONS {
-            let phi = if let Boom::Flexible(_) = self { q[k.min(q.len() - 1)] } else { theta };
-            values.set_real(vr::SECTIONS + k as u32, phi);
+        let mut sections = [0.0; 2 * MAX_SECTIONS];
+        self.me_states(q, qd, &mut sections);
+        let refs = (vr::SECTIONS..).take(MAX_SECTIONS).chain((vr::SECTION_RATES..).take(MAX_SECTIONS));
+        for (r, x) in refs.zip(sections) {
+            values.set_real(r, x);
         }
     }
 }

@@ -17,7 +17,7 @@
 //!   series with the oil column and a mass `Z_c h` at the pin; `Z_c = sqrt(k_oil m_eff)` makes
 //!   both relative errors equal to omega h.
 
-use crate::fmi2::{Values, Variable};
+use crate::fmi2::{Value, Values, Variable};
 use crate::params::ParamSpec;
 
 /// Value references of the port (the same in both FMUs; 80-99, after the section angles 41-72).
@@ -42,6 +42,23 @@ pub enum Coupling {
     /// Wave variables of a transmission line with impedance `z_c` [N s/m], each emitted wave
     /// low-pass filtered with `alpha` (0: none).
     Tlm { z_c: f64, alpha: f64 },
+}
+
+/// The port settings that change a split model's equations: plain and TLM.
+pub(crate) fn configurations() -> Vec<Vec<(u32, Value)>> {
+    vec![vec![(vr::COUPLING, Value::Integer(0))], vec![(vr::COUPLING, Value::Integer(1))]]
+}
+
+/// Model Exchange runs the plain port only: the TLM port is a delay line of one communication
+/// step, which Model Exchange does not have; without it the two waves form an algebraic loop
+/// (c_h depends on c_m and c_m on c_h).
+pub(crate) fn model_exchange_check(values: &Values) -> Result<(), String> {
+    match Coupling::from_values(values) {
+        Coupling::Plain => Ok(()),
+        Coupling::Tlm { .. } => Err(
+            "port.coupling = 1 (TLM) is a Co-Simulation coupling (a delay line of one communication step); in Model Exchange use port.coupling = 0 (plain): the importer's integrator solves both sides together".into(),
+        ),
+    }
 }
 
 impl Coupling {

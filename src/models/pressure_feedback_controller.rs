@@ -12,7 +12,7 @@
 use super::port::Ramp;
 use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
 use crate::fmi2::instance::bounded_slope;
-use crate::fmi2::{Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
 
 /// Value references (stable across releases).
 pub mod vr {
@@ -28,6 +28,7 @@ pub mod vr {
     pub const U_MAX: u32 = 9;
     pub const P_LP: u32 = 10;
     pub const EXTRAPOLATION: u32 = 11;
+    pub const DER_P_LP: u32 = 12;
 }
 
 /// Admissible fed-back pressure: absolute zero (gauge) up to 1000 bar, far above the PVG32's
@@ -97,7 +98,17 @@ const VARIABLES: &[Variable] = &[
         "Without an input derivative of p, extrapolate p linearly through its last two received samples (for Jacobi masters: libcosim, ecos, fmpy's SSP simulator); false holds p over a step",
     )
     .fixed(),
+    Variable::real_local(
+        "der(filter.p_lp)",
+        vr::DER_P_LP,
+        "Pa/s",
+        "bar/s",
+        "Time derivative of the continuous state (Model Exchange)",
+    ),
 ];
+
+/// Model Exchange: the filter state, nominal 1 bar.
+const STATES: &[ContinuousState] = &[ContinuousState { state: vr::P_LP, derivative: vr::DER_P_LP, nominal: 1e5 }];
 
 const DOCUMENTATION: &str = r#"<p>High-pass filtered pressure feedback of thesis section 6.1 (Fig. 6.1, 6.2).
 The fed-back pressure <i>p</i> (p4) passes G<sub>f</sub>(s) = K<sub>f</sub> s / (s/&omega;<sub>f</sub> + 1) (eq. 6.2),
@@ -210,6 +221,7 @@ impl Model for PressureFeedbackController {
         documentation: DOCUMENTATION,
     };
     const VARIABLES: &'static [Variable] = VARIABLES;
+    const STATES: &'static [ContinuousState] = STATES;
 
     fn initialize(values: &Values) -> Result<Self, String> {
         Self::from_values(values, values.real(vr::P))
@@ -235,6 +247,20 @@ impl Model for PressureFeedbackController {
         values.set_real(vr::U_COMP, u_comp);
         values.set_real(vr::U, u.clamp(self.u_min, self.u_max));
         values.set_real(vr::P_LP, self.x);
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) {
+        x[0] = self.x;
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        self.x = x[0];
+        Ok(())
+    }
+
+    /// The filter of eq. 6.2 (Model Exchange: p is the input as set; the exact discretisation of [`HighPassFeedback::advance`] is the Co-Simulation step's).
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        dx[0] = self.feedback.state_derivative(values.real(vr::P), self.x);
     }
 
     fn inputs_set(&mut self, vrs: &[u32]) {
