@@ -39,6 +39,8 @@ import tomllib
 
 import numpy as np
 
+from metrics import CBV_OPEN
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 FMU_DIR = ROOT / "target" / "fmu"
 SCENARIO_DIR = ROOT / "scripts" / "scenarios"
@@ -211,6 +213,9 @@ class Result:
     feedback_on_at: float | None  # time the feedback was switched on (feedback_start)
     feedback_start: str = "t0"
     status: str = "ok"
+    #: Work counts: `rhs`, the plant's right-hand-side evaluations (CS: its solver's; ME: CVode's
+    #: fmi2GetDerivatives calls).
+    counts: dict = dataclasses.field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -293,13 +298,14 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
             ctrl.doStep(t, step)
             p4 = p4_next
             u_ref = reference(table, t + step)
-            if enable and not on and y[i_cbv] > 0.0:
+            if enable and not on and y[i_cbv] > CBV_OPEN:
                 # feedback_start = "cbv_open": the feedback starts when the CBV cracks open, from
                 # rest (the controller is re-initialised: filter state = present p4, no kick)
                 on, fb_on_at = True, t + step
                 init_controller(t + step, True, False)
             ctrl.setReal([vc["p"], vc["u_ref"]], [p4, u_ref])
         data = np.array(rows)
+        rhs = plant.getReal([vp["solver.rhs_evals"]])[0]
     finally:
         for s in (plant, ctrl):
             try:
@@ -308,7 +314,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
                 pass
             s.freeInstance()
     return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at,
-                  fb_start)
+                  fb_start, counts={"rhs": int(rhs)})
 
 
 def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
@@ -319,7 +325,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     valve.u_ref = controller.u and controller.p = plant.p4 at every right-hand side, so there is
     no communication step and no delay in the loop. Rows every millisecond; CVode is restarted
     at the reference table's breakpoints and where the feedback switches on (its discontinuities).
-    The returned counts: `rhs` derivative evaluations of the plant (fmi2GetDerivatives)."""
+    `counts["rhs"]`: CVode's right-hand-side evaluations (fmi2GetDerivatives of each FMU)."""
     from ctypes import POINTER, c_double
     from fmpy.sundials import CVodeSolver
 
@@ -414,7 +420,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
             u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])
             rows.append([t, reference(table, t), u_comp, u, *y])
             restart = round(t, 9) in breaks
-            if enable and not on and y[i_cbv] > 0.0:
+            if enable and not on and y[i_cbv] > CBV_OPEN:
                 # feedback_start = "cbv_open": from rest, the filter state at the present p4
                 on, fb_on_at, restart = True, t, True
                 ctrl.enterEventMode()
@@ -433,9 +439,8 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
             except Exception:  # noqa: BLE001 - terminate after an error may be refused
                 pass
             m.freeInstance()
-    res = Result(scenario, boom, 1e-3, False, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at, fb_start)
-    res.counts = counts
-    return res
+    return Result(scenario, boom, 1e-3, False, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at, fb_start,
+                  counts=counts)
 
 
 # --------------------------------------------------------------------------- output

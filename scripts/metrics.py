@@ -25,6 +25,10 @@ MOTION_FRACTION = 0.1
 #: p3 oscillates when its dominant spectral peak is at least this large [bar] (the same limit as
 #: f_dom's comparison in baselines/tolerances.toml).
 OSCILLATING = 0.5
+#: The CBV counts as open above this opening: a millionth of full opening, far below any flow that
+#: matters (Q3 at 1e-6 opening and 100 bar is 1e-5 l/min) and far above the round-off of an
+#: integrator that carries u_cbv = 0 as a state (CVode in Model Exchange leaves ~1e-15).
+CBV_OPEN = 1e-6
 #: Hysteresis of the cycle detection, as a fraction of the swing (ringing near the mean is not a cycle).
 HYSTERESIS = 0.1
 
@@ -119,7 +123,7 @@ def compute(res) -> dict:
     q_exp = abs(v_exp) * A_PISTON
     moving = np.nonzero(-d["Q3"] > MOTION_FRACTION * q_exp)[0]
     m["t_motion"] = float(t[moving[0]]) if len(moving) else None
-    cbv = np.nonzero(d["cbv.u_cbv"] > 0)[0]
+    cbv = np.nonzero(d["cbv.u_cbv"] > CBV_OPEN)[0]
     m["t_cbv_open"] = float(t[cbv[0]]) if len(cbv) else None
     if m["t_motion"] is None:
         ts = None  # a load that never moves has not answered the step

@@ -11,8 +11,8 @@ use boomsim::fmi2::log::Logger;
 use boomsim::fmi2::state::Interface;
 use boomsim::fmi2::variables::BaseType;
 use boomsim::fmi2::xml::initial_dependencies;
-use boomsim::fmi2::{Causality, Initial, Kind, Model, Value};
-use boomsim::models::parts::vr;
+use boomsim::fmi2::{Causality, Initial, Kind, Model, Value, Values};
+use boomsim::models::vr;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -137,4 +137,73 @@ fn hydraulic_circuit_dependencies_are_exact() {
 #[test]
 fn boom_mechanics_dependencies_are_exact() {
     check::<BoomMechanics>(&[&[RIGID, (vr::F, Value::Real(23e3))], &[RIGID, TLM]]);
+}
+
+/// Outputs and derivatives of model `M` after initialisation, by value reference.
+fn me_unknowns<M: Model>(model: &M, values: &Values) -> Vec<(u32, f64)> {
+    let mut v = values.clone();
+    model.outputs(&mut v);
+    let mut dx = vec![0.0; M::STATES.len()];
+    model.derivatives(values, &mut dx);
+    let outputs = M::VARIABLES.iter().filter(|x| x.causality == Causality::Output).map(|x| (x.vr, v.real(x.vr)));
+    outputs.chain(M::STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d))).collect()
+}
+
+/// The states' part of ModelStructure against the model along Co-Simulation runs (states the
+/// generator's probe never sampled): every state or input that moves an output or a derivative
+/// at any of these states is among its declared dependencies (`<Outputs>`, `<Derivatives>`).
+/// Moves of 1e-3 and 1e-6 nominal, both signs, at 10 times per run; a change above 1e-12
+/// relative counts (round-off of a recomputation is below 1e-15).
+fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
+    let declared = boomsim::fmi2::xml::dependencies::<M>(&boomsim::fmi2::structure::probe::<M>());
+    let name = |r: u32| M::VARIABLES.iter().find(|v| v.vr == r).map_or("?", |v| v.name);
+    let mut missing = BTreeSet::new();
+    for setup in configurations {
+        let mut i = instance::<M>(setup);
+        i.exit_initialization_mode().unwrap();
+        for k in 0..steps {
+            i.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+            if (k + 1) % (steps / 10) != 0 {
+                continue;
+            }
+            let values = i.core.values.clone();
+            let mut model = i.core.model.clone().unwrap();
+            let mut x = vec![0.0; M::STATES.len()];
+            model.continuous_states(&mut x);
+            let base = me_unknowns(&model, &values);
+            let moved = |known: u32, unknowns: Vec<(u32, f64)>, missing: &mut BTreeSet<_>| {
+                for ((r, a), (_, b)) in base.iter().zip(unknowns) {
+                    if (a - b).abs() > 1e-12 * a.abs().max(b.abs()).max(1e-300) && !declared[r].contains(&known) {
+                        missing.insert((name(*r), name(known)));
+                    }
+                }
+            };
+            for (j, s) in M::STATES.iter().enumerate() {
+                for d in [1e-3, -1e-3, 1e-6, -1e-6] {
+                    let mut y = x.clone();
+                    y[j] += d * s.nominal;
+                    if model.set_continuous_states(&y).is_ok() {
+                        moved(s.state, me_unknowns(&model, &values), &mut missing);
+                    }
+                }
+            }
+            model.set_continuous_states(&x).unwrap();
+            for input in M::VARIABLES.iter().filter(|v| v.causality == Causality::Input) {
+                let mut v = values.clone();
+                v.set_real(input.vr, perturbed(input.kind, values.real(input.vr)));
+                moved(input.vr, me_unknowns(&model, &v), &mut missing);
+            }
+        }
+    }
+    assert!(missing.is_empty(), "{}: undeclared (unknown, known): {missing:?}", M::INFO.identifier);
+}
+
+#[test]
+fn model_exchange_dependencies_hold_along_runs() {
+    use boomsim::models::pressure_feedback_controller::vr as c;
+    let opening = (vr::U_REF, Value::Real(-0.3));
+    check_states::<HydraulicBoom>(&[&[opening.clone(), RIGID], &[opening.clone()]], 500);
+    check_states::<HydraulicCircuit>(&[&[opening.clone(), (vr::V, Value::Real(-0.01))]], 500);
+    check_states::<BoomMechanics>(&[&[RIGID, (vr::F, Value::Real(23e3))], &[(vr::F, Value::Real(23e3))]], 500);
+    check_states::<PressureFeedbackController>(&[&[(c::P, Value::Real(40e5))]], 100);
 }

@@ -50,3 +50,45 @@ fn controller_runs_in_the_fmi_crate_and_matches_the_analytic_step_response() {
     assert!(s.do_step(0.2, -h, true).is_err(), "negative step refused");
     s.terminate().unwrap();
 }
+
+/// The Model Exchange interface of the same .fmu in the fmi crate: the filter state relaxes to a
+/// pressure step as x(t) = p + (x0 - p) e^(-omega_f t) (eq. 6.2's low pass), integrated here by
+/// classical Runge-Kutta from fmi2GetDerivatives: local error (omega_f h)^5 / 120 = 5e-10 of the
+/// pressure step per step, at most 1e-7 of it over 200 steps.
+#[test]
+fn controller_runs_as_model_exchange_in_the_fmi_crate() {
+    use fmi::fmi2::instance::ModelExchange;
+    use fmi::EventFlags;
+    let import = fmu("PressureFeedbackController");
+    let mut m = import.instantiate_me("pfc-me", false, true).expect("instantiates as ME");
+    m.setup_experiment(Some(1e-6), 0.0, None).unwrap();
+    m.enter_initialization_mode().unwrap();
+    let (p0, p) = (45e5, 43e5);
+    m.set_real(&[vr::P], &[p0]).unwrap();
+    m.exit_initialization_mode().unwrap();
+    m.new_discrete_states(&mut EventFlags::default()).unwrap();
+    m.enter_continuous_time_mode().unwrap();
+    m.set_real(&[vr::P], &[p]).unwrap();
+    let mut x = [0.0];
+    m.get_continuous_states(&mut x).unwrap();
+    assert_eq!(x[0], p0, "the filter starts at rest at the initial pressure");
+    let mut f = |t: f64, x: f64| {
+        m.set_time(t).unwrap();
+        m.set_continuous_states(&[x]).unwrap();
+        let mut dx = [0.0];
+        m.get_derivatives(&mut dx).unwrap();
+        dx[0]
+    };
+    let (h, w) = (1e-3, 35.8);
+    let mut y = p0;
+    for k in 0..200 {
+        let t = k as f64 * h;
+        let k1 = f(t, y);
+        let k2 = f(t + h / 2.0, y + h / 2.0 * k1);
+        let k3 = f(t + h / 2.0, y + h / 2.0 * k2);
+        let k4 = f(t + h, y + h * k3);
+        y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        let exact = p + (p0 - p) * (-w * (t + h)).exp();
+        assert!((y - exact).abs() <= 1e-7 * (p0 - p).abs(), "t = {}: {y} vs {exact}", t + h);
+    }
+}

@@ -11,8 +11,8 @@ use boomsim::fmi2::types::*;
 use boomsim::fmi2::Model;
 use boomsim::mechanics::params::BoomParams;
 use boomsim::mechanics::rigid_boom::RigidBoom;
-use boomsim::models::parts::vr;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
+use boomsim::models::vr;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
 use common::{forge_value, Slave};
 use std::ptr::null_mut;
@@ -239,7 +239,11 @@ fn plants_interpolate_the_spool_reference() {
         for r in [vr::X_V, vr::P2, vr::P3] {
             let (a, b, c) = (one.real(r), ten.real(r), held.real(r));
             let scale = (a - c).abs();
-            assert!((a - b).abs() <= 1e-6 * scale, "{} vr {r}: ramp {a}, sub-stepped {b}, held {c}", M::INFO.identifier);
+            assert!(
+                (a - b).abs() <= 1e-6 * scale,
+                "{} vr {r}: ramp {a}, sub-stepped {b}, held {c}",
+                M::INFO.identifier
+            );
         }
     }
     check::<HydraulicBoom>();

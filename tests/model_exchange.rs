@@ -8,7 +8,7 @@ use boomsim::fmi2::api;
 use boomsim::fmi2::types::*;
 use boomsim::fmi2::Model;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
-use boomsim::models::{parts::vr, BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
+use boomsim::models::{vr, BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
 use common::Slave;
 use std::os::raw::c_int;
 
@@ -115,7 +115,8 @@ fn the_interfaces_are_kept_apart() {
     assert_eq!(unsafe { api::set_time::<Pfc>(cs.c, 0.0) }, ERR);
 }
 
-/// Wrong counts and non-finite states are refused without touching the instance.
+/// Wrong counts, NULL arrays and non-finite states and times are refused with a reason, without
+/// touching the instance.
 #[test]
 fn wrong_state_vectors_are_refused() {
     let s = at(St::ContinuousTimeMode);
@@ -125,6 +126,20 @@ fn wrong_state_vectors_are_refused() {
     assert_eq!(unsafe { api::set_continuous_states::<Pfc>(s.c, &f64::NAN, 1) }, ERR);
     assert!(s.last_error().contains("filter.p_lp = NaN"), "{}", s.last_error());
     assert_eq!(unsafe { api::get_event_indicators::<Pfc>(s.c, &mut 0.0, 1) }, ERR, "no event indicators");
+    let null = std::ptr::null_mut();
+    unsafe {
+        assert_eq!(api::get_derivatives::<Pfc>(s.c, null, 1), ERR);
+        assert!(s.last_error().contains("derivatives is NULL"), "{}", s.last_error());
+        assert_eq!(api::get_continuous_states::<Pfc>(s.c, null, 1), ERR);
+        assert_eq!(api::set_continuous_states::<Pfc>(s.c, null, 1), ERR);
+        assert_eq!(api::get_nominals_of_continuous_states::<Pfc>(s.c, null, 1), ERR);
+        assert_eq!(api::completed_integrator_step::<Pfc>(s.c, 1, std::ptr::null_mut(), std::ptr::null_mut()), ERR);
+        assert_eq!(api::set_time::<Pfc>(s.c, f64::NAN), ERR);
+        assert!(s.last_error().contains("time = NaN must be finite"), "{}", s.last_error());
+        assert_eq!(api::enter_event_mode::<Pfc>(s.c), OK);
+        assert_eq!(api::new_discrete_states::<Pfc>(s.c, std::ptr::null_mut()), ERR);
+        assert_eq!(api::enter_continuous_time_mode::<Pfc>(s.c), OK, "still usable");
+    }
     assert_eq!(s.real(pfc::P_LP), 0.0, "the filter state is the start value's rest state");
 }
 

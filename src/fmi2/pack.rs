@@ -101,8 +101,13 @@ fn facts<M: Model>(platforms: &[Platform]) -> String {
     let interpolated: Vec<&str> = i.interpolated_inputs.iter().map(name).collect();
     let categories: Vec<&str> = GENERIC_CATEGORIES.iter().chain(i.log_categories).map(|c| c.0).collect();
     let platforms: Vec<&str> = platforms.iter().map(|p| p.name).collect();
+    let states: Vec<&str> = M::STATES.iter().map(|s| name(&s.state)).collect();
     let rows = [
-        ("Interface", "FMI 2.0 Co-Simulation".to_owned()),
+        ("Interfaces", "FMI 2.0 Model Exchange and Co-Simulation".to_owned()),
+        (
+            "Continuous states (Model Exchange, in fmi2GetContinuousStates order)",
+            format!("{}: {}", states.len(), states.join(", ")),
+        ),
         ("Model identifier", i.identifier.to_owned()),
         ("Version", i.version.to_owned()),
         ("GUID", guid::<M>()),

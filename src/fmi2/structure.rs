@@ -2,10 +2,11 @@
 //! model itself: which outputs and derivatives change when a state or an input moves.
 //!
 //! The model is probed in each of its [`Model::configurations`] at a few states around its start
-//! state (deterministic pseudo-random offsets of 0.5 to 1000 nominal values: pressures up to 1000 bar, where the valves open) with random inputs
-//! inside their ranges. A known is a dependency where moving it by a small step changes the
-//! unknown at any sample (by more than round-off, see [`record`]). A dependency that shows only outside the
-//! sampled states would be missed; `tests/dependencies.rs` probes other states, later in a run.
+//! state (deterministic pseudo-random offsets of 0.5 to 1000 nominal values: pressures up to
+//! 1000 bar, where the valves open) with random inputs around their start values inside their
+//! ranges. A known is a dependency where moving it by a small step changes the unknown at any
+//! sample (by more than round-off, see [`record`]). A dependency that shows only outside the
+//! sampled states would be missed; `tests/dependencies.rs` probes other states, along runs.
 
 use super::model::Model;
 use super::variables::{Causality, Kind, Values};
@@ -120,9 +121,12 @@ pub fn probe<M: Model>() -> Structure {
         for spread in SPREAD.into_iter().flat_map(|s| std::iter::repeat_n(s, if s == 0.0 { 1 } else { SAMPLES })) {
             let x: Vec<f64> = x0.iter().zip(M::STATES).map(|(x, s)| x + spread * s.nominal * noise.next()).collect();
             let mut v = values.clone();
+            // Inputs around their start values, as far as the states move (a third of the range
+            // at 100 nominal values and beyond), inside their ranges.
             for &(r, min, max) in &ins {
-                if spread > 0.0 && (max - min).is_finite() {
-                    v.set_real(r, min + (max - min) * 0.5 * (noise.next() + 1.0));
+                if (max - min).is_finite() {
+                    let x = v.real(r) + (max - min) * (spread / 300.0).min(1.0) * noise.next();
+                    v.set_real(r, x.clamp(min, max));
                 }
             }
             if model.set_continuous_states(&x).is_err() {

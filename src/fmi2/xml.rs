@@ -7,6 +7,7 @@ use super::structure::{probe, Structure};
 use super::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
 use crate::units::{self, BASE_NAMES};
 use quick_xml::Writer;
+use std::collections::BTreeMap;
 use std::io;
 
 type Attrs = Vec<(&'static str, String)>;
@@ -92,16 +93,17 @@ pub fn initial_dependencies<M: Model>(v: &Variable) -> Vec<u32> {
     v.initial_depends_on.unwrap_or(v.depends_on).iter().copied().chain(parameters).collect()
 }
 
-/// The knowns of the unknown `vr` after initialisation: for an output its declared inputs and
-/// the states it depends on; for a `der()` variable the states and inputs.
-fn dependencies<M: Model>(structure: &Structure, vr: u32, declared: &[u32]) -> Vec<u32> {
+/// The knowns of every unknown after initialisation, by value reference: for an output its
+/// declared inputs and the states it depends on; for a `der()` variable the states and inputs
+/// (both from [`probe`]).
+pub fn dependencies<M: Model>(structure: &Structure) -> BTreeMap<u32, Vec<u32>> {
     let is_state = |r: &u32| M::STATES.iter().any(|s| s.state == *r);
-    let probed = structure.after.get(&vr).into_iter().flatten();
-    if M::STATES.iter().any(|s| s.derivative == vr) {
-        probed.copied().collect()
-    } else {
-        declared.iter().copied().chain(probed.copied().filter(is_state)).collect()
-    }
+    let probed = |vr: u32| structure.after.get(&vr).into_iter().flatten().copied();
+    let outputs = M::VARIABLES
+        .iter()
+        .filter(|v| v.causality == Causality::Output)
+        .map(|v| (v.vr, v.depends_on.iter().copied().chain(probed(v.vr).filter(is_state)).collect()));
+    outputs.chain(M::STATES.iter().map(|s| (s.derivative, probed(s.derivative).collect()))).collect()
 }
 
 /// FMI 2.0 section 2.2.8: the initial unknowns in index order with their dependencies on the
@@ -233,6 +235,7 @@ fn write<M: Model>() -> io::Result<String> {
                 Ok(())
             })?;
             let structure = probe::<M>();
+            let deps = dependencies::<M>(&structure);
             w.create_element("ModelStructure").write_inner_content(|w| {
                 let unknown = |w: &mut Writer<Vec<u8>>, vr: u32, deps: &[u32]| {
                     element(w, "Unknown", &vec![("index", indices::<M>(&[vr])), ("dependencies", indices::<M>(deps))])
@@ -242,7 +245,7 @@ fn write<M: Model>() -> io::Result<String> {
                 if !outputs.is_empty() {
                     w.create_element("Outputs").write_inner_content(|w| {
                         for v in &outputs {
-                            unknown(w, v.vr, &dependencies::<M>(&structure, v.vr, v.depends_on))?;
+                            unknown(w, v.vr, &deps[&v.vr])?;
                         }
                         Ok(())
                     })?;
@@ -251,7 +254,7 @@ fn write<M: Model>() -> io::Result<String> {
                     // The order of the state vector (fmi2GetContinuousStates).
                     w.create_element("Derivatives").write_inner_content(|w| {
                         for s in M::STATES {
-                            unknown(w, s.derivative, &dependencies::<M>(&structure, s.derivative, &[]))?;
+                            unknown(w, s.derivative, &deps[&s.derivative])?;
                         }
                         Ok(())
                     })?;

@@ -9,29 +9,28 @@
 //! (`cylinder.k_stop`, `cylinder.c_stop`). HydraulicCircuit's port force has none, so the pair
 //! coupled equals HydraulicBoom, and the boom alone with no force comes to rest on the bottom stop.
 
-use super::parts::{
-    self, out, Boom, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION,
-};
+use super::boom::Boom;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::states::{BOOM_DERIVATIVES, BOOM_STATES};
+use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION};
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
-/// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
+/// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
 /// ([`port::vr`]; its `F` is `port.F`).
 pub mod vr {
-    pub use crate::models::parts::vr::*;
     pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, START_F, Z_C};
+    pub use crate::models::vr::*;
 }
 
 /// The circuit parameters the boom uses (indices in [`PARAMS`]): the cylinder's stroke, its range
 /// of motion, and its end stops.
-const STROKE: usize = parts::param_index("cylinder.stroke");
-const K_STOP: usize = parts::param_index("cylinder.k_stop");
-const C_STOP: usize = parts::param_index("cylinder.c_stop");
+const STROKE: usize = super::table::param_index("cylinder.stroke");
+const K_STOP: usize = super::table::param_index("cylinder.k_stop");
+const C_STOP: usize = super::table::param_index("cylinder.c_stop");
 
 #[rustfmt::skip]
 const OWN: [Variable; 17] = [
@@ -81,6 +80,8 @@ Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). The cylin
 (<code>cylinder.k_stop</code>, <code>cylinder.c_stop</code>; HydraulicCircuit's port force has none): with no force
 the boom comes to rest on the bottom stop. Outputs: stroke, velocity, boom angle, payload position, tip deflection
 and section angles.</p>"#,
+    "<p>Model Exchange runs the plain port (<code>port.coupling</code> = 0): the TLM port is a delay line of one \
+communication step, which Model Exchange does not have.</p>",
     port::coupling_recipe!()
 );
 
@@ -161,7 +162,8 @@ impl BoomMechanics {
             boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
         let input = Ramp { t0: t, y0: input, slope: 0.0 };
         let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input, cylinder };
-        let state = parts::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
+        let state =
+            super::stepping::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
         let solver = Radau5::new(sys.dim());
         Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
     }
@@ -182,7 +184,7 @@ impl Model for BoomMechanics {
             "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
         interpolated_inputs: &[vr::F, vr::C_H],
         documentation: DOCUMENTATION,
-        ..parts::PLANT_INFO
+        ..super::stepping::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &BOOM_STATES;
@@ -190,7 +192,10 @@ impl Model for BoomMechanics {
     /// Rigid and flexible boom, each with the plain and the TLM port.
     fn configurations() -> Vec<Vec<(u32, Value)>> {
         let ports = port::configurations();
-        parts::boom_configurations().iter().flat_map(|b| ports.iter().map(move |p| [&b[..], p].concat())).collect()
+        super::boom::boom_configurations()
+            .iter()
+            .flat_map(|b| ports.iter().map(move |p| [&b[..], p].concat()))
+            .collect()
     }
 
     fn model_exchange_check(values: &Values) -> Result<(), String> {
@@ -243,7 +248,7 @@ impl Model for BoomMechanics {
         for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
             values.set_real(r, y);
         }
-        parts::solver_outputs(self.solver.stats(), values);
+        super::stepping::solver_outputs(self.solver.stats(), values);
         sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
 
@@ -258,7 +263,16 @@ impl Model for BoomMechanics {
     ) -> Result<(), StepError> {
         self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
         let sys = &self.sys;
-        parts::advance(&mut self.solver, sys, &mut self.state, t, h, tolerance, || sys.boom.scale().collect(), log)?;
+        super::stepping::advance(
+            &mut self.solver,
+            sys,
+            &mut self.state,
+            t,
+            h,
+            tolerance,
+            || sys.boom.scale().collect(),
+            log,
+        )?;
         self.t = t + h;
         let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
         let v = self.sys.boom.mechanics().stroke_rate(q, qd);
@@ -267,11 +281,11 @@ impl Model for BoomMechanics {
     }
 
     fn save(&self) -> Vec<f64> {
-        parts::save(&[self.t, self.sys.input.at(self.t), self.c_m], &self.state, &self.solver)
+        super::stepping::save(&[self.t, self.sys.input.at(self.t), self.c_m], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let (head, state, solver) = parts::split_saved(saved, 3)?;
+        let (head, state, solver) = super::stepping::split_saved(saved, 3)?;
         let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
         m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)

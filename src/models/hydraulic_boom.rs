@@ -8,13 +8,14 @@
 //! angle of each section). The operator's reference `valve.u_ref` is linear over a step with the
 //! slope the master passes with fmi2SetRealInputDerivatives (held without one).
 
-pub use super::parts::Boom;
-use super::parts::{
-    self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, FLEXIBLE_SWITCH, N_BOOM_ROWS,
-    SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
-};
+pub use super::boom::Boom;
+use super::circuit::CIRCUIT_SCALE;
 use super::port::Ramp;
 use super::states::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
+use super::table::{
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE,
+    TIP_DEFLECTION, U_REF_INPUT,
+};
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
@@ -22,7 +23,7 @@ use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
-    pub use crate::models::parts::vr::*;
+    pub use crate::models::vr::*;
 }
 
 #[rustfmt::skip]
@@ -71,7 +72,13 @@ inside fmi2DoStep with the tolerance of fmi2SetupExperiment; the flexible arm co
 boom's time (see the README's speed table).</p>
 <p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
-spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>"#;
+spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>
+<p>Model Exchange: the importer's integrator gets the same states in every configuration (FMI 2.0 fixes their number;
+the table above lists them): the circuit's six, then the section angles <code>boom.section[k].phi</code> and their rates
+<code>boom.section[k].omega</code>. Slots beyond the last section repeat it, with its derivative; the rigid boom is
+its angle theta2 in every slot (Co-Simulation integrates it in the stroke). The models are smooth where the
+importer integrates (regularised orifices and friction, end stops as stiff springs), so there are no event
+indicators.</p>"#;
 
 /// Circuit + boom as one ODE, with the operator's reference held.
 #[derive(Debug, Clone)]
@@ -118,7 +125,7 @@ impl Plant {
 
     /// The plant from the FMU's parameter values; refuses inconsistent combinations.
     pub fn from_values(values: &Values) -> Result<Self, String> {
-        let circuit = parts::circuit_from_values(values)?;
+        let circuit = super::circuit::circuit_from_values(values)?;
         let boom = Boom::from_values(values, circuit.cylinder.stroke)?;
         Ok(Plant { circuit, boom, u_ref: Ramp { t0: 0.0, y0: values.real(vr::U_REF), slope: 0.0 } })
     }
@@ -161,7 +168,7 @@ impl HydraulicBoom {
     /// The model with the plant of `values` and the given state (the equilibrium if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
         let plant = Plant::from_values(values)?;
-        let state = parts::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0)))?;
+        let state = super::stepping::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0)))?;
         let solver = Radau5::new(plant.dim());
         Ok(HydraulicBoom { plant, state, solver })
     }
@@ -174,13 +181,13 @@ impl Model for HydraulicBoom {
             "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
         interpolated_inputs: &[vr::U_REF],
         documentation: DOCUMENTATION,
-        ..parts::PLANT_INFO
+        ..super::stepping::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &PLANT_STATES;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {
-        parts::boom_configurations()
+        super::boom::boom_configurations()
     }
 
     fn initialize(values: &Values) -> Result<Self, String> {
@@ -222,8 +229,8 @@ impl Model for HydraulicBoom {
         let (q, qd) = boom.split_at(b.dof());
         let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
         let e = self.plant.circuit.evaluate(c.try_into().expect("circuit slice"), values.real(vr::U_REF), x, v);
-        parts::circuit_outputs(c.try_into().expect("circuit slice"), &e, values);
-        parts::solver_outputs(self.solver.stats(), values);
+        super::circuit::circuit_outputs(c.try_into().expect("circuit slice"), &e, values);
+        super::stepping::solver_outputs(self.solver.stats(), values);
         for (r, y) in [(vr::X, x), (vr::V, v)] {
             values.set_real(r, y);
         }
@@ -241,15 +248,15 @@ impl Model for HydraulicBoom {
     ) -> Result<(), StepError> {
         self.plant.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
         let plant = &self.plant;
-        parts::advance(&mut self.solver, plant, &mut self.state, t, h, tolerance, || plant.state_scale(), log)
+        super::stepping::advance(&mut self.solver, plant, &mut self.state, t, h, tolerance, || plant.state_scale(), log)
     }
 
     fn save(&self) -> Vec<f64> {
-        parts::save(&[], &self.state, &self.solver)
+        super::stepping::save(&[], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let (_, state, solver) = parts::split_saved(saved, 0)?;
+        let (_, state, solver) = super::stepping::split_saved(saved, 0)?;
         let mut m = Self::with_state(values, Some(state))?;
         m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)

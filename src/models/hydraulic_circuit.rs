@@ -7,22 +7,21 @@
 //! step, x(t) = x_k + integral of v, v(t) = v_k + v' (t - t_k) (v' from
 //! fmi2SetRealInputDerivatives, 0 holds v), so chamber volumes and piston flows agree.
 
-use super::parts::{
-    self, out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, CIRCUIT_SCALE, SOLVER_LOCALS, START_STROKE, U_REF_INPUT,
-};
+use super::circuit::CIRCUIT_SCALE;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::states::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
+use super::table::{out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_STROKE, U_REF_INPUT};
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
-/// Value references: HydraulicBoom's for the same names ([`super::parts::vr`]), the port's
+/// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
 /// ([`port::vr`]; its `F` is `port.F`).
 pub mod vr {
-    pub use crate::models::parts::vr::*;
     pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, M, START_F, Z_C};
+    pub use crate::models::vr::*;
     /// Stroke and velocity the circuit uses (the plain inputs, or the TLM rod's states).
     pub const PORT_X: u32 = 87;
     pub const PORT_V: u32 = 88;
@@ -108,6 +107,8 @@ Z<sub>c</sub>/h and a mass Z<sub>c</sub>h at the pin.</li></ul>
 the mechanics (BoomMechanics has them; mechanics of your own keeps the stroke within [0, <code>cylinder.stroke</code>]).
 The circuit starts in the static equilibrium that holds <code>start.F</code> with the CBV closed (set it to the
 mechanics' static cylinder force at the start).</p>"#,
+    "<p>Model Exchange runs the plain port (<code>port.coupling</code> = 0): the TLM port is a delay line of one \
+communication step, which Model Exchange does not have.</p>",
     port::coupling_recipe!()
 );
 
@@ -190,7 +191,7 @@ impl HydraulicCircuit {
     /// The model at time `t` with the received wave `c_m`, the emitted `c_h` and the given state
     /// (the equilibrium holding start.F if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [c_m, c_h]: [f64; 2]) -> Result<Self, String> {
-        let mut circuit = parts::circuit_from_values(values)?;
+        let mut circuit = super::circuit::circuit_from_values(values)?;
         // The end stops are the piston's contact with the barrel: mechanics, on the other side of
         // the cut (BoomMechanics applies them), so the port force is pressure forces - friction.
         (circuit.cylinder.k_stop, circuit.cylinder.c_stop) = (0.0, 0.0);
@@ -205,7 +206,7 @@ impl HydraulicCircuit {
             v: Ramp { t0: t, y0: values.real(vr::V), slope: 0.0 },
             c_m: Ramp { t0: t, y0: c_m, slope: 0.0 },
         };
-        let state = parts::checked_state(sys.dim(), state, || {
+        let state = super::stepping::checked_state(sys.dim(), state, || {
             if !(0.0..=stroke).contains(&x0) {
                 return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
             }
@@ -234,7 +235,7 @@ impl Model for HydraulicCircuit {
         // cylinder.x follows the integral of cylinder.v within a step: it has no slope of its own.
         interpolated_inputs: &[vr::U_REF, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
-        ..parts::PLANT_INFO
+        ..super::stepping::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
@@ -282,8 +283,8 @@ impl Model for HydraulicCircuit {
         let (x, v) = sys.motion(self.t, s);
         let (e, f_line) = sys.evaluate(self.t, s);
         let c_h = if sys.coupling == Coupling::Plain { f_line } else { self.c_h };
-        parts::circuit_outputs(s[..N_CIRCUIT].try_into().expect("circuit slice"), &e, values);
-        parts::solver_outputs(self.solver.stats(), values);
+        super::circuit::circuit_outputs(s[..N_CIRCUIT].try_into().expect("circuit slice"), &e, values);
+        super::stepping::solver_outputs(self.solver.stats(), values);
         for (r, y) in [(vr::C_H, c_h), (port::vr::F, f_line), (vr::PORT_X, x), (vr::PORT_V, v)] {
             values.set_real(r, y);
         }
@@ -304,7 +305,16 @@ impl Model for HydraulicCircuit {
         sys.v = Ramp::read(values, input_derivatives, vr::V, t);
         sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);
         let n = self.sys.dim();
-        parts::advance(&mut self.solver, &self.sys, &mut self.state, t, h, tolerance, || Self::state_scale(n), log)?;
+        super::stepping::advance(
+            &mut self.solver,
+            &self.sys,
+            &mut self.state,
+            t,
+            h,
+            tolerance,
+            || Self::state_scale(n),
+            log,
+        )?;
         self.t = t + h;
         let (_, v) = self.sys.motion(self.t, &self.state);
         self.c_h = self.sys.coupling.emit(self.c_h, self.sys.evaluate(self.t, &self.state).1, v);
@@ -312,11 +322,11 @@ impl Model for HydraulicCircuit {
     }
 
     fn save(&self) -> Vec<f64> {
-        parts::save(&[self.t, self.sys.c_m.at(self.t), self.c_h], &self.state, &self.solver)
+        super::stepping::save(&[self.t, self.sys.c_m.at(self.t), self.c_h], &self.state, &self.solver)
     }
 
     fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let (head, state, solver) = parts::split_saved(saved, 3)?;
+        let (head, state, solver) = super::stepping::split_saved(saved, 3)?;
         let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
         m.solver.load_state(solver).map_err(|e| e.to_string())?;
         Ok(m)

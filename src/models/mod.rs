@@ -1,12 +1,16 @@
 //! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].
 
+pub mod boom;
 pub mod boom_mechanics;
+pub mod circuit;
 pub mod hydraulic_boom;
 pub mod hydraulic_circuit;
-pub mod parts;
 pub mod port;
 pub mod pressure_feedback_controller;
 pub mod states;
+pub mod stepping;
+pub mod table;
+pub mod vr;
 
 pub use boom_mechanics::BoomMechanics;
 pub use hydraulic_boom::HydraulicBoom;

@@ -5,13 +5,14 @@
 //! boom's states are therefore the 32 section angles `boom.section[k].phi` and their rates
 //! `boom.section[k].omega`, in both configurations: the slots beyond the last section repeat the
 //! last one (as the outputs always did) with its derivative, and the rigid boom is its angle
-//! theta2 in every slot (its Co-Simulation solver keeps the stroke, see [`super::parts::Boom`]).
+//! theta2 in every slot (its Co-Simulation solver keeps the stroke, see [`super::boom::Boom`]).
 
-use super::parts::{out, vr};
+use super::table::out;
+use super::vr;
 use crate::fmi2::{ContinuousState, Variable};
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 
-/// Typical magnitudes of the boom states (see [`super::parts::Boom::scale`]): 2 mrad, 0.1 rad/s.
+/// Typical magnitudes of the boom states (see [`super::boom::Boom::scale`]): 2 mrad, 0.1 rad/s.
 const PHI_NOMINAL: f64 = 2e-3;
 const OMEGA_NOMINAL: f64 = 0.1;
 
@@ -22,13 +23,13 @@ const fn der_vr(k: usize) -> u32 {
 }
 
 /// The circuit's states p1..p4, spool position, load-holding opening, with their nominals
-/// ([`super::parts::CIRCUIT_SCALE`]).
+/// ([`super::circuit::CIRCUIT_SCALE`]).
 pub(crate) const CIRCUIT_STATES: [ContinuousState; 6] = {
     let r = [vr::P1, vr::P2, vr::P3, vr::P4, vr::X_V, vr::U_CBV];
     let mut s = [ContinuousState { state: 0, derivative: 0, nominal: 0.0 }; 6];
     let mut k = 0;
     while k < 6 {
-        s[k] = ContinuousState { state: r[k], derivative: der_vr(k), nominal: super::parts::CIRCUIT_SCALE[k] };
+        s[k] = ContinuousState { state: r[k], derivative: der_vr(k), nominal: super::circuit::CIRCUIT_SCALE[k] };
         k += 1;
     }
     s

@@ -28,6 +28,13 @@ SerializeFMUstate DeSerializeFMUstate GetDirectionalDerivative SetRealInputDeriv
 GetRealOutputDerivatives DoStep CancelStep GetStatus GetRealStatus GetIntegerStatus GetBooleanStatus
 GetStringStatus""".split()
 
+#: The 10 Model Exchange functions (FMI 2.0, 3.2.2) beside the 25 common and 9 CS ones.
+FMI2_ME_FUNCTIONS = """EnterEventMode NewDiscreteStates EnterContinuousTimeMode CompletedIntegratorStep SetTime
+SetContinuousStates GetDerivatives GetEventIndicators GetContinuousStates GetNominalsOfContinuousStates""".split()
+
+#: Every function a boomsim FMU exports: both interfaces.
+FMI2_FUNCTIONS = FMI2_CS_FUNCTIONS + FMI2_ME_FUNCTIONS
+
 
 def fmu_path(identifier):
     path = FMU_DIR / f"{identifier}.fmu"

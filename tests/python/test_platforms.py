@@ -26,7 +26,7 @@ import fmpy
 from fmpy.validation import validate_fmu
 import pytest
 
-from conftest import FMI2_CS_FUNCTIONS, fmu_path
+from conftest import FMI2_FUNCTIONS, fmu_path
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HOST_SOURCE = ROOT / "tests" / "host" / "fmu_host.c"
@@ -134,7 +134,7 @@ def test_exports_and_dependencies(unpacked, ident, platform):
     Windows 10 or glibc Linux lacks (no libgcc_s_seh, libwinpthread, libstdc++)."""
     lib = unpacked[ident][0] / "binaries" / platform / (ident + SUFFIX[platform])
     exports, imports = exports_and_imports(platform, lib)
-    assert exports == {"fmi2" + f for f in FMI2_CS_FUNCTIONS}
+    assert exports == {"fmi2" + f for f in FMI2_FUNCTIONS}
     allowed = ALLOWED_DLLS if platform == "win64" else ALLOWED_SO
     extra = {i for i in imports if i not in allowed and not i.startswith("api-ms-win-core-")}
     assert not extra, f"{ident} on {platform} imports {sorted(extra)}"

@@ -1,0 +1,61 @@
+"""Model Exchange against Co-Simulation, the comparison a user makes before choosing an interface:
+cases U and B (10 s, as `boomsim bench`), rigid and flexible boom, plant and controller
+
+    CS: fmpy drives both FMUs' fmi2DoStep at 1 ms (scripts/cosim.py `run`, the internal Radau IIA
+        solver at rtol 1e-6, the controller fed p4 with its slope over each step);
+    ME: fmpy's CVode (BDF, rtol 1e-6, atol = rtol x nominals) integrates both FMUs as one ODE
+        (scripts/cosim.py `run_me`: no communication step, no delay in the loop);
+
+with wall time, real-time factor, the plant's right-hand-side evaluations, and the error against a
+reference: ME at rtol 1e-9, the continuous loop without a communication step. A benchmark: it
+prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
+references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
+"""
+
+import argparse
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).parent))
+import cosim  # noqa: E402
+
+STOP = 10.0
+CASES = [("U", "rigid"), ("B", "rigid"), ("U", "flexible"), ("B", "flexible")]
+
+
+def timed(f, *args, **kw):
+    t0 = time.perf_counter()
+    r = f(*args, **kw)
+    return r, time.perf_counter() - t0
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
+    args = ap.parse_args(argv)
+    cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
+    rows = []
+    start = time.perf_counter()
+    for k, (sid, boom) in enumerate(cases, 1):
+        sc = cosim.load_scenario(sid)
+        print(f"[{k}/{len(cases)} {time.perf_counter() - start:.0f} s] {sid} {boom}: reference (ME, rtol 1e-9) ...",
+              flush=True)
+        ref = cosim.run_me(sc, boom, stop_time=STOP, tolerance=1e-9)
+        for interface, run in (("CS 1 ms", lambda: cosim.run(sc, boom, stop_time=STOP)),
+                               ("ME CVode", lambda: cosim.run_me(sc, boom, stop_time=STOP))):
+            res, wall = timed(run)
+            d, r = res.data, ref.data
+            rows.append((sid, boom, interface, wall, STOP / wall, res.counts["rhs"],
+                         np.abs(d["p3"] - r["p3"]).max() / 1e5, np.abs(d["cylinder.x"] - r["cylinder.x"]).max() * 1e3))
+            print(f"    {interface}: {wall:.2f} s", flush=True)
+    print("\n| case | boom | interface | wall [s] | real-time factor | RHS | max abs p3 error [bar] | max abs stroke error [mm] |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for sid, boom, interface, wall, rtf, rhs, ep3, ex in rows:
+        print(f"| {sid} | {boom} | {interface} | {wall:.2f} | {rtf:.1f}x | {rhs} | {ep3:.3g} | {ex:.3g} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,165 @@
+//! The boom a model drives, from its parameter values: rigid or lumped flexible, its outputs, its
+//! tolerance scales and its Model Exchange states ([`super::states`]).
+
+use super::table::param_value;
+use super::vr;
+use crate::fmi2::log::num;
+use crate::fmi2::{Value, Values};
+use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
+use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
+use crate::mechanics::rigid_boom::RigidBoom;
+use crate::mechanics::BoomMechanics;
+use crate::params::ParamSpec;
+
+/// The parameter settings that change a boom model's equations: rigid, the default flexible
+/// arm (4 + 5 sections), and the most sections (16 + 16, every Model Exchange slot live).
+pub(crate) fn boom_configurations() -> Vec<Vec<(u32, Value)>> {
+    let beam = |name| vr::BEAM + BEAM_SPECS.iter().position(|s| s.name == name).expect("beam parameter") as u32;
+    vec![
+        vec![(vr::FLEXIBLE, Value::Boolean(false))],
+        vec![],
+        vec![(beam("boom.n2"), Value::Integer(16)), (beam("boom.n3"), Value::Integer(16))],
+    ]
+}
+
+/// The boom the cylinder drives.
+#[derive(Debug, Clone)]
+pub enum Boom {
+    Rigid(RigidBoom),
+    Flexible(FlexibleBoom),
+}
+
+impl Boom {
+    /// The boom of the parameter values (boom, beam, `boom.flexible`) for a cylinder `stroke`.
+    pub(crate) fn from_values(values: &Values, stroke: f64) -> Result<Self, String> {
+        let lookup = |specs: &[ParamSpec], base: u32, name: &str| {
+            let k = specs.iter().position(|s| s.name == name).expect("parameter name");
+            param_value(values, base + k as u32, &specs[k])
+        };
+        let params = BoomParams::from_lookup(|n| lookup(BOOM_SPECS, vr::BOOM, n));
+        let boom = if values.boolean(vr::FLEXIBLE) {
+            let beam = BeamParams::from_lookup(|n| lookup(BEAM_SPECS, vr::BEAM, n));
+            FlexibleBoom::new(&params, &beam, stroke).map(Boom::Flexible)
+        } else {
+            RigidBoom::new(&params, stroke).map(Boom::Rigid)
+        };
+        boom.map_err(|e| format!("boom geometry (boom.*, cylinder.l_retracted, cylinder.stroke): {e}"))
+    }
+
+    /// The boom's mechanics.
+    pub fn mechanics(&self) -> &dyn BoomMechanics {
+        match self {
+            Boom::Rigid(b) => b,
+            Boom::Flexible(b) => b,
+        }
+    }
+
+    /// Typical magnitudes of q and q_dot (atol = rtol x scale). Rigid: 1 mm and 1 mm/s of
+    /// stroke. Flexible: 2 mrad for the section angles (1 mm of stroke through the cylinder's
+    /// lever about B, dx/dtheta2 = 0.55 m at 465 mm; away from the horizontal rtol |q| binds
+    /// anyway) and 0.1 rad/s for their rates, the boom's angular rate while lowering (U peaks at
+    /// 0.24 rad/s). Convergence study (scenario U, 15 s, against rtol 1e-9): every output stays as
+    /// close to the reference as with 2 mrad/s (pressures within 28 Pa, stroke 2e-8 m, tip
+    /// deflection 1e-7 m, section angles 5e-8 rad, regression metrics to 5 digits, both at a Newton
+    /// tolerance of 1e-3), while the tighter scale made the integrator resolve the beam's chatter
+    /// during cylinder stiction (v < v_s) to 1e-9 rad/s at a third more steps.
+    pub(crate) fn scale(&self) -> impl Iterator<Item = f64> {
+        let dof = self.mechanics().dof();
+        let (q, qd) = if let Boom::Rigid(_) = self { (1e-3, 1e-3) } else { (2e-3, 0.1) };
+        std::iter::repeat_n(q, dof).chain(std::iter::repeat_n(qd, dof))
+    }
+
+    /// The boom's Model Exchange states ([`crate::models::states`]) at coordinates `q`,
+    /// velocities `qd`: the section angles and rates, the slots beyond the last section the last
+    /// one's. Rigid: the boom angle theta2(l_cyl) and its rate theta2' v (eq. 2.7 in closed form,
+    /// [`crate::mechanics::kinematics::Triangle::theta2_derivatives`]) in every slot.
+    pub(crate) fn me_states(&self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let (phi, omega) = out.split_at_mut(MAX_SECTIONS);
+        match self {
+            Boom::Rigid(b) => {
+                let (theta, d1, _) = b.kinematics().triangle().theta2_derivatives(b.l_cyl(q[0]));
+                phi.fill(theta);
+                omega.fill(d1 * qd[0]);
+            }
+            Boom::Flexible(_) => {
+                for k in 0..MAX_SECTIONS {
+                    let i = k.min(q.len() - 1);
+                    (phi[k], omega[k]) = (q[i], qd[i]);
+                }
+            }
+        }
+    }
+
+    /// Coordinates `q` and velocities `qd` from the boom's Model Exchange states `x` (the slots
+    /// of the sections the boom has; the others are the importer's copies of the last one).
+    pub(crate) fn read_me_states(&self, x: &[f64], q: &mut [f64], qd: &mut [f64]) -> Result<(), String> {
+        let (phi, omega) = x.split_at(MAX_SECTIONS);
+        match self {
+            Boom::Rigid(b) => {
+                let t = b.kinematics().triangle();
+                let l = t.l_cyl(phi[0]).ok_or_else(|| {
+                    let (lo, hi) = t.theta2_range();
+                    format!(
+                        "boom.section[1].phi = {} rad is outside ({}, {}) rad, where the cylinder triangle closes (rigid boom)",
+                        num(phi[0]),
+                        num(lo),
+                        num(hi)
+                    )
+                })?;
+                let (_, d1, _) = t.theta2_derivatives(l);
+                (q[0], qd[0]) = (l - b.l_cyl(0.0), omega[0] / d1);
+            }
+            Boom::Flexible(_) => {
+                let n = q.len();
+                q.copy_from_slice(&phi[..n]);
+                qd.copy_from_slice(&omega[..n]);
+            }
+        }
+        Ok(())
+    }
+
+    /// The derivatives of the Model Exchange states from the velocities `qd` and accelerations
+    /// `qdd` at `q`. Rigid: dtheta2/dt = theta2' v, domega/dt = theta2'' v^2 + theta2' a.
+    pub(crate) fn me_derivatives(&self, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let (dphi, domega) = out.split_at_mut(MAX_SECTIONS);
+        match self {
+            Boom::Rigid(b) => {
+                let (_, d1, d2) = b.kinematics().triangle().theta2_derivatives(b.l_cyl(q[0]));
+                let v = qd[0];
+                dphi.fill(d1 * v);
+                domega.fill(d2 * v * v + d1 * qdd[0]);
+            }
+            Boom::Flexible(_) => {
+                for k in 0..MAX_SECTIONS {
+                    let i = k.min(q.len() - 1);
+                    (dphi[k], domega[k]) = (qd[i], qdd[i]);
+                }
+            }
+        }
+    }
+
+    /// Writes the boom outputs (angle, angular velocity, payload, tip deflection, section angles)
+    /// at coordinates `q`, velocities `qd`; `theta`, `omega` and the payload use the value
+    /// references `r = [theta, omega, payload.x, payload.y]` of the model.
+    pub(crate) fn outputs(&self, q: &[f64], qd: &[f64], r: [u32; 4], values: &mut Values) {
+        let b = self.mechanics();
+        let (theta, omega, tip) = match self {
+            Boom::Rigid(rb) => {
+                let st = rb.state(b.stroke(q), b.stroke_rate(q, qd));
+                (st.theta2, st.theta2_dot, 0.0)
+            }
+            Boom::Flexible(f) => (q[0], qd[0], f.tip_deflection(q)),
+        };
+        let payload = b.payload(q);
+        for (r, x) in r.into_iter().zip([theta, omega, payload.x, payload.y]) {
+            values.set_real(r, x);
+        }
+        values.set_real(vr::TIP_DEFLECTION, tip);
+        let mut sections = [0.0; 2 * MAX_SECTIONS];
+        self.me_states(q, qd, &mut sections);
+        let refs = (vr::SECTIONS..).take(MAX_SECTIONS).chain((vr::SECTION_RATES..).take(MAX_SECTIONS));
+        for (r, x) in refs.zip(sections) {
+            values.set_real(r, x);
+        }
+    }
+}

@@ -1,0 +1,53 @@
+//! The circuit of an FMU model ([`crate::hydraulics::circuit`]) from its parameter values, its
+//! outputs and the tolerance scales of its states.
+
+use super::table::param_value;
+use super::vr;
+use crate::fmi2::Values;
+use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
+
+/// The circuit from the parameter values at [`vr::HYDRAULICS`]; refuses inconsistent combinations.
+pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
+    let mut circuit = Circuit::default();
+    for (k, p) in crate::hydraulics::params::PARAMS.iter().enumerate() {
+        (p.set)(&mut circuit, param_value(values, vr::HYDRAULICS + k as u32, &p.spec));
+    }
+    let cyl = &circuit.cylinder;
+    if cyl.d_rod >= cyl.d_piston {
+        return Err(format!("cylinder.d_rod = {} must be less than cylinder.d_piston = {}", cyl.d_rod, cyl.d_piston));
+    }
+    if circuit.dcv.x_db >= circuit.dcv.x_max {
+        return Err(format!("valve.x_db = {} must be less than valve.x_max = {}", circuit.dcv.x_db, circuit.dcv.x_max));
+    }
+    Ok(circuit)
+}
+
+/// Scales of the circuit states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar,
+/// 1 mm of spool travel, full valve opening.
+pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
+
+/// Writes the circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
+/// load-sensing pressure) for state `c` and its evaluation `e`.
+pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values) {
+    let outputs = [
+        (vr::P1, c[circuit::P1]),
+        (vr::P2, c[circuit::P2]),
+        (vr::P3, c[circuit::P3]),
+        (vr::P4, c[circuit::P4]),
+        (vr::U, e.u),
+        (vr::U_CV, e.u_cv),
+        (vr::U_CBV, c[circuit::U_CBV]),
+        (vr::Q1, e.q[0]),
+        (vr::Q2, e.q[1]),
+        (vr::Q3, e.q[2]),
+        (vr::Q4, e.q[3]),
+        (vr::F, e.force),
+        (vr::F_FR, e.f_friction),
+        (vr::X_V, c[circuit::X_V]),
+        (vr::U_PCV, e.u_pcv),
+        (vr::P_X, e.p_x),
+    ];
+    for (r, x) in outputs {
+        values.set_real(r, x);
+    }
+}

@@ -1,0 +1,259 @@
+//! The rows the FMU models' variable tables share and the const builders that assemble a table:
+//! the circuit's outputs, the physical parameters with the same names and value references in
+//! every model, the boom's section outputs.
+
+use super::vr;
+use crate::fmi2::{Values, Variable};
+use crate::hydraulics::params::Param;
+use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::mechanics::params::{BEAM_SPECS, SPECS as BOOM_SPECS};
+use crate::params::ParamSpec;
+
+/// A continuous Real output.
+pub(crate) const fn out(
+    name: &'static str,
+    r: u32,
+    unit: &'static str,
+    display: &'static str,
+    d: &'static str,
+) -> Variable {
+    Variable::real_output(name, r, unit, display, d)
+}
+
+/// `valve.u_ref`, the operator's spool reference.
+pub(crate) const U_REF_INPUT: Variable = Variable::real_input(
+    "valve.u_ref",
+    vr::U_REF,
+    0.0,
+    "1",
+    "%",
+    (-1.0, 1.0),
+    "Operator's spool reference; > 0 lifts (P->A), < 0 lowers through the CBV",
+);
+
+/// The circuit's outputs p1..Q4 (value references 1-11).
+#[rustfmt::skip]
+pub(crate) const CIRCUIT_OUTPUTS: [Variable; 11] = [
+    out("p1", vr::P1, "Pa", "bar", "Compensated pressure after the PCV (line 1), gauge"),
+    out("p2", vr::P2, "Pa", "bar", "Line 2 pressure, DCV port A to CBV, gauge"),
+    out("p3", vr::P3, "Pa", "bar", "Piston-side chamber pressure (line 3), gauge"),
+    out("p4", vr::P4, "Pa", "bar", "Rod-side chamber pressure (line 4, CBV pilot), gauge"),
+    out("valve.u", vr::U, "1", "%", "Main spool opening u (eq. 2.44)"),
+    out("cbv.u_cv", vr::U_CV, "1", "%", "Check valve opening (eq. 2.55)"),
+    out("cbv.u_cbv", vr::U_CBV, "1", "%", "Load-holding valve opening (eq. 2.56, 2.57)"),
+    out("Q1", vr::Q1, "m3/s", "l/min", "PCV flow, supply to line 1 (eq. 2.50)"),
+    out("Q2", vr::Q2, "m3/s", "l/min", "DCV flow into line 2, P->A / A->T (eq. 2.40, 2.42)"),
+    out("Q3", vr::Q3, "m3/s", "l/min", "CBV flow, line 2 to line 3 (eq. 2.58, 2.59)"),
+    out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
+];
+
+/// The circuit's locals: spool position, compensator opening, load-sensing pressure.
+#[rustfmt::skip]
+pub(crate) const CIRCUIT_LOCALS: [Variable; 3] = [
+    Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
+    Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
+    Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x, gauge"),
+];
+
+/// The integrator's counters.
+#[rustfmt::skip]
+pub(crate) const SOLVER_LOCALS: [Variable; 4] = [
+    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
+    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
+    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
+    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
+];
+
+pub(crate) const START_STROKE: ParamSpec = ParamSpec {
+    name: "start.x",
+    default: 0.480,
+    unit: "m",
+    display_unit: "mm",
+    min: 0.0,
+    max: 10.0,
+    description: "Initial stroke; the load starts at rest, held by the closed CBV, pressures in equilibrium",
+    source: "Start stroke of the experiments, 480 mm (sections 6.2, chapter 7)",
+};
+
+pub(crate) const FLEXIBLE_SWITCH: Variable = Variable::bool_param(
+    "boom.flexible",
+    vr::FLEXIBLE,
+    true,
+    "Lumped flexible arm (boom.n2 + boom.n3 sections, eq. 2.34-2.39); false: rigid boom",
+)
+.fixed();
+
+pub(crate) const TIP_DEFLECTION: Variable = out(
+    "boom.tip_deflection",
+    vr::TIP_DEFLECTION,
+    "m",
+    "mm",
+    "Deflection of the arm's end normal to the rigid boom line at the same cylinder length, > 0 up (0 when rigid)",
+);
+
+/// Names of the section-angle outputs (structured names, 1-based as in the thesis).
+const SECTION_NAMES: [&str; MAX_SECTIONS] = [
+    "boom.section[1].phi",
+    "boom.section[2].phi",
+    "boom.section[3].phi",
+    "boom.section[4].phi",
+    "boom.section[5].phi",
+    "boom.section[6].phi",
+    "boom.section[7].phi",
+    "boom.section[8].phi",
+    "boom.section[9].phi",
+    "boom.section[10].phi",
+    "boom.section[11].phi",
+    "boom.section[12].phi",
+    "boom.section[13].phi",
+    "boom.section[14].phi",
+    "boom.section[15].phi",
+    "boom.section[16].phi",
+    "boom.section[17].phi",
+    "boom.section[18].phi",
+    "boom.section[19].phi",
+    "boom.section[20].phi",
+    "boom.section[21].phi",
+    "boom.section[22].phi",
+    "boom.section[23].phi",
+    "boom.section[24].phi",
+    "boom.section[25].phi",
+    "boom.section[26].phi",
+    "boom.section[27].phi",
+    "boom.section[28].phi",
+    "boom.section[29].phi",
+    "boom.section[30].phi",
+    "boom.section[31].phi",
+    "boom.section[32].phi",
+];
+
+/// Parameters that count or select (a model index, section counts): exposed as Integers.
+const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
+
+const fn str_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// Index of the circuit parameter `name` in [`crate::hydraulics::params::PARAMS`] (compile-time
+/// error if there is none).
+pub(crate) const fn param_index(name: &str) -> usize {
+    let params = crate::hydraulics::params::PARAMS;
+    let mut k = 0;
+    while !str_eq(params[k].spec.name, name) {
+        k += 1;
+    }
+    k
+}
+
+const fn is_selector(name: &str) -> bool {
+    let mut i = 0;
+    while i < SELECTORS.len() {
+        if str_eq(name, SELECTORS[i]) {
+            return true;
+        }
+        i += 1;
+    }
+    false
+}
+
+/// The FMU variable of a physical parameter: fixed, an Integer where it counts or selects.
+const fn param(r: u32, p: ParamSpec) -> Variable {
+    if is_selector(p.name) {
+        Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
+    } else {
+        Variable::param(r, p).fixed()
+    }
+}
+
+/// The value of parameter `p` with value reference `r`, as a number.
+pub(crate) fn param_value(values: &Values, r: u32, p: &ParamSpec) -> f64 {
+    if is_selector(p.name) {
+        values.integer(r) as f64
+    } else {
+        values.real(r)
+    }
+}
+
+/// A table under construction: `N` rows, the first `len` filled.
+pub(crate) struct TableBuilder<const N: usize> {
+    rows: [Variable; N],
+    len: usize,
+}
+
+impl<const N: usize> TableBuilder<N> {
+    /// A table starting with `vars`.
+    pub(crate) const fn new(vars: &[Variable]) -> Self {
+        Self { rows: [vars[0]; N], len: 0 }.vars(vars)
+    }
+
+    /// Appends `vars`.
+    pub(crate) const fn vars(mut self, vars: &[Variable]) -> Self {
+        let mut k = 0;
+        while k < vars.len() {
+            self.rows[self.len] = vars[k];
+            (self.len, k) = (self.len + 1, k + 1);
+        }
+        self
+    }
+
+    /// Appends the parameters `specs`, value references `base + index`.
+    pub(crate) const fn params(mut self, base: u32, specs: &[ParamSpec]) -> Self {
+        let mut k = 0;
+        while k < specs.len() {
+            self.rows[self.len] = param(base + k as u32, specs[k]);
+            (self.len, k) = (self.len + 1, k + 1);
+        }
+        self
+    }
+
+    /// Appends the circuit parameters `params[from..to]` at their [`vr::HYDRAULICS`] references.
+    pub(crate) const fn hydraulics(mut self, params: &[Param], from: usize, to: usize) -> Self {
+        let mut k = from;
+        while k < to {
+            self.rows[self.len] = param(vr::HYDRAULICS + k as u32, params[k].spec);
+            (self.len, k) = (self.len + 1, k + 1);
+        }
+        self
+    }
+
+    /// Appends the boom and flexible-beam parameters.
+    pub(crate) const fn boom_params(self) -> Self {
+        self.params(vr::BOOM, BOOM_SPECS).params(vr::BEAM, BEAM_SPECS)
+    }
+
+    /// Appends the section-angle and section-rate outputs.
+    pub(crate) const fn sections(mut self) -> Self {
+        let mut k = 0;
+        while k < MAX_SECTIONS {
+            self.rows[self.len] = out(
+                SECTION_NAMES[k],
+                vr::SECTIONS + k as u32,
+                "rad",
+                "deg",
+                "Absolute angle of the arm section (from the joint outwards); beyond the last section, the last one's",
+            );
+            (self.len, k) = (self.len + 1, k + 1);
+        }
+        self.vars(&super::states::SECTION_RATES)
+    }
+
+    /// The finished table; fails to compile unless every row is filled.
+    pub(crate) const fn build(self) -> [Variable; N] {
+        assert!(self.len == N, "variable table: row count differs from its length");
+        self.rows
+    }
+}
+
+/// Number of boom parameters, flexible-beam parameters and section angles and rates (table rows).
+pub(crate) const N_BOOM_ROWS: usize = BOOM_SPECS.len() + BEAM_SPECS.len() + 2 * MAX_SECTIONS;

@@ -1,0 +1,45 @@
+//! Value references shared by every model that has the variable (stable: append, never renumber).
+
+pub const U_REF: u32 = 0;
+pub const P1: u32 = 1;
+pub const P2: u32 = 2;
+pub const P3: u32 = 3;
+pub const P4: u32 = 4;
+pub const U: u32 = 5;
+pub const U_CV: u32 = 6;
+pub const U_CBV: u32 = 7;
+pub const Q1: u32 = 8;
+pub const Q2: u32 = 9;
+pub const Q3: u32 = 10;
+pub const Q4: u32 = 11;
+pub const X: u32 = 12;
+pub const V: u32 = 13;
+pub const F: u32 = 14;
+pub const F_FR: u32 = 15;
+pub const THETA: u32 = 16;
+pub const OMEGA: u32 = 17;
+pub const PAYLOAD_X: u32 = 18;
+pub const PAYLOAD_Y: u32 = 19;
+pub const X_V: u32 = 20;
+pub const U_PCV: u32 = 21;
+pub const P_X: u32 = 22;
+pub const SOLVER_STEPS: u32 = 23;
+pub const SOLVER_REJECTED: u32 = 24;
+pub const SOLVER_RHS: u32 = 25;
+pub const SOLVER_JACOBIANS: u32 = 26;
+pub const X0: u32 = 30;
+pub const FLEXIBLE: u32 = 31;
+pub const TIP_DEFLECTION: u32 = 40;
+/// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
+pub const SECTIONS: u32 = 41;
+/// Section rates: `SECTION_RATES + i` is `boom.section[i + 1].omega`.
+pub const SECTION_RATES: u32 = 300;
+/// Derivatives of the continuous states: `DERIVATIVES + k` is der() of state k of
+/// HydraulicBoom's layout ([`crate::models::states`]).
+pub const DERIVATIVES: u32 = 400;
+/// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
+pub const HYDRAULICS: u32 = 100;
+/// Boom parameters: `BOOM + index` in [`crate::mechanics::params::SPECS`].
+pub const BOOM: u32 = 200;
+/// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_SPECS`].
+pub const BEAM: u32 = 250;
