@@ -7,7 +7,9 @@ cases U and B (10 s, as `boomsim bench`), rigid and flexible boom, plant and con
         (scripts/cosim.py `run_me`: no communication step, no delay in the loop);
 
 with wall time, real-time factor, the plant's right-hand-side evaluations, and the error against a
-reference: ME at rtol 1e-9, the continuous loop without a communication step. A benchmark: it
+reference: ME at rtol 1e-9, the continuous loop without a communication step. A second table
+measures the event indicators (rigid boom, B and C1.3, where the compensated spool command
+crosses the dead band): ME with and without CVode's root finding on them. A benchmark: it
 prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
 references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
 """
@@ -51,10 +53,23 @@ def main(argv=None):
             rows.append((sid, boom, interface, wall, STOP / wall, res.counts["rhs"],
                          np.abs(d["p3"] - r["p3"]).max() / 1e5, np.abs(d["cylinder.x"] - r["cylinder.x"]).max() * 1e3))
             print(f"    {interface}: {wall:.2f} s", flush=True)
+    print("\nEvent indicators (rigid boom, 15 s, against ME at rtol 1e-9 with events):", flush=True)
+    ev_rows = []
+    for sid in ("B", "C1.3"):
+        sc = cosim.load_scenario(sid)
+        ref = cosim.run_me(sc, "rigid", tolerance=1e-9)
+        for events in (True, False):
+            res, wall = timed(cosim.run_me, sc, "rigid", events=events)
+            ev_rows.append((sid, "on" if events else "off", res.counts["events"], res.counts["rhs"], wall,
+                            np.abs(res.data["p3"] - ref.data["p3"]).max() / 1e5))
     print("\n| case | boom | interface | wall [s] | real-time factor | RHS | max abs p3 error [bar] | max abs stroke error [mm] |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     for sid, boom, interface, wall, rtf, rhs, ep3, ex in rows:
         print(f"| {sid} | {boom} | {interface} | {wall:.2f} | {rtf:.1f}x | {rhs} | {ep3:.3g} | {ex:.3g} |")
+    print("\n| case | event indicators | state events | RHS | wall [s] | max abs p3 error [bar] |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for sid, on, n_events, rhs, wall, ep3 in ev_rows:
+        print(f"| {sid} | {on} | {n_events} | {rhs} | {wall:.2f} | {ep3:.3g} |")
 
 
 if __name__ == "__main__":

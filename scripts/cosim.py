@@ -222,6 +222,27 @@ class Result:
         return variant_name(self.scenario, self.boom, self.feedback_start)
 
 
+def initialize_plant(plant_f: FmuFile, plant, ctrl, scenario: dict, switch, tolerance, t_end: float):
+    """Sets both instances up and into Initialization Mode, and initialises the plant with the
+    scenario's start stroke, boom and parameters (either interface)."""
+    for m in (plant, ctrl):
+        m.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
+        m.enterInitializationMode()
+    plant_f.set(plant, "start.x", scenario["start_stroke"])
+    if switch:
+        plant_f.set(plant, *switch)
+    for name, value in scenario["plant"].items():
+        plant_f.set(plant, name, value)
+    plant.exitInitializationMode()
+
+
+def set_filter(ctrl_f: FmuFile, ctrl, cfg: dict):
+    """The scenario's filter and limits, where it gives them."""
+    for name in ("K_f", "omega_f", "u_min", "u_max"):
+        if name in cfg:
+            ctrl_f.set(ctrl, name, cfg[name])
+
+
 def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
         interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
         tolerance: float | None = None) -> Result:
@@ -247,15 +268,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
     ctrl = ctrl_f.slave(f"{scenario['id']}.controller")
     vp, vc = plant_f.vr, ctrl_f.vr
     try:
-        for s in (plant, ctrl):
-            s.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
-            s.enterInitializationMode()
-        plant_f.set(plant, "start.x", scenario["start_stroke"])
-        if switch:
-            plant_f.set(plant, *switch)
-        for name, value in scenario["plant"].items():
-            plant_f.set(plant, name, value)
-        plant.exitInitializationMode()
+        initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
         p4 = plant.getReal([vp["p4"]])[0]
 
         def init_controller(t0: float, feedback: bool, first: bool):
@@ -264,9 +277,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
                 ctrl.reset()
                 ctrl.setupExperiment(tolerance=tolerance, startTime=t0, stopTime=t_end)
                 ctrl.enterInitializationMode()
-            for name in ("K_f", "omega_f", "u_min", "u_max"):
-                if name in ctrl_cfg:
-                    ctrl_f.set(ctrl, name, ctrl_cfg[name])
+            set_filter(ctrl_f, ctrl, ctrl_cfg)
             ctrl_f.set(ctrl, "enable", feedback)
             ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, t0)])
             ctrl.exitInitializationMode()
@@ -318,14 +329,17 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
 
 
 def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
-           feedback_start: str | None = None) -> Result:
+           feedback_start: str | None = None, events: bool = True) -> Result:
     """The scenario variant with both FMUs as Model Exchange, integrated together by fmpy's CVode
     (BDF, dense Newton with difference-quotient Jacobian, rtol `tolerance`, atol = rtol x the
     FMUs' nominal values): one ODE of the plant's and the controller's states, with
     valve.u_ref = controller.u and controller.p = plant.p4 at every right-hand side, so there is
     no communication step and no delay in the loop. Rows every millisecond; CVode is restarted
-    at the reference table's breakpoints and where the feedback switches on (its discontinuities).
-    `counts["rhs"]`: CVode's right-hand-side evaluations (fmi2GetDerivatives of each FMU)."""
+    at the reference table's breakpoints and where the feedback switches on (its discontinuities),
+    and, with `events`, where one of the plant's event indicators changes sign (CVode's root
+    finding: the dead-band jump of the spool demand, the load-sensing switch).
+    `counts`: CVode's right-hand-side evaluations (`rhs`, fmi2GetDerivatives of each FMU) and the
+    state events (`events`)."""
     from ctypes import POINTER, c_double
     from fmpy.sundials import CVodeSolver
 
@@ -340,20 +354,11 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     ctrl = ctrl_f.model(f"{scenario['id']}.controller")
     vp, vc = plant_f.vr, ctrl_f.vr
     np_, nc = len(plant_f.md.derivatives), len(ctrl_f.md.derivatives)
-    counts = {"rhs": 0}
+    nz = plant_f.md.numberOfEventIndicators if events else 0
+    counts = {"rhs": 0, "events": 0}
     try:
-        for m in (plant, ctrl):
-            m.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
-            m.enterInitializationMode()
-        plant_f.set(plant, "start.x", scenario["start_stroke"])
-        if switch:
-            plant_f.set(plant, *switch)
-        for name, value in scenario["plant"].items():
-            plant_f.set(plant, name, value)
-        plant.exitInitializationMode()
-        for name in ("K_f", "omega_f", "u_min", "u_max"):
-            if name in ctrl_cfg:
-                ctrl_f.set(ctrl, name, ctrl_cfg[name])
+        initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
+        set_filter(ctrl_f, ctrl, ctrl_cfg)
         on = enable and fb_start == "t0"
         ctrl_f.set(ctrl, "enable", on)
         ctrl.setReal([vc["p"], vc["u_ref"]], [plant.getReal([vp["p4"]])[0], reference(table, 0.0)])
@@ -386,6 +391,10 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
             for m, p, n in parts(ptr):
                 m.getDerivatives(p, n)
 
+        def get_z(ptr, n):
+            couple(now[0])
+            plant.getEventIndicators(ptr, n)
+
         def get_nominals(ptr, _n):
             for m, p, n in parts(ptr):
                 m.getNominalsOfContinuousStates(p, n)
@@ -401,8 +410,8 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
             def apply(self, t):
                 pass
 
-        solver = CVodeSolver(nx=np_ + nc, nz=0, get_x=get_x, set_x=set_x, get_dx=get_dx,
-                             get_z=lambda *a: None, get_nominals=get_nominals, set_time=set_time,
+        solver = CVodeSolver(nx=np_ + nc, nz=nz, get_x=get_x, set_x=set_x, get_dx=get_dx,
+                             get_z=get_z, get_nominals=get_nominals, set_time=set_time,
                              input=NoInput(), startTime=0.0, relativeTolerance=tolerance, maxNumSteps=100000)
         breaks = set(np.round(table[:, 0], 9))
         out_p = [vp[k] for k in PLANT_OUT]
@@ -412,9 +421,18 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
         n = int(round(t_end / 1e-3))
         for k in range(n + 1):
             t = k * 1e-3
-            if k > 0:
-                _, _, t_reached = solver.step(now[0], t)
+            while k > 0:
+                event, _, t_reached = solver.step(now[0], t)
                 set_time(t_reached)
+                if not event:
+                    break
+                # A state event: nothing is reinitialised (no discrete states), CVode restarts.
+                counts["events"] += 1
+                for m in (plant, ctrl):
+                    m.enterEventMode()
+                    m.newDiscreteStates()
+                    m.enterContinuousTimeMode()
+                solver.reset(t_reached)
             couple(t)
             y = plant.getReal(out_p)
             u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])

@@ -11,7 +11,7 @@ use boomsim::fmi2::log::Logger;
 use boomsim::fmi2::state::Interface;
 use boomsim::fmi2::variables::BaseType;
 use boomsim::fmi2::xml::initial_dependencies;
-use boomsim::fmi2::{Causality, Initial, Kind, Model, Value, Values};
+use boomsim::fmi2::{Causality, Initial, Kind, Model, Value};
 use boomsim::models::vr;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController};
 use std::collections::{BTreeMap, BTreeSet};
@@ -139,16 +139,6 @@ fn boom_mechanics_dependencies_are_exact() {
     check::<BoomMechanics>(&[&[RIGID, (vr::F, Value::Real(23e3))], &[RIGID, TLM]]);
 }
 
-/// Outputs and derivatives of model `M` after initialisation, by value reference.
-fn me_unknowns<M: Model>(model: &M, values: &Values) -> Vec<(u32, f64)> {
-    let mut v = values.clone();
-    model.outputs(&mut v);
-    let mut dx = vec![0.0; M::STATES.len()];
-    model.derivatives(values, &mut dx);
-    let outputs = M::VARIABLES.iter().filter(|x| x.causality == Causality::Output).map(|x| (x.vr, v.real(x.vr)));
-    outputs.chain(M::STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d))).collect()
-}
-
 /// The states' part of ModelStructure against the model along Co-Simulation runs (states the
 /// generator's probe never sampled): every state or input that moves an output or a derivative
 /// at any of these states is among its declared dependencies (`<Outputs>`, `<Derivatives>`).
@@ -170,7 +160,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
             let mut model = i.core.model.clone().unwrap();
             let mut x = vec![0.0; M::STATES.len()];
             model.continuous_states(&mut x);
-            let base = me_unknowns(&model, &values);
+            let base = boomsim::fmi2::structure::unknowns(&model, &values);
             let moved = |known: u32, unknowns: Vec<(u32, f64)>, missing: &mut BTreeSet<_>| {
                 for ((r, a), (_, b)) in base.iter().zip(unknowns) {
                     if (a - b).abs() > 1e-12 * a.abs().max(b.abs()).max(1e-300) && !declared[r].contains(&known) {
@@ -183,7 +173,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
                     let mut y = x.clone();
                     y[j] += d * s.nominal;
                     if model.set_continuous_states(&y).is_ok() {
-                        moved(s.state, me_unknowns(&model, &values), &mut missing);
+                        moved(s.state, boomsim::fmi2::structure::unknowns(&model, &values), &mut missing);
                     }
                 }
             }
@@ -191,7 +181,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
             for input in M::VARIABLES.iter().filter(|v| v.causality == Causality::Input) {
                 let mut v = values.clone();
                 v.set_real(input.vr, perturbed(input.kind, values.real(input.vr)));
-                moved(input.vr, me_unknowns(&model, &v), &mut missing);
+                moved(input.vr, boomsim::fmi2::structure::unknowns(&model, &v), &mut missing);
             }
         }
     }

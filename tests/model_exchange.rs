@@ -126,6 +126,7 @@ fn wrong_state_vectors_are_refused() {
     assert_eq!(unsafe { api::set_continuous_states::<Pfc>(s.c, &f64::NAN, 1) }, ERR);
     assert!(s.last_error().contains("filter.p_lp = NaN"), "{}", s.last_error());
     assert_eq!(unsafe { api::get_event_indicators::<Pfc>(s.c, &mut 0.0, 1) }, ERR, "no event indicators");
+    assert!(s.last_error().contains("ni = 1, but PressureFeedbackController has 0 event indicators"));
     let null = std::ptr::null_mut();
     unsafe {
         assert_eq!(api::get_derivatives::<Pfc>(s.c, null, 1), ERR);
@@ -281,4 +282,37 @@ fn tlm_port_is_refused_in_model_exchange() {
     }
     check::<HydraulicCircuit>();
     check::<BoomMechanics>();
+}
+
+/// HydraulicBoom's event indicators change sign where its right-hand side jumps: u_ref through
+/// 0 (the spool demand jumps across the dead band) and x_v through -x_db and +x_db (the
+/// load-sensing switch), with x_db the FMU's own `valve.x_db`.
+#[test]
+fn event_indicators_mark_the_dead_band() {
+    let s = model::<HydraulicBoom>("events");
+    let x_db_vr = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "valve.x_db").unwrap().vr;
+    unsafe {
+        assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), OK);
+        assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(s.c), OK);
+        let x_db = s.real(x_db_vr);
+        assert_eq!(s.set_real(vr::U_REF, -0.2), OK);
+        assert_eq!(api::enter_continuous_time_mode::<HydraulicBoom>(s.c), OK);
+        let n = HydraulicBoom::STATES.len();
+        let mut x = vec![0.0; n];
+        assert_eq!(api::get_continuous_states::<HydraulicBoom>(s.c, x.as_mut_ptr(), n), OK);
+        let mut z = [0.0; 3];
+        for (x_v, signs) in
+            [(0.0, [-1.0, -1.0, 1.0]), (2.0 * x_db, [-1.0, 1.0, 1.0]), (-2.0 * x_db, [-1.0, -1.0, -1.0])]
+        {
+            x[4] = x_v;
+            assert_eq!(api::set_continuous_states::<HydraulicBoom>(s.c, x.as_ptr(), n), OK);
+            assert_eq!(api::get_event_indicators::<HydraulicBoom>(s.c, z.as_mut_ptr(), 3), OK);
+            let got: Vec<f64> = z.iter().map(|z| z.signum()).collect();
+            assert_eq!(got, signs, "x_v = {x_v}: {z:?}");
+        }
+        assert_eq!(z, [-0.2, -3.0 * x_db, -x_db]);
+        assert_eq!(api::get_event_indicators::<HydraulicBoom>(s.c, z.as_mut_ptr(), 2), ERR);
+        assert!(s.last_error().contains("ni = 2, but HydraulicBoom has 3 event indicators"), "{}", s.last_error());
+    }
 }

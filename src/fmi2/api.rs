@@ -552,8 +552,10 @@ pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> fmi2Status {
     })
 }
 
-/// fmi2NewDiscreteStates. The models have no discrete states, time events or state events:
-/// nothing changes at an event, so the event iteration ends at once.
+/// fmi2NewDiscreteStates. The models have no discrete states and no time events; at a state
+/// event (an event indicator changed sign) nothing is reinitialised either: the right-hand side
+/// changes branch by itself, and the event only lets the integrator restart there. So the event
+/// iteration ends at once.
 pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status {
     call::<M>(c, "fmi2NewDiscreteStates", allowed::NEW_DISCRETE_STATES, |_| {
         *info.as_mut().ok_or("fmi2EventInfo is NULL")? = fmi2EventInfo::default();
@@ -619,12 +621,9 @@ pub unsafe fn get_derivatives<M: Model>(c: fmi2Component, dx: *mut f64, nx: usiz
     })
 }
 
-/// fmi2GetEventIndicators: the models declare none (`numberOfEventIndicators="0"`).
-pub unsafe fn get_event_indicators<M: Model>(c: fmi2Component, _z: *mut f64, ni: usize) -> fmi2Status {
-    call::<M>(c, "fmi2GetEventIndicators", allowed::GET_EVENT_INDICATORS, |_| {
-        if ni != 0 {
-            return Err(format!("ni = {ni}, but {} has 0 event indicators (modelDescription.xml)", M::INFO.identifier));
-        }
+pub unsafe fn get_event_indicators<M: Model>(c: fmi2Component, z: *mut f64, ni: usize) -> fmi2Status {
+    call::<M>(c, "fmi2GetEventIndicators", allowed::GET_EVENT_INDICATORS, |inst| {
+        inst.event_indicators(slice_mut(z, ni, "eventIndicators")?)?;
         Ok(fmi2Status::OK)
     })
 }

@@ -215,7 +215,8 @@ impl<M: Model> Instance<M> {
         if n == expected {
             return Ok(());
         }
-        Err(format!("{what} = {n}, but {} has {expected} (modelDescription.xml)", M::INFO.identifier))
+        let of = if what == "ni" { "event indicators" } else { "continuous states" };
+        Err(format!("{what} = {n}, but {} has {expected} {of} (modelDescription.xml)", M::INFO.identifier))
     }
 
     /// fmi2SetContinuousStates: all or nothing.
@@ -240,6 +241,16 @@ impl<M: Model> Instance<M> {
         match &self.core.model {
             Some(model) if self.core.state != State::InitializationMode => model.continuous_states(x),
             _ => M::initialize(&self.core.values)?.continuous_states(x),
+        }
+        Ok(())
+    }
+
+    /// fmi2GetEventIndicators (in Initialization Mode: those the values set so far give).
+    pub fn event_indicators(&mut self, z: &mut [f64]) -> Result<(), String> {
+        Self::check_count("ni", z.len(), M::EVENT_INDICATORS)?;
+        match &self.core.model {
+            Some(model) if self.core.state != State::InitializationMode => model.event_indicators(&self.core.values, z),
+            _ => M::initialize(&self.core.values)?.event_indicators(&self.core.values, z),
         }
         Ok(())
     }

@@ -76,6 +76,10 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// in modelDescription.xml, so it is the same for every parameter value.
     const STATES: &'static [ContinuousState];
 
+    /// Number of event indicators (`numberOfEventIndicators`): functions of states and inputs
+    /// whose sign changes where the right-hand side jumps. Default: none.
+    const EVENT_INDICATORS: usize = 0;
+
     /// Parameter settings that change the model's equations (rigid/flexible, port couplings):
     /// ModelStructure's dependencies hold in each. Default: the start values only.
     fn configurations() -> Vec<Vec<(u32, Value)>> {
@@ -109,6 +113,9 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Writes the states' time derivatives at the current states with the inputs of `values`.
     /// A non-finite value tells the importer to retry with a smaller step (fmi2Discard).
     fn derivatives(&self, values: &Values, dx: &mut [f64]);
+
+    /// Writes the [`Model::EVENT_INDICATORS`] event indicators at the current states and inputs.
+    fn event_indicators(&self, _values: &Values, _z: &mut [f64]) {}
 
     /// The master set the variables `vrs` between two steps (inputs and tunable parameters,
     /// after [`Model::retune`]): a model that extrapolates an input takes a new value as a sample

@@ -62,8 +62,8 @@ fn input_step(x: f64, min: f64, max: f64) -> f64 {
     }
 }
 
-/// The unknowns after initialisation: every output and the `der()` variables.
-fn unknowns<M: Model>(model: &M, values: &Values) -> Vec<(u32, f64)> {
+/// The unknowns after initialisation, by value reference: every output and the `der()` variables.
+pub fn unknowns<M: Model>(model: &M, values: &Values) -> Vec<(u32, f64)> {
     let mut v = values.clone();
     model.outputs(&mut v);
     let mut dx = vec![0.0; M::STATES.len()];

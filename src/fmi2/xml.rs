@@ -153,7 +153,7 @@ fn write<M: Model>() -> io::Result<String> {
         ("license", "MIT OR Apache-2.0".into()),
         ("generationTool", format!("boomsim {}", env!("CARGO_PKG_VERSION"))),
         ("variableNamingConvention", "structured".into()),
-        ("numberOfEventIndicators", "0".into()),
+        ("numberOfEventIndicators", M::EVENT_INDICATORS.to_string()),
     ];
     w.create_element("fmiModelDescription")
         .with_attributes(root.iter().map(|(k, v)| (*k, v.as_str())))

@@ -51,3 +51,18 @@ pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values)
         values.set_real(r, x);
     }
 }
+
+/// Number of the circuit's event indicators, [`event_indicators`].
+pub(crate) const EVENT_INDICATORS: usize = 3;
+
+/// The circuit's event indicators at spool position `x_v` and reference `u_ref`: the places
+/// where its right-hand side jumps. `u_ref`: the spool demand jumps between -x_db and +x_db
+/// through 0 ([`crate::hydraulics::dcv::Dcv::spool_reference`]); `x_v - x_db`, `x_v + x_db`: the
+/// load-sensing pressure switches between p2 or p4 and tank at the edges of the closed dead band
+/// ([`crate::hydraulics::dcv::Dcv::ls_pressure`]), and with it the compensator's demand. Elsewhere
+/// the circuit is continuous: the orifices' roots are regularised and the valve openings only
+/// saturate (kinks, no jumps).
+pub(crate) fn event_indicators(circuit: &Circuit, x_v: f64, u_ref: f64, z: &mut [f64]) {
+    let x_db = circuit.dcv.x_db;
+    z.copy_from_slice(&[u_ref, x_v - x_db, x_v + x_db]);
+}

@@ -185,6 +185,7 @@ impl Model for HydraulicBoom {
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &PLANT_STATES;
+    const EVENT_INDICATORS: usize = super::circuit::EVENT_INDICATORS;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {
         super::boom::boom_configurations()
@@ -207,6 +208,10 @@ impl Model for HydraulicBoom {
         let (q, qd) = boom.split_at_mut(dof);
         c.copy_from_slice(&x[..N_CIRCUIT]);
         self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        super::circuit::event_indicators(&self.plant.circuit, self.state[circuit::X_V], values.real(vr::U_REF), z);
     }
 
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {

@@ -239,6 +239,7 @@ impl Model for HydraulicCircuit {
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
+    const EVENT_INDICATORS: usize = super::circuit::EVENT_INDICATORS;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {
         port::configurations()
@@ -260,6 +261,10 @@ impl Model for HydraulicCircuit {
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
         self.state[..N_CIRCUIT].copy_from_slice(x);
         Ok(())
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        super::circuit::event_indicators(&self.sys.circuit, self.state[circuit::X_V], values.real(vr::U_REF), z);
     }
 
     /// The plain port's circuit at the stroke and velocity inputs.
