@@ -16,6 +16,8 @@ use std::ptr::null;
 
 // fmi2Type and fmi2StatusKind values as the `c_int` the fuzzer passes (which may be invalid ones).
 pub const CO_SIMULATION: c_int = binding::fmi2Type_fmi2CoSimulation as c_int;
+pub const MODEL_EXCHANGE: c_int = binding::fmi2Type_fmi2ModelExchange as c_int;
+pub use fmi::fmi2::binding::fmi2EventInfo as EventInfo;
 pub const LAST_SUCCESSFUL_TIME: c_int = binding::fmi2StatusKind_fmi2LastSuccessfulTime as c_int;
 pub const TERMINATED: c_int = binding::fmi2StatusKind_fmi2Terminated as c_int;
 
@@ -34,8 +36,8 @@ pub struct Library {
 }
 
 impl Library {
-    /// Opens `lib<Id>.so` (or `<Id>.so`), checks that it exports the 25 common and 9
-    /// co-simulation functions of FMI 2.0, reads `modelDescription/<Id>.xml` and instantiates
+    /// Opens `lib<Id>.so` (or `<Id>.so`), checks that it exports the 25 common, 9
+    /// co-simulation and 10 model-exchange functions of FMI 2.0, reads `modelDescription/<Id>.xml` and instantiates
     /// once with its GUID: a stale build would refuse every instantiation, and the fuzzer would
     /// test nothing but error paths.
     pub fn load(path: &Path) -> Result<Self, String> {
@@ -53,7 +55,10 @@ impl Library {
             fmi2SetString fmi2GetFMUstate fmi2SetFMUstate fmi2FreeFMUstate fmi2SerializedFMUstateSize
             fmi2SerializeFMUstate fmi2DeSerializeFMUstate fmi2GetDirectionalDerivative
             fmi2SetRealInputDerivatives fmi2GetRealOutputDerivatives fmi2DoStep fmi2CancelStep fmi2GetStatus
-            fmi2GetRealStatus fmi2GetIntegerStatus fmi2GetBooleanStatus fmi2GetStringStatus);
+            fmi2GetRealStatus fmi2GetIntegerStatus fmi2GetBooleanStatus fmi2GetStringStatus
+            fmi2EnterEventMode fmi2NewDiscreteStates fmi2EnterContinuousTimeMode fmi2CompletedIntegratorStep
+            fmi2SetTime fmi2SetContinuousStates fmi2GetDerivatives fmi2GetEventIndicators fmi2GetContinuousStates
+            fmi2GetNominalsOfContinuousStates);
         if let Some(function) = missing {
             return Err(format!("{}: {function} is not exported", path.display()));
         }

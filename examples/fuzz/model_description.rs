@@ -135,6 +135,10 @@ pub struct Description {
     pub real_inputs: Vec<usize>,
     /// `boom.flexible`, when the model has it.
     pub flexible: Option<u32>,
+    /// Continuous states (Real variables with `derivative`) and event indicators, for Model
+    /// Exchange.
+    pub states: usize,
+    pub event_indicators: usize,
     pub max_vr: u32,
     index: HashMap<u32, usize>,
 }
@@ -148,17 +152,25 @@ impl Description {
     fn parse(xml: &str) -> Result<Self, String> {
         let mut reader = quick_xml::Reader::from_str(xml);
         let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
+        let (mut states, mut event_indicators) = (0, 0);
         let mut scalar: Option<Attributes> = None;
         loop {
             match reader.read_event().map_err(|e| e.to_string())? {
                 Event::Start(e) | Event::Empty(e) => {
                     let a = attributes(&e)?;
                     match e.name().0 {
-                        "fmiModelDescription" => guid = a.get("guid").cloned(),
+                        "fmiModelDescription" => {
+                            guid = a.get("guid").cloned();
+                            event_indicators = a
+                                .get("numberOfEventIndicators")
+                                .map_or(Ok(0), |n| n.parse())
+                                .map_err(|e| format!("numberOfEventIndicators: {e}"))?;
+                        }
                         "CoSimulation" => identifier = a.get("modelIdentifier").cloned(),
                         "Category" => categories.extend(a.get("name").cloned()),
                         "ScalarVariable" => scalar = Some(a),
                         tag @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration") => {
+                            states += usize::from(tag == "Real" && a.contains_key("derivative"));
                             if let Some(s) = scalar.take() {
                                 variables.push(Variable::new(&s, tag, &a)?);
                             }
@@ -194,6 +206,8 @@ impl Description {
             identifier: identifier.ok_or("no CoSimulation modelIdentifier")?,
             guid: guid.ok_or("no guid")?,
             flexible,
+            states,
+            event_indicators,
             categories,
             variables,
         })

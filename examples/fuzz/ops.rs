@@ -128,38 +128,154 @@ pub struct Instantiation {
 pub enum Op {
     GetTypesPlatform,
     GetVersion,
-    SetDebugLogging { logging_on: c_int, categories: Arr<Text> },
+    SetDebugLogging {
+        logging_on: c_int,
+        categories: Arr<Text>,
+    },
     Instantiate(Instantiation),
-    FreeInstance { instance: Component },
-    SetupExperiment { tolerance_defined: c_int, tolerance: f64, start: f64, stop_defined: c_int, stop: f64 },
+    FreeInstance {
+        instance: Component,
+    },
+    SetupExperiment {
+        tolerance_defined: c_int,
+        tolerance: f64,
+        start: f64,
+        stop_defined: c_int,
+        stop: f64,
+    },
     EnterInitializationMode,
     ExitInitializationMode,
     Terminate,
     Reset,
-    GetReal { vr: Arr<u32>, null_values: bool },
-    GetInteger { vr: Arr<u32>, null_values: bool },
-    GetBoolean { vr: Arr<u32>, null_values: bool },
-    GetString { vr: Arr<u32>, null_values: bool },
-    SetReal { vr: Arr<u32>, values: Arr<f64> },
-    SetInteger { vr: Arr<u32>, values: Arr<c_int> },
-    SetBoolean { vr: Arr<u32>, values: Arr<c_int> },
-    SetString { vr: Arr<u32>, values: Arr<Text> },
-    GetFMUstate { state: Slot },
-    SetFMUstate { state: FmuState },
-    FreeFMUstate { state: Slot },
-    SerializedFMUstateSize { state: FmuState, null_size: bool },
-    SerializeFMUstate { state: FmuState, size: usize, null_buffer: bool },
-    DeSerializeFMUstate { bytes: Blob, null_state: bool },
-    GetDirectionalDerivative { unknowns: Arr<u32>, knowns: Arr<u32>, dv_known: Arr<f64>, null_dv_unknown: bool },
-    SetRealInputDerivatives { vr: Arr<u32>, orders: Arr<c_int>, values: Arr<f64> },
-    GetRealOutputDerivatives { vr: Arr<u32>, orders: Arr<c_int>, null_values: bool },
-    DoStep { t: f64, h: f64, no_set_prior: c_int },
+    GetReal {
+        vr: Arr<u32>,
+        null_values: bool,
+    },
+    GetInteger {
+        vr: Arr<u32>,
+        null_values: bool,
+    },
+    GetBoolean {
+        vr: Arr<u32>,
+        null_values: bool,
+    },
+    GetString {
+        vr: Arr<u32>,
+        null_values: bool,
+    },
+    SetReal {
+        vr: Arr<u32>,
+        values: Arr<f64>,
+    },
+    SetInteger {
+        vr: Arr<u32>,
+        values: Arr<c_int>,
+    },
+    SetBoolean {
+        vr: Arr<u32>,
+        values: Arr<c_int>,
+    },
+    SetString {
+        vr: Arr<u32>,
+        values: Arr<Text>,
+    },
+    GetFMUstate {
+        state: Slot,
+    },
+    SetFMUstate {
+        state: FmuState,
+    },
+    FreeFMUstate {
+        state: Slot,
+    },
+    SerializedFMUstateSize {
+        state: FmuState,
+        null_size: bool,
+    },
+    SerializeFMUstate {
+        state: FmuState,
+        size: usize,
+        null_buffer: bool,
+    },
+    DeSerializeFMUstate {
+        bytes: Blob,
+        null_state: bool,
+    },
+    GetDirectionalDerivative {
+        unknowns: Arr<u32>,
+        knowns: Arr<u32>,
+        dv_known: Arr<f64>,
+        null_dv_unknown: bool,
+    },
+    SetRealInputDerivatives {
+        vr: Arr<u32>,
+        orders: Arr<c_int>,
+        values: Arr<f64>,
+    },
+    GetRealOutputDerivatives {
+        vr: Arr<u32>,
+        orders: Arr<c_int>,
+        null_values: bool,
+    },
+    DoStep {
+        t: f64,
+        h: f64,
+        no_set_prior: c_int,
+    },
     CancelStep,
-    GetStatus { kind: c_int, null_value: bool },
-    GetRealStatus { kind: c_int, null_value: bool },
-    GetIntegerStatus { kind: c_int, null_value: bool },
-    GetBooleanStatus { kind: c_int, null_value: bool },
-    GetStringStatus { kind: c_int, null_value: bool },
+    GetStatus {
+        kind: c_int,
+        null_value: bool,
+    },
+    GetRealStatus {
+        kind: c_int,
+        null_value: bool,
+    },
+    GetIntegerStatus {
+        kind: c_int,
+        null_value: bool,
+    },
+    GetBooleanStatus {
+        kind: c_int,
+        null_value: bool,
+    },
+    GetStringStatus {
+        kind: c_int,
+        null_value: bool,
+    },
+    EnterEventMode,
+    NewDiscreteStates {
+        null_info: bool,
+    },
+    EnterContinuousTimeMode,
+    CompletedIntegratorStep {
+        no_set_prior: c_int,
+        null_flags: bool,
+    },
+    SetTime {
+        t: f64,
+    },
+    SetContinuousStates {
+        x: Arr<f64>,
+    },
+    /// fmi2GetDerivatives, fmi2GetEventIndicators, fmi2GetContinuousStates and
+    /// fmi2GetNominalsOfContinuousStates: `n` announced, NULL for `null`.
+    GetDerivatives {
+        n: usize,
+        null: bool,
+    },
+    GetEventIndicators {
+        n: usize,
+        null: bool,
+    },
+    GetContinuousStates {
+        n: usize,
+        null: bool,
+    },
+    GetNominalsOfContinuousStates {
+        n: usize,
+        null: bool,
+    },
 }
 
 impl Op {

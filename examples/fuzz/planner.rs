@@ -41,6 +41,16 @@ impl Planner {
                 self.queue.pop_front().map_or(Op::Reset, |(_, op)| op)
             }
             Phase::StepComplete => self.stepping(rng, s),
+            Phase::EventMode => match rng.below(12) {
+                0..=5 => Op::EnterContinuousTimeMode,
+                6 => Op::NewDiscreteStates { null_info: false },
+                7 => plausible_set(rng, m, &m.step_settable).unwrap_or(Op::EnterContinuousTimeMode),
+                8 => get_reals(rng, m),
+                9 => Op::GetContinuousStates { n: m.states, null: false },
+                10 => state_op(rng, s),
+                _ => Op::Terminate,
+            },
+            Phase::ContinuousTime => self.integrating(rng, s),
             Phase::StepFailed => match rng.below(10) {
                 0..=2 => last_successful_time,
                 3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
@@ -123,6 +133,35 @@ impl Planner {
             85..=96 => state_op(rng, s),
             97..=98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
             _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
+        }
+    }
+}
+
+impl Planner {
+    /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
+    /// the sequence's step, states near the last ones read, derivatives, event indicators,
+    /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
+    fn integrating(&self, rng: &mut Rng, s: &Session) -> Op {
+        let m = s.model;
+        if !(s.view.time < 1.0) {
+            return if rng.chance(0.7) { Op::Terminate } else { Op::Reset };
+        }
+        match rng.below(100) {
+            0..=19 => Op::SetTime { t: s.view.time + self.h * rng.uniform(0.0, 1.0) },
+            20..=34 if s.x.len() == m.states => {
+                let x = s.x.iter().map(|x| x + (1e-6 + 1e-4 * x.abs()) * rng.uniform(-1.0, 1.0)).collect();
+                Op::SetContinuousStates { x: Arr::Items(x) }
+            }
+            20..=34 => Op::GetContinuousStates { n: m.states, null: false },
+            35..=59 => Op::GetDerivatives { n: m.states, null: false },
+            60..=64 => Op::GetEventIndicators { n: m.event_indicators, null: false },
+            65..=69 => Op::CompletedIntegratorStep { no_set_prior: c_int::from(rng.chance(0.9)), null_flags: false },
+            70..=77 => plausible_set(rng, m, &m.real_inputs).unwrap_or_else(|| get_reals(rng, m)),
+            78..=86 => get_reals(rng, m),
+            87..=89 => Op::EnterEventMode,
+            90..=94 => state_op(rng, s),
+            95..=97 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
+            _ => Op::GetContinuousStates { n: m.states, null: false },
         }
     }
 }

@@ -2,7 +2,9 @@
 //! returned and keeps track of the instance's state. The oracle (a violation fails the sequence):
 //! - every function returns a valid fmi2Status (0..=4), and never fmi2OK or fmi2Warning for a
 //!   NULL instance;
-//! - fmi2GetReal with fmi2OK or fmi2Warning wrote finite numbers only;
+//! - fmi2GetReal with fmi2OK or fmi2Warning wrote finite numbers only, and so did
+//!   fmi2GetContinuousStates, fmi2GetNominalsOfContinuousStates (positive, too),
+//!   fmi2GetEventIndicators and fmi2GetDerivatives (Model Exchange);
 //!   fmi2GetRealStatus(fmi2LastSuccessfulTime) is the end of the last step the fuzzer saw succeed;
 //! - fmi2GetTypesPlatform is "default" and fmi2GetVersion "2.0";
 //! - the logger gets the componentEnvironment given to fmi2Instantiate, a valid status,
@@ -14,7 +16,10 @@
 //! Crashes and hangs are caught by `batch`.
 
 use crate::callbacks::LOG;
-use crate::fmi2::{CallbackFunctions, Component, Fmi2, FmuState, Library, Status, LAST_SUCCESSFUL_TIME, OK, WARNING};
+use crate::fmi2::{
+    CallbackFunctions, Component, EventInfo, Fmi2, FmuState, Library, Status, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK,
+    WARNING,
+};
 use crate::fmu_states::FmuStates;
 use crate::model_description::Description;
 use crate::ops::{Arr, Instantiation, Op, Slot, Text};
@@ -59,6 +64,10 @@ pub struct Session<'a> {
     pub second: Component,
     /// The main fmi2Instantiate has been called.
     opened: bool,
+    /// The main instance is a Model Exchange one.
+    pub me: bool,
+    /// The continuous states fmi2GetContinuousStates last returned (Model Exchange).
+    pub x: Vec<f64>,
     /// Callback structures of the instances, alive until the end of the sequence; boxed, since
     /// an FMU may keep the pointer and a Vec moves its elements.
     #[allow(clippy::vec_box)]
@@ -78,6 +87,8 @@ impl<'a> Session<'a> {
             c: null_mut(),
             second: null_mut(),
             opened: false,
+            me: false,
+            x: Vec::new(),
             callbacks: Vec::new(),
             view: View::fresh(),
             states: FmuStates::default(),
@@ -206,6 +217,28 @@ impl<'a> Session<'a> {
             Op::GetStringStatus { kind, null_value } => {
                 status(f.fmi2GetStringStatus(c, *kind as u32, out(&mut [null()], *null_value)))
             }
+            Op::EnterEventMode => status(f.fmi2EnterEventMode(c)),
+            Op::NewDiscreteStates { null_info } => {
+                status(f.fmi2NewDiscreteStates(c, out(&mut [EventInfo::default()], *null_info)))
+            }
+            Op::EnterContinuousTimeMode => status(f.fmi2EnterContinuousTimeMode(c)),
+            Op::CompletedIntegratorStep { no_set_prior, null_flags } => {
+                let (mut a, mut b) = ([0], [0]);
+                status(f.fmi2CompletedIntegratorStep(
+                    c,
+                    *no_set_prior,
+                    out(&mut a, *null_flags),
+                    out(&mut b, *null_flags),
+                ))
+            }
+            Op::SetTime { t } => status(f.fmi2SetTime(c, *t)),
+            Op::SetContinuousStates { x } => status(f.fmi2SetContinuousStates(c, x.ptr(), x.len())),
+            Op::GetDerivatives { n, null } => reals(*n, *null, |p| f.fmi2GetDerivatives(c, p, *n)),
+            Op::GetEventIndicators { n, null } => reals(*n, *null, |p| f.fmi2GetEventIndicators(c, p, *n)),
+            Op::GetContinuousStates { n, null } => reals(*n, *null, |p| f.fmi2GetContinuousStates(c, p, *n)),
+            Op::GetNominalsOfContinuousStates { n, null } => {
+                reals(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
+            }
         }
     }
 
@@ -233,7 +266,12 @@ impl<'a> Session<'a> {
         match (op, output) {
             (Op::GetTypesPlatform, Output::Text(p)) => expect_text(p, "default", "fmi2GetTypesPlatform")?,
             (Op::GetVersion, Output::Text(p)) => expect_text(p, "2.0", "fmi2GetVersion")?,
-            (Op::Instantiate(_), Output::Instance(c)) => self.instantiated(c)?,
+            (Op::Instantiate(spec), Output::Instance(c)) => {
+                if !self.opened {
+                    self.me = spec.fmu_type == MODEL_EXCHANGE;
+                }
+                self.instantiated(c)?
+            }
             (Op::FreeInstance { instance }, _) if instance == self.c => {
                 self.c = null_mut();
                 self.states.live.clear();
@@ -248,7 +286,23 @@ impl<'a> Session<'a> {
                 (v.time, v.stop, v.set_up) = (start, (stop_defined != 0).then_some(stop), true);
             }
             (Op::EnterInitializationMode, _) if ok => self.view.phase = Phase::Initialization,
-            (Op::ExitInitializationMode, _) if ok => self.view.phase = Phase::StepComplete,
+            (Op::ExitInitializationMode, _) if ok => {
+                self.view.phase = if self.me { Phase::EventMode } else { Phase::StepComplete }
+            }
+            (Op::EnterEventMode, _) if ok => self.view.phase = Phase::EventMode,
+            (Op::EnterContinuousTimeMode, _) if ok => self.view.phase = Phase::ContinuousTime,
+            (Op::SetTime { t }, _) if ok => self.view.time = t,
+            (Op::GetDerivatives { .. }, Output::Reals(v)) if ok => finite(&v, "fmi2GetDerivatives")?,
+            (Op::GetEventIndicators { .. }, Output::Reals(v)) if ok => finite(&v, "fmi2GetEventIndicators")?,
+            (Op::GetContinuousStates { .. }, Output::Reals(v)) if ok => {
+                finite(&v, "fmi2GetContinuousStates")?;
+                self.x = v;
+            }
+            (Op::GetNominalsOfContinuousStates { .. }, Output::Reals(v)) if ok => {
+                if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+                    return Err(format!("fmi2GetNominalsOfContinuousStates returned fmi2OK with a nominal {x}"));
+                }
+            }
             (Op::ExitInitializationMode, _) if phase == Phase::Initialization => self.view.phase = Phase::Broken,
             (Op::Terminate, _) if ok => self.view.phase = Phase::Terminated,
             (Op::Reset, _) if ok => self.view = View::fresh(),
@@ -311,6 +365,22 @@ impl<'a> Session<'a> {
     /// Simulated seconds left for the sequence.
     pub fn budget(&self) -> f64 {
         SIMULATION_BUDGET - self.simulated
+    }
+}
+
+/// Calls `f` with a buffer of `n` NaNs (NULL for `null`): the status and what it holds after (a
+/// value the FMU does not write fails the finiteness check).
+unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
+    let mut v = vec![f64::NAN; n];
+    let s = f(out(&mut v, null));
+    (Some(s), Output::Reals(if null { Vec::new() } else { v }))
+}
+
+/// An fmi2OK answer of a Model Exchange getter holds finite numbers only.
+fn finite(values: &[f64], function: &str) -> Result<(), String> {
+    match values.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(format!("{function} returned fmi2OK or fmi2Warning, but element {i} is {}", values[i])),
+        None => Ok(()),
     }
 }
 

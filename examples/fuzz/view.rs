@@ -10,6 +10,9 @@ pub enum Phase {
     Initialization,
     StepComplete,
     StepFailed,
+    /// Model Exchange: Event Mode and Continuous-Time Mode.
+    EventMode,
+    ContinuousTime,
     Terminated,
     /// A step that might have been carried out returned fmi2Error: probe with fmi2GetRealStatus.
     Unknown,
@@ -85,7 +88,15 @@ impl View {
         if !self.certain {
             return true;
         }
-        if matches!(self.phase, Phase::Instantiated | Phase::Initialization | Phase::StepFailed | Phase::Terminated) {
+        if matches!(
+            self.phase,
+            Phase::Instantiated
+                | Phase::Initialization
+                | Phase::StepFailed
+                | Phase::EventMode
+                | Phase::ContinuousTime
+                | Phase::Terminated
+        ) {
             return false;
         }
         // Twice the FMU's tolerances: what is refused here is refused there.

@@ -3,10 +3,11 @@
 //! is legal), calls in the wrong state, zero, negative, tiny and huge step sizes, communication
 //! points that do not match, input derivatives of any order and size, freed FMU states and states
 //! of a second instance, serialized states with a flipped bit, truncated, extended, random, or
-//! edited with the CRC recomputed, unknown log categories, NULL and non-UTF-8 strings.
+//! edited with the CRC recomputed, unknown log categories, NULL and non-UTF-8 strings; Model
+//! Exchange calls with NULL or wrongly sized arrays, special states and times.
 
 use crate::callbacks::Callbacks;
-use crate::fmi2::{FmuState, CO_SIMULATION};
+use crate::fmi2::{FmuState, CO_SIMULATION, MODEL_EXCHANGE};
 use crate::model_description::{Description, Type, Variable, TYPES};
 use crate::ops::{Arr, Blob, Instantiation, Op, Slot, Text};
 use crate::rng::Rng;
@@ -40,7 +41,7 @@ const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m", "%s
 pub fn wild(rng: &mut Rng, s: &Session) -> Op {
     let m = s.model;
     let real = Type::Real;
-    match rng.below(33) {
+    match rng.below(38) {
         0 => Op::GetTypesPlatform,
         1 => Op::GetVersion,
         2 => Op::SetDebugLogging { logging_on: wild_boolean(rng), categories: categories(rng, m) },
@@ -86,16 +87,48 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
         29 => Op::GetRealStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
         30 => Op::GetIntegerStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
         31 => Op::GetBooleanStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
-        _ => Op::GetStringStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
+        32 => Op::GetStringStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
+        33 => match rng.below(4) {
+            0 => Op::EnterEventMode,
+            1 => Op::EnterContinuousTimeMode,
+            2 => Op::NewDiscreteStates { null_info: rng.chance(0.3) },
+            _ => Op::CompletedIntegratorStep { no_set_prior: wild_boolean(rng), null_flags: rng.chance(0.3) },
+        },
+        34 => Op::SetTime { t: wild_real(rng, None) },
+        35 => {
+            let n = wild_count(rng, m.states);
+            let x: Vec<f64> = (0..n)
+                .map(|k| if rng.chance(0.7) { s.x.get(k).copied().unwrap_or(0.0) } else { wild_real(rng, None) })
+                .collect();
+            Op::SetContinuousStates { x: maybe_null(rng, x) }
+        }
+        36 => match rng.below(3) {
+            0 => Op::GetDerivatives { n: wild_count(rng, m.states), null: rng.chance(0.1) },
+            1 => Op::GetContinuousStates { n: wild_count(rng, m.states), null: rng.chance(0.1) },
+            _ => Op::GetNominalsOfContinuousStates { n: wild_count(rng, m.states), null: rng.chance(0.1) },
+        },
+        _ => Op::GetEventIndicators { n: wild_count(rng, m.event_indicators), null: rng.chance(0.1) },
+    }
+}
+
+/// A count announced for an array of `n`: mostly `n`, else 0, one off, or far off.
+fn wild_count(rng: &mut Rng, n: usize) -> usize {
+    match rng.below(10) {
+        0..=5 => n,
+        6 => 0,
+        7 => n + 1,
+        8 => n.saturating_sub(1),
+        _ => rng.range(0, 200),
     }
 }
 
 /// The main fmi2Instantiate: mostly valid (logger and memory callbacks sometimes NULL), now and
-/// then with a wrong GUID, an empty, NULL or non-UTF-8 name, another fmuType or NULL functions.
+/// then with a wrong GUID, an empty, NULL or non-UTF-8 name, another fmuType or NULL functions;
+/// a third of them for Model Exchange.
 pub fn instantiation(rng: &mut Rng, m: &Description) -> Instantiation {
     let mut spec = Instantiation {
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
-        fmu_type: CO_SIMULATION,
+        fmu_type: if rng.chance(0.3) { MODEL_EXCHANGE } else { CO_SIMULATION },
         guid: Text::new(&m.guid),
         resources: rng.pick(&[Text::Null, Text::new("file:///tmp/"), Text::new("")]).clone(),
         callbacks: Some(Callbacks { logger: !rng.chance(0.1), memory: !rng.chance(0.2) }),
@@ -106,7 +139,7 @@ pub fn instantiation(rng: &mut Rng, m: &Description) -> Instantiation {
         match rng.below(5) {
             0 => spec.guid = bad_guid(rng, &m.guid),
             1 => spec.name = rng.pick(&[Text::new(""), Text::Null]).clone(),
-            2 => spec.fmu_type = *rng.pick(&[0, 2, -1, c_int::MAX]),
+            2 => spec.fmu_type = *rng.pick(&[2, -1, c_int::MAX]),
             3 => spec.callbacks = None,
             _ => spec.name = Text::bytes(b"\xff\xfe"),
         }
