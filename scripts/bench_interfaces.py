@@ -9,7 +9,9 @@ cases U and B (10 s, as `boomsim bench`), rigid and flexible boom, plant and con
 with wall time, real-time factor, the plant's right-hand-side evaluations, and the error against a
 reference: ME at rtol 1e-9, the continuous loop without a communication step. A second table
 measures the event indicators (rigid boom, B and C1.3, where the compensated spool command
-crosses the dead band): ME with and without CVode's root finding on them. A benchmark: it
+crosses the dead band): ME with and without CVode's root finding on them. A third one is the
+tolerance an ME user picks: HydraulicBoom alone (rigid, valve.u_ref = -0.3 from rest, 1 s)
+through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9. A benchmark: it
 prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
 references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
 """
@@ -34,11 +36,8 @@ def timed(f, *args, **kw):
     return r, time.perf_counter() - t0
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
-    args = ap.parse_args(argv)
-    cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
+def interface_rows(cases) -> list:
+    """CS and ME per case, against the ME reference at rtol 1e-9."""
     rows = []
     start = time.perf_counter()
     for k, (sid, boom) in enumerate(cases, 1):
@@ -53,23 +52,67 @@ def main(argv=None):
             rows.append((sid, boom, interface, wall, STOP / wall, res.counts["rhs"],
                          np.abs(d["p3"] - r["p3"]).max() / 1e5, np.abs(d["cylinder.x"] - r["cylinder.x"]).max() * 1e3))
             print(f"    {interface}: {wall:.2f} s", flush=True)
-    print("\nEvent indicators (rigid boom, 15 s, against ME at rtol 1e-9 with events):", flush=True)
-    ev_rows = []
+    return rows
+
+
+def event_rows() -> list:
+    """ME with and without root finding on the event indicators (rigid boom, B and C1.3)."""
+    print("Event indicators (rigid boom, 15 s, against ME at rtol 1e-9 with events) ...", flush=True)
+    rows = []
     for sid in ("B", "C1.3"):
         sc = cosim.load_scenario(sid)
         ref = cosim.run_me(sc, "rigid", tolerance=1e-9)
         for events in (True, False):
             res, wall = timed(cosim.run_me, sc, "rigid", events=events)
-            ev_rows.append((sid, "on" if events else "off", res.counts["events"], res.counts["rhs"], wall,
-                            np.abs(res.data["p3"] - ref.data["p3"]).max() / 1e5))
-    print("\n| case | boom | interface | wall [s] | real-time factor | RHS | max abs p3 error [bar] | max abs stroke error [mm] |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
-    for sid, boom, interface, wall, rtf, rhs, ep3, ex in rows:
-        print(f"| {sid} | {boom} | {interface} | {wall:.2f} | {rtf:.1f}x | {rhs} | {ep3:.3g} | {ex:.3g} |")
-    print("\n| case | event indicators | state events | RHS | wall [s] | max abs p3 error [bar] |")
-    print("| --- | --- | --- | --- | --- | --- |")
-    for sid, on, n_events, rhs, wall, ep3 in ev_rows:
-        print(f"| {sid} | {on} | {n_events} | {rhs} | {wall:.2f} | {ep3:.3g} |")
+            rows.append((sid, "on" if events else "off", res.counts["events"], res.counts["rhs"], wall,
+                         np.abs(res.data["p3"] - ref.data["p3"]).max() / 1e5))
+    return rows
+
+
+def tolerance_rows() -> tuple:
+    """HydraulicBoom ME alone through fmpy.simulate_fmu at several CVode tolerances."""
+    print("Tolerance (HydraulicBoom ME alone, rigid, u_ref -0.3, 1 s) ...", flush=True)
+    from fmpy import simulate_fmu
+
+    fmu = str(cosim.FMU_DIR / "HydraulicBoom.fmu")
+    kw = dict(stop_time=1.0, output_interval=1e-3, output=["p3"],
+              start_values={"boom.flexible": False, "valve.u_ref": -0.3})
+    cs_ref = simulate_fmu(fmu, fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
+    rows = []
+    for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
+        try:
+            r, wall = timed(simulate_fmu, fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)
+            err = np.abs(np.interp(cs_ref["time"], r["time"], r["p3"]) - cs_ref["p3"]).max() / 1e5
+            rows.append((f"{tol:g}", f"{r['p3'][-1] / 1e5:.4g}", f"{err:.3g}", f"{wall:.2f}"))
+        except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
+            rows.append((f"{tol:g}", "failed", str(e).split(":")[0][:60], "-"))
+    return cs_ref["p3"][-1] / 1e5, rows
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
+    ap.add_argument("--only", choices=("interfaces", "events", "tolerance"), help="one table")
+    args = ap.parse_args(argv)
+    cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
+    if args.only in (None, "interfaces"):
+        rows = interface_rows(cases)
+        print("\n| case | boom | interface | wall [s] | real-time factor | RHS | max abs p3 error [bar] | max abs stroke error [mm] |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+        for sid, boom, interface, wall, rtf, rhs, ep3, ex in rows:
+            print(f"| {sid} | {boom} | {interface} | {wall:.2f} | {rtf:.1f}x | {rhs} | {ep3:.3g} | {ex:.3g} |")
+    if args.only in (None, "events"):
+        rows = event_rows()
+        print("\n| case | event indicators | state events | RHS | wall [s] | max abs p3 error [bar] |")
+        print("| --- | --- | --- | --- | --- | --- |")
+        for sid, on, n_events, rhs, wall, ep3 in rows:
+            print(f"| {sid} | {on} | {n_events} | {rhs} | {wall:.2f} | {ep3:.3g} |")
+    if args.only in (None, "tolerance"):
+        p3_ref, rows = tolerance_rows()
+        print(f"\n| CVode rtol | p3 at 1 s [bar] (CS rtol 1e-9: {p3_ref:.4g}) | max abs p3 error [bar] | wall [s] |")
+        print("| --- | --- | --- | --- |")
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
 
 
 if __name__ == "__main__":

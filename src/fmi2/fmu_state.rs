@@ -170,6 +170,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         tolerance,
         last_successful_time,
         outputs_current,
+        derivatives_current: false,
     })
 }
 

@@ -33,6 +33,8 @@ pub struct Instance<M: Model> {
     pub(crate) strings: Vec<std::ffi::CString>,
     /// The model's GUID, computed once at instantiation (FMU state bytes carry it).
     pub guid: String,
+    /// Per table row: whether it is the `der()` variable of a continuous state.
+    pub(crate) derivative_rows: Vec<bool>,
     /// The FMU states this instance allocated and the importer has not freed yet; freed with the
     /// instance (FMI 2.0, 2.1.5: fmi2FreeInstance frees all memory the instance allocated).
     pub(crate) fmu_states: Vec<*mut Core<M>>,
@@ -54,6 +56,9 @@ pub struct Core<M: Model> {
     pub last_successful_time: f64,
     /// Whether outputs reflect the current state and inputs.
     pub outputs_current: bool,
+    /// Whether the `der()` variables do too (computed when one is read: a Co-Simulation step
+    /// does not pay a right-hand side for values few importers read).
+    pub derivatives_current: bool,
 }
 
 impl<M: Model> Core<M> {
@@ -70,6 +75,7 @@ impl<M: Model> Core<M> {
             tolerance: None,
             last_successful_time: 0.0,
             outputs_current: false,
+            derivatives_current: false,
         }
     }
 }
@@ -120,6 +126,7 @@ impl<M: Model> Instance<M> {
             core: Core::new(),
             strings: Vec::new(),
             guid,
+            derivative_rows: M::VARIABLES.iter().map(|v| M::STATES.iter().any(|s| s.derivative == v.vr)).collect(),
             fmu_states: Vec::new(),
         }
     }
@@ -171,6 +178,7 @@ impl<M: Model> Instance<M> {
     pub fn enter_initialization_mode(&mut self) {
         self.core.state = State::InitializationMode;
         self.core.outputs_current = false;
+        self.core.derivatives_current = false;
     }
 
     /// fmi2ExitInitializationMode: builds the model from the final parameters and inputs; then
@@ -181,9 +189,10 @@ impl<M: Model> Instance<M> {
             M::model_exchange_check(&c.values)?;
         }
         let model = M::initialize(&c.values)?;
-        write_outputs(&model, &mut c.values);
+        model.outputs(&mut c.values);
         c.model = Some(model);
         c.outputs_current = true;
+        c.derivatives_current = false;
         c.last_successful_time = c.time;
         c.state = match self.interface {
             Interface::CoSimulation => State::StepComplete,
@@ -207,6 +216,7 @@ impl<M: Model> Instance<M> {
         }
         self.core.time = t;
         self.core.outputs_current = false;
+        self.core.derivatives_current = false;
         Ok(())
     }
 
@@ -232,6 +242,7 @@ impl<M: Model> Instance<M> {
             return Err(e);
         }
         self.core.outputs_current = false;
+        self.core.derivatives_current = false;
         Ok(())
     }
 
@@ -283,11 +294,28 @@ impl<M: Model> Instance<M> {
         }
         if c.state == State::InitializationMode {
             // Initial outputs follow from the values set so far.
-            write_outputs(&M::initialize(&c.values)?, &mut c.values);
+            M::initialize(&c.values)?.outputs(&mut c.values);
         } else if let Some(model) = &c.model {
-            write_outputs(model, &mut c.values);
+            model.outputs(&mut c.values);
         }
         c.outputs_current = true;
+        c.derivatives_current = false;
+        Ok(())
+    }
+
+    /// Writes the `der()` variables from the current states and inputs (in Initialization Mode,
+    /// those the values set so far give).
+    fn refresh_derivatives(&mut self) -> Result<(), String> {
+        let c = &mut self.core;
+        let mut dx = vec![0.0; M::STATES.len()];
+        match &c.model {
+            Some(model) if c.state != State::InitializationMode => model.derivatives(&c.values, &mut dx),
+            _ => M::initialize(&c.values)?.derivatives(&c.values, &mut dx),
+        }
+        for (s, d) in M::STATES.iter().zip(dx) {
+            c.values.set_real(s.derivative, d);
+        }
+        c.derivatives_current = true;
         Ok(())
     }
 
@@ -316,6 +344,9 @@ impl<M: Model> Instance<M> {
         self.refresh_outputs()?;
         for (k, &vr) in vrs.iter().enumerate() {
             let (i, v) = self.lookup(vr, wanted)?;
+            if self.derivative_rows[i] && !self.core.derivatives_current {
+                self.refresh_derivatives()?;
+            }
             let value = self.core.values.at(i);
             if let Value::Real(x) = value {
                 // Never a non-finite value with fmi2OK (a model evaluated outside its range).
@@ -360,6 +391,7 @@ impl<M: Model> Instance<M> {
             model.inputs_set(vrs);
         }
         self.core.outputs_current = false;
+        self.core.derivatives_current = false;
         Ok(())
     }
 
@@ -442,6 +474,7 @@ impl<M: Model> Instance<M> {
         let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
         let result = model.do_step(&c.values, &slopes, start, end - start, tolerance, &mut ModelLog(&self.log));
         c.outputs_current = false;
+        c.derivatives_current = false;
         if let Err(e) = result {
             c.time = e.time;
             c.last_successful_time = e.time;
@@ -462,8 +495,9 @@ impl<M: Model> Instance<M> {
         c.last_successful_time = end;
         // Every Real the importer can read is finite after a good step, or the step is an error.
         c.values.take_non_finite();
-        write_outputs(model, &mut c.values);
+        model.outputs(&mut c.values);
         c.outputs_current = true;
+        c.derivatives_current = false;
         if let Some(i) = c.values.take_non_finite() {
             c.state = State::Error;
             let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
@@ -475,16 +509,6 @@ impl<M: Model> Instance<M> {
             ));
         }
         Ok(Step::Done(warning))
-    }
-}
-
-/// Writes the model's outputs and locals and the `der()` variables of its continuous states.
-fn write_outputs<M: Model>(model: &M, values: &mut Values) {
-    model.outputs(values);
-    let mut dx = vec![0.0; M::STATES.len()];
-    model.derivatives(values, &mut dx);
-    for (s, d) in M::STATES.iter().zip(dx) {
-        values.set_real(s.derivative, d);
     }
 }
 

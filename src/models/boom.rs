@@ -142,21 +142,16 @@ impl Boom {
     /// at coordinates `q`, velocities `qd`; `theta`, `omega` and the payload use the value
     /// references `r = [theta, omega, payload.x, payload.y]` of the model.
     pub(crate) fn outputs(&self, q: &[f64], qd: &[f64], r: [u32; 4], values: &mut Values) {
-        let b = self.mechanics();
-        let (theta, omega, tip) = match self {
-            Boom::Rigid(rb) => {
-                let st = rb.state(b.stroke(q), b.stroke_rate(q, qd));
-                (st.theta2, st.theta2_dot, 0.0)
-            }
-            Boom::Flexible(f) => (q[0], qd[0], f.tip_deflection(q)),
-        };
-        let payload = b.payload(q);
+        // The section angles and rates; the first is the boom angle and rate, rigid or flexible.
+        let mut sections = [0.0; 2 * MAX_SECTIONS];
+        self.me_states(q, qd, &mut sections);
+        let (theta, omega) = (sections[0], sections[MAX_SECTIONS]);
+        let tip = if let Boom::Flexible(f) = self { f.tip_deflection(q) } else { 0.0 };
+        let payload = self.mechanics().payload(q);
         for (r, x) in r.into_iter().zip([theta, omega, payload.x, payload.y]) {
             values.set_real(r, x);
         }
         values.set_real(vr::TIP_DEFLECTION, tip);
-        let mut sections = [0.0; 2 * MAX_SECTIONS];
-        self.me_states(q, qd, &mut sections);
         let refs = (vr::SECTIONS..).take(MAX_SECTIONS).chain((vr::SECTION_RATES..).take(MAX_SECTIONS));
         for (r, x) in refs.zip(sections) {
             values.set_real(r, x);
