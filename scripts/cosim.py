@@ -6,7 +6,7 @@
 
 Usage:
     .venv/bin/python scripts/cosim.py scripts/scenarios/B.toml [--boom rigid] [--step 1e-3]
-        [--stop-time 15] [--hold] [--out out/cosim]
+        [--stop-time 15] [--hold] [--interface cs|me] [--out out/cosim]
 writes <out>/<scenario>-<boom>.csv and .png (p3, p4, cylinder velocity, u_ref / u_comp / u).
 
 Coupling (Gauss-Seidel, loop-free). The plant's outputs do not depend directly on valve.u_ref
@@ -216,6 +216,8 @@ class Result:
     #: Work counts: `rhs`, the plant's right-hand-side evaluations (CS: its solver's; ME: CVode's
     #: fmi2GetDerivatives calls).
     counts: dict = dataclasses.field(default_factory=dict)
+    #: "CS 1 ms" (fmi2DoStep at the step) or "Model Exchange, CVode rtol ..." (`run_me`).
+    interface: str = ""
 
     @property
     def name(self) -> str:
@@ -458,7 +460,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
                 pass
             m.freeInstance()
     return Result(scenario, boom, 1e-3, False, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at, fb_start,
-                  counts=counts)
+                  counts=counts, interface=f"Model Exchange, CVode rtol {tolerance:g}")
 
 
 # --------------------------------------------------------------------------- output
@@ -528,7 +530,7 @@ def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
             else "no compensation")
     if c["enable"] and res.feedback_on_at not in (None, 0.0):
         filt += f", feedback on at {res.feedback_on_at:.3f} s (CBV open)"
-    title = f"{sc['id']} ({res.boom} boom): u_ref = {sc['reference'][-1, 1]:+.2f}, {filt}, communication step {res.step:g} s"
+    title = f"{sc['id']} ({res.boom} boom): u_ref = {sc['reference'][-1, 1]:+.2f}, {filt}, {res.interface or f'communication step {res.step:g} s'}"
     if metrics:
         tm = metrics.get("t_motion")
         title += "\nload starts lowering (CBV flow) at " + (f"{tm:.2f} s" if tm is not None else "- (never)")
@@ -549,10 +551,14 @@ def main(argv=None):
                     help="communication step [s] (default: the scenario's `step`, else 1e-3)")
     ap.add_argument("--stop-time", type=float, default=None)
     ap.add_argument("--hold", action="store_true", help="hold p4 over a step in the controller (no slope)")
+    ap.add_argument("--interface", choices=("cs", "me"), default="cs",
+                    help="cs: both FMUs' fmi2DoStep (default); me: both as Model Exchange under fmpy's CVode, one ODE")
     ap.add_argument("--feedback-start", choices=("t0", "cbv_open"), default=None,
                     help="only this feedback start (default: every start listed by the scenario)")
     ap.add_argument("--out", default=str(ROOT / "out" / "cosim"))
     args = ap.parse_args(argv)
+    if args.interface == "me" and (args.step is not None or args.hold):
+        ap.error("--step and --hold are Co-Simulation options: Model Exchange has no communication step")
     for name, value in (("--step", args.step), ("--stop-time", args.stop_time)):
         if value is not None and not (0 < value < float("inf")):
             ap.error(f"{name} {value} must be a positive number of seconds (e.g. 1e-3)")
@@ -569,7 +575,10 @@ def main(argv=None):
                 for f in ([args.feedback_start] if args.feedback_start else sc["starts"])]
     for boom, fb in variants:
         try:
-            res = run(sc, boom, args.step, args.stop_time, not args.hold, feedback_start=fb)
+            if args.interface == "me":
+                res = run_me(sc, boom, args.stop_time, feedback_start=fb)
+            else:
+                res = run(sc, boom, args.step, args.stop_time, not args.hold, feedback_start=fb)
         except UsageError as e:
             ap.error(str(e))
         except Skip as e:
