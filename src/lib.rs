@@ -15,5 +15,6 @@ pub mod mechanics;
 pub mod models;
 pub mod params;
 pub mod platform;
+pub mod scalar;
 pub mod solver;
 pub mod units;

@@ -228,7 +228,7 @@ const ROWS: &[Row] = &[
     Row { at: At::Stepping, what: "getIntegerStatus", call: |s| unsafe { api::get_integer_status::<Pfc>(s.c) }, status: ERR, says: &["fmi2GetIntegerStatus", "not supported"] },
     Row { at: At::Stepping, what: "getStringStatus", call: |s| unsafe { api::get_string_status::<Pfc>(s.c) }, status: ERR, says: &["fmi2GetStringStatus", "not supported"] },
     Row { at: At::Stepping, what: "getRealOutputDerivatives", call: |s| unsafe { api::get_real_output_derivatives::<Pfc>(s.c) }, status: ERR, says: &["maxOutputDerivativeOrder"] },
-    Row { at: At::Stepping, what: "getDirectionalDerivative", call: |s| unsafe { api::get_directional_derivative::<Pfc>(s.c) }, status: ERR, says: &["providesDirectionalDerivative"] },
+    Row { at: At::Stepping, what: "getDirectionalDerivative", call: |s| { let (u, k, dv, mut o) = (vr::U, vr::P, 1.0, 0.0); unsafe { api::get_directional_derivative::<Pfc>(s.c, &u, 1, &k, 1, &dv, &mut o) } }, status: ERR, says: &["providesDirectionalDerivative"] },
     // Input derivatives (4.2.1).
     Row { at: At::Stepping, what: "input derivative of order 2", call: |s| derivative(s, vr::P, 2, 1.0), status: ERR, says: &["derivative order 2 of \"p\"", "[1, 1]"] },
     Row { at: At::Stepping, what: "input derivative of an output", call: |s| derivative(s, vr::U, 1, 1.0), status: ERR, says: &["\"u\"", "derivatives can be set for u_ref, p"] },

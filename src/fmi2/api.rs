@@ -457,13 +457,32 @@ fn unsupported<M: Model>(c: fmi2Component, function: &str, rule: Rule, why: &str
     call::<M>(c, function, rule, |_| Err(format!("not supported: {why}")))
 }
 
-pub unsafe fn get_directional_derivative<M: Model>(c: fmi2Component) -> fmi2Status {
-    unsupported::<M>(
-        c,
-        "fmi2GetDirectionalDerivative",
-        allowed::DIRECTIONAL_DERIVATIVE,
-        "providesDirectionalDerivative=\"false\"",
-    )
+/// fmi2GetDirectionalDerivative (FMI 2.0, 2.1.9), for the models that provide it.
+pub unsafe fn get_directional_derivative<M: Model>(
+    c: fmi2Component,
+    unknown: *const u32,
+    n_unknown: usize,
+    known: *const u32,
+    n_known: usize,
+    dv_known: *const f64,
+    dv_unknown: *mut f64,
+) -> fmi2Status {
+    if !M::DIRECTIONAL_DERIVATIVES {
+        return unsupported::<M>(
+            c,
+            "fmi2GetDirectionalDerivative",
+            allowed::DIRECTIONAL_DERIVATIVE,
+            "providesDirectionalDerivative=\"false\"",
+        );
+    }
+    call::<M>(c, "fmi2GetDirectionalDerivative", allowed::DIRECTIONAL_DERIVATIVE, |inst| {
+        let unknowns = slice(unknown, n_unknown, "vUnknown_ref")?;
+        let knowns = slice(known, n_known, "vKnown_ref")?;
+        let seeds = slice(dv_known, n_known, "dvKnown")?;
+        let out = slice_mut(dv_unknown, n_unknown, "dvUnknown")?;
+        inst.directional_derivative(unknowns, knowns, seeds, out)?;
+        Ok(fmi2Status::OK)
+    })
 }
 
 pub unsafe fn set_real_input_derivatives<M: Model>(

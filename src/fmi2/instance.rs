@@ -281,6 +281,51 @@ impl<M: Model> Instance<M> {
         }))
     }
 
+    /// fmi2GetDirectionalDerivative: the unknowns must be outputs or (Model Exchange) `der()`
+    /// variables, the knowns Real inputs or (Model Exchange) continuous states, FMI 2.0, 2.1.9;
+    /// after initialisation.
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seeds: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let me = self.interface == Interface::ModelExchange;
+        let what = if me { "an output or a derivative" } else { "an output" };
+        for &vr in unknowns {
+            let (_, v) = self.lookup(vr, BaseType::Real)?;
+            let derivative = M::STATES.iter().any(|s| s.derivative == vr);
+            if !(v.causality == Causality::Output || (me && derivative)) {
+                return Err(format!("unknown \"{}\" (vr {vr}) is not {what} of ModelStructure", v.name));
+            }
+        }
+        let what = if me { "an input or a continuous state" } else { "an input" };
+        for (&vr, &dv) in knowns.iter().zip(seeds) {
+            let (_, v) = self.lookup(vr, BaseType::Real)?;
+            let state = M::STATES.iter().any(|s| s.state == vr);
+            if !(v.causality == Causality::Input || (me && state)) {
+                return Err(format!("known \"{}\" (vr {vr}) is not {what}", v.name));
+            }
+            if !dv.is_finite() {
+                return Err(format!("dvKnown of \"{}\" = {} is not a finite number", v.name, num(dv)));
+            }
+        }
+        if matches!(self.core.state, State::InitializationMode) {
+            return Err("directional derivatives are provided after initialisation".into());
+        }
+        let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
+        let knowns: Vec<(u32, f64)> = knowns.iter().copied().zip(seeds.iter().copied()).collect();
+        model.directional_derivative(&self.core.values, &knowns, unknowns, out)?;
+        if let Some(k) = out.iter().position(|x| !x.is_finite()) {
+            return Err(format!(
+                "the derivative of \"{}\" is not finite at these states",
+                self.name(unknowns[k]).unwrap_or("?")
+            ));
+        }
+        Ok(())
+    }
+
     /// The name of the `k`-th continuous state.
     fn state_name(&self, k: usize) -> &'static str {
         self.name(M::STATES[k].state).unwrap_or("?")

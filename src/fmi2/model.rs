@@ -114,6 +114,23 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// A non-finite value tells the importer to retry with a smaller step (fmi2Discard).
     fn derivatives(&self, values: &Values, dx: &mut [f64]);
 
+    /// Whether [`Model::directional_derivative`] is provided (`providesDirectionalDerivative`).
+    const DIRECTIONAL_DERIVATIVES: bool = false;
+
+    /// fmi2GetDirectionalDerivative at the current states and inputs: for each unknown (an
+    /// output or a `der()` variable) the sum over the knowns (states and inputs, with their
+    /// seeds) of its partial derivative times the seed, by exact forward-mode differentiation.
+    /// The FMI layer has checked the references; `Err` names what the model cannot differentiate.
+    fn directional_derivative(
+        &self,
+        _values: &Values,
+        _knowns: &[(u32, f64)],
+        _unknowns: &[u32],
+        _out: &mut [f64],
+    ) -> Result<(), String> {
+        Err("providesDirectionalDerivative=\"false\"".into())
+    }
+
     /// Writes the [`Model::EVENT_INDICATORS`] event indicators at the current states and inputs.
     fn event_indicators(&self, _values: &Values, _z: &mut [f64]) {}
 

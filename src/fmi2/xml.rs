@@ -167,7 +167,7 @@ fn write<M: Model>() -> io::Result<String> {
                 ("canNotUseMemoryManagementFunctions", flag(true)),
                 ("canGetAndSetFMUstate", flag(true)),
                 ("canSerializeFMUstate", flag(true)),
-                ("providesDirectionalDerivative", flag(false)),
+                ("providesDirectionalDerivative", flag(M::DIRECTIONAL_DERIVATIVES)),
             ];
             element(w, "ModelExchange", &me)?;
             let cs: Attrs = vec![
@@ -181,7 +181,7 @@ fn write<M: Model>() -> io::Result<String> {
                 ("canNotUseMemoryManagementFunctions", flag(true)),
                 ("canGetAndSetFMUstate", flag(true)),
                 ("canSerializeFMUstate", flag(true)),
-                ("providesDirectionalDerivative", flag(false)),
+                ("providesDirectionalDerivative", flag(M::DIRECTIONAL_DERIVATIVES)),
             ];
             element(w, "CoSimulation", &cs)?;
             w.create_element("UnitDefinitions").write_inner_content(|w| {

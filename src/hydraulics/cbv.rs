@@ -4,6 +4,7 @@
 //! flows eq. 2.58-2.59. `Q3` is positive from line 2 to line 3.
 
 use super::orifice;
+use crate::scalar::{clamp, Scalar};
 
 /// CBV parameters (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,31 +38,31 @@ impl Cbv {
 
     /// Check valve opening `u_cv = (p2 - p3 - p_cv) / p_fo,cv` (eq. 2.55), limited to
     /// [0, 1]. Its dynamics are neglected as in the thesis.
-    pub fn check_opening(&self, p2: f64, p3: f64) -> f64 {
-        ((p2 - p3 - self.p_cv) / self.p_fo_cv).clamp(0.0, 1.0)
+    pub fn check_opening<T: Scalar>(&self, p2: T, p3: T) -> T {
+        clamp((p2 - p3 - self.p_cv) / self.p_fo_cv, 0.0, 1.0)
     }
 
     /// Static opening of the load-holding valve
     /// `u_cbv = (mu_p p4 + p3 - p_set - (1 + mu_p) p_T) / p_fo,cbv` (eq. 2.56), limited to
     /// [0, 1]; the input of the lag of eq. 2.57.
-    pub fn holding_opening(&self, p3: f64, p4: f64, p_t: f64) -> f64 {
-        ((self.mu_p * p4 + p3 - self.p_set - (1.0 + self.mu_p) * p_t) / self.p_fo_cbv).clamp(0.0, 1.0)
+    pub fn holding_opening<T: Scalar>(&self, p3: T, p4: T, p_t: f64) -> T {
+        clamp((p4 * self.mu_p + p3 - self.p_set - (1.0 + self.mu_p) * p_t) / self.p_fo_cbv, 0.0, 1.0)
     }
 
     /// Rate of the load-holding valve opening, first-order lag
     /// `G_cbv(s) = 1 / (s / omega_cbv + 1)` (eq. 2.57) from the static opening `u_static` of
     /// [`Cbv::holding_opening`]: `du_cbv/dt = omega_cbv (u_static - u_cbv)`. Starting in
     /// [0, 1] the opening stays there.
-    pub fn holding_rate(&self, u_cbv: f64, u_static: f64) -> f64 {
-        self.omega_cbv * (u_static - u_cbv)
+    pub fn holding_rate<T: Scalar>(&self, u_cbv: T, u_static: T) -> T {
+        (u_static - u_cbv) * self.omega_cbv
     }
 
     /// Flow `Q3` from line 2 to line 3 (m^3/s): `K2 u_cv sqrt(p2 - p3)` for `p2 >= p3`
     /// (eq. 2.58, check valve) and `-K2 u_cbv sqrt(p3 - p2)` for `p2 < p3` (eq. 2.59,
     /// load-holding valve), with the regularised root. Both branches vanish at `p2 = p3`, so
     /// the flow is continuous. `u_cbv` is clamped to [0, 1] against solver overshoot.
-    pub fn flow(&self, u_cv: f64, u_cbv: f64, p2: f64, p3: f64, p_tr: f64) -> f64 {
-        let u = if p2 >= p3 { u_cv } else { u_cbv.clamp(0.0, 1.0) };
+    pub fn flow<T: Scalar>(&self, u_cv: T, u_cbv: T, p2: T, p3: T, p_tr: f64) -> T {
+        let u = if p2 >= p3 { u_cv } else { clamp(u_cbv, 0.0, 1.0) };
         orifice::flow(self.k2(), u, p2 - p3, p_tr)
     }
 }

@@ -21,6 +21,7 @@ use super::line::{Fluid, Lines};
 use super::pcv::Pcv;
 use super::solve::bisect;
 use super::supply::Supply;
+use crate::scalar::{max, Scalar};
 
 /// Number of continuous states.
 pub const N_STATES: usize = 6;
@@ -61,33 +62,33 @@ pub struct Circuit {
 
 /// Everything the circuit computes at one state.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Eval {
+pub struct Eval<T = f64> {
     /// State derivatives.
-    pub dx: State,
+    pub dx: [T; N_STATES],
     /// Flows `[Q1, Q2, Q3, Q4]` (m^3/s) numbered and signed as in the thesis: Q1 supply ->
     /// line 1 (PCV), Q2 valve -> line 2, Q3 line 2 -> line 3 (CBV), Q4 line 4 -> valve.
-    pub q: [f64; 4],
+    pub q: [T; 4],
     /// Leakages to tank `[Q_LP, Q_LA, Q_LB]` (m^3/s), eq. 2.46-2.48.
-    pub q_leak: [f64; 3],
+    pub q_leak: [T; 3],
     /// Main spool opening `u` (eq. 2.44).
-    pub u: f64,
+    pub u: T,
     /// PCV opening `u_pcv` (eq. 2.49).
-    pub u_pcv: f64,
+    pub u_pcv: T,
     /// Check valve opening `u_cv` (eq. 2.55).
-    pub u_cv: f64,
+    pub u_cv: T,
     /// Static load-holding opening of eq. 2.56 (the input of the lag 2.57).
-    pub u_cbv_static: f64,
+    pub u_cbv_static: T,
     /// Load-sensing pressure `p_x` (Pa).
-    pub p_x: f64,
+    pub p_x: T,
     /// Pressure force `F1 - F2` (N), eq. 2.60-2.61.
-    pub f_pressure: f64,
+    pub f_pressure: T,
     /// Friction `F_fr` (N), with the sign of `v`.
-    pub f_friction: f64,
+    pub f_friction: T,
     /// End-stop force (N).
-    pub f_stop: f64,
+    pub f_stop: T,
     /// Net force of the cylinder on the mechanics (N, positive extending):
     /// `f_pressure - f_friction + f_stop`.
-    pub force: f64,
+    pub force: T,
 }
 
 /// Why [`Circuit::equilibrium`] has no static solution.
@@ -126,7 +127,7 @@ impl Circuit {
     ///
     /// The geometric chamber volumes are kept above 10 % of the dead volume, a guard that only
     /// matters for strokes far outside the end stops.
-    pub fn evaluate(&self, s: &State, u_ref: f64, x: f64, v: f64) -> Eval {
+    pub fn evaluate<T: Scalar>(&self, s: &[T; N_STATES], u_ref: T, x: T, v: T) -> Eval<T> {
         let [p1, p2, p3, p4, x_v, u_cbv] = *s;
         let (p_s, p_t, p_tr) = (self.supply.p_s, self.supply.p_t, self.p_tr);
         let (cyl, fl, ln) = (&self.cylinder, &self.fluid, &self.lines);
@@ -143,13 +144,13 @@ impl Circuit {
         let q_p = if u >= 0.0 { q2 } else { -q4 };
 
         let (a, b) = (cyl.area_a(), cyl.area_b());
-        let v3 = (ln.v_l3 + cyl.volume_a(x)).max(ln.v_l3 + 0.1 * cyl.v_dead_a);
-        let v4 = (ln.v_l4 + cyl.volume_b(x)).max(ln.v_l4 + 0.1 * cyl.v_dead_b);
-        let mut dx = [0.0; N_STATES];
-        dx[P1] = fl.pressure_rate(p1, q1 - q_p - q_lp, ln.v_l1, 0.0, 0.0);
-        dx[P2] = fl.pressure_rate(p2, q2 - q3 - q_la, ln.v_l2, 0.0, ln.hose_compliance(ln.v_l2));
-        dx[P3] = fl.pressure_rate(p3, q3, v3, a * v, ln.hose_compliance(ln.v_l3));
-        dx[P4] = fl.pressure_rate(p4, -q4 - q_lb, v4, -b * v, ln.hose_compliance(ln.v_l4));
+        let v3 = max(cyl.volume_a(x) + ln.v_l3, ln.v_l3 + 0.1 * cyl.v_dead_a);
+        let v4 = max(cyl.volume_b(x) + ln.v_l4, ln.v_l4 + 0.1 * cyl.v_dead_b);
+        let (zero, mut dx) = (T::from(0.0), [T::from(0.0); N_STATES]);
+        dx[P1] = fl.pressure_rate(p1, q1 - q_p - q_lp, T::from(ln.v_l1), zero, 0.0);
+        dx[P2] = fl.pressure_rate(p2, q2 - q3 - q_la, T::from(ln.v_l2), zero, ln.hose_compliance(ln.v_l2));
+        dx[P3] = fl.pressure_rate(p3, q3, v3, v * a, ln.hose_compliance(ln.v_l3));
+        dx[P4] = fl.pressure_rate(p4, -q4 - q_lb, v4, v * (-b), ln.hose_compliance(ln.v_l4));
         dx[X_V] = self.dcv.spool_rate(x_v, u_ref);
         dx[U_CBV] = self.cbv.holding_rate(u_cbv, u_cbv_static);
 

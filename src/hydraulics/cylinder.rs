@@ -2,6 +2,7 @@
 //! (eq. 2.60-2.61), chamber volumes and physical end stops. Stroke `x` is 0 fully retracted and
 //! positive extending; `v = dx/dt`.
 
+use crate::scalar::{min, Scalar};
 use std::f64::consts::FRAC_PI_4;
 
 /// Penetration over which the end-stop damping fades in (m). Damping applied at zero
@@ -50,18 +51,18 @@ impl Cylinder {
 
     /// Pressure force on the rod `F1 - F2 = p3 A - p4 mu_c A` (eq. 2.60, 2.61), N,
     /// positive extending.
-    pub fn pressure_force(&self, p3: f64, p4: f64) -> f64 {
+    pub fn pressure_force<T: Scalar>(&self, p3: T, p4: T) -> T {
         p3 * self.area_a() - p4 * self.area_b()
     }
 
     /// Piston-side chamber volume `V_CH1 + A x` (m^3).
-    pub fn volume_a(&self, x: f64) -> f64 {
-        self.v_dead_a + self.area_a() * x
+    pub fn volume_a<T: Scalar>(&self, x: T) -> T {
+        x * self.area_a() + self.v_dead_a
     }
 
     /// Rod-side chamber volume `V_CH2 + mu_c A (s_c - x)` (m^3).
-    pub fn volume_b(&self, x: f64) -> f64 {
-        self.v_dead_b + self.area_b() * (self.stroke - x)
+    pub fn volume_b<T: Scalar>(&self, x: T) -> T {
+        (T::from(self.stroke) - x) * self.area_b() + self.v_dead_b
     }
 
     /// End-stop force on the rod (N, positive extending): zero inside `[0, s_c]`, pushing
@@ -72,20 +73,20 @@ impl Cylinder {
     /// contact to 1 at 0.1 mm penetration (no damping force before contact) and `r` the C1
     /// rounding of `max(0, .)` over 10 N (`r(y) = y^2 / 20 N` below 10 N). So the force is C1
     /// in `(x, v)`, exactly zero out of contact, never pulls, and finite for finite inputs.
-    pub fn end_stop_force(&self, x: f64, v: f64) -> f64 {
+    pub fn end_stop_force<T: Scalar>(&self, x: T, v: T) -> T {
         self.stop_push(-x, -v) - self.stop_push(x - self.stroke, v)
     }
 
     /// Magnitude of the contact force of one stop at penetration `d` with rate `d_dot`.
-    fn stop_push(&self, d: f64, d_dot: f64) -> f64 {
+    fn stop_push<T: Scalar>(&self, d: T, d_dot: T) -> T {
         if d <= 0.0 {
-            return 0.0;
+            return T::from(0.0);
         }
-        let s = (d / STOP_DAMPING_RAMP).min(1.0);
-        let w = s * s * (3.0 - 2.0 * s);
-        let y = self.k_stop * d + self.c_stop * w * d_dot;
+        let s = min(d / STOP_DAMPING_RAMP, 1.0);
+        let w = s * s * (T::from(3.0) - s * 2.0);
+        let y = d * self.k_stop + w * self.c_stop * d_dot;
         if y <= 0.0 {
-            0.0
+            T::from(0.0)
         } else if y < STOP_FORCE_ROUNDING {
             y * y / (2.0 * STOP_FORCE_ROUNDING)
         } else {
@@ -141,6 +142,6 @@ mod tests {
         // static stiffness deep in the stop: k d - rounding offset
         let f = c.end_stop_force(-mm(1.0), 0.0);
         assert!((f - (c.k_stop * mm(1.0) - 5.0)).abs() < 1e-6);
-        assert!(c.end_stop_force(-1e3, 1e3).is_finite());
+        assert!(c.end_stop_force(-1e3_f64, 1e3).is_finite());
     }
 }

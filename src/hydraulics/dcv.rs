@@ -8,6 +8,7 @@
 //! line 4 into the valve, as in eq. 2.40-2.43.
 
 use super::orifice;
+use crate::scalar::{clamp, max, min, Scalar};
 
 /// Main spool parameters (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,12 +44,12 @@ impl Dcv {
     /// eq. 2.44 outside the dead band, so in steady state the opening equals the reference
     /// (`u = u_ref`), as the rig's 5 % steps and Fig. 3.17/3.19 assume. `u_ref = 0` demands the
     /// neutral position; the demand jumps to `+-x_db` for any non-zero reference.
-    pub fn spool_reference(&self, u_ref: f64) -> f64 {
-        let u = u_ref.clamp(-1.0, 1.0);
+    pub fn spool_reference<T: Scalar>(&self, u_ref: T) -> T {
+        let u = clamp(u_ref, -1.0, 1.0);
         if u == 0.0 {
-            0.0
+            T::from(0.0)
         } else {
-            u.signum() * (self.x_db + u.abs() * (self.x_max - self.x_db))
+            u.signum() * (u.abs() * (self.x_max - self.x_db) + self.x_db)
         }
     }
 
@@ -57,8 +58,8 @@ impl Dcv {
     ///
     /// The thesis applies the lag to the opening (3.2.2); applying it to the spool position
     /// makes the spool cross the dead band, which delays the flow after a step as on the rig.
-    pub fn spool_rate(&self, x_v: f64, u_ref: f64) -> f64 {
-        self.omega_v * (self.spool_reference(u_ref) - x_v)
+    pub fn spool_rate<T: Scalar>(&self, x_v: T, u_ref: T) -> T {
+        (self.spool_reference(u_ref) - x_v) * self.omega_v
     }
 
     /// Main spool opening from the spool travel, eq. 2.44, branch by branch:
@@ -70,14 +71,14 @@ impl Dcv {
     ///   so `u(-x_v) = -u(x_v)` and `u(-x_max) = -1`.
     ///
     /// The opening is continuous (zero at both dead-band edges) and limited to [-1, 1].
-    pub fn opening(&self, x_v: f64) -> f64 {
+    pub fn opening<T: Scalar>(&self, x_v: T) -> T {
         let travel = self.x_max - self.x_db;
         if x_v >= self.x_db {
-            ((x_v - self.x_db) / travel).min(1.0)
+            min((x_v - self.x_db) / travel, 1.0)
         } else if x_v < -self.x_db {
-            ((x_v + self.x_db) / travel).max(-1.0)
+            max((x_v + self.x_db) / travel, -1.0)
         } else {
-            0.0
+            T::from(0.0)
         }
     }
 
@@ -85,13 +86,13 @@ impl Dcv {
     /// (section 3.2.2: "p2 or p4 depending on the direction of the main spool"). In the dead
     /// band (`u = 0`) the LS line of the closed-neutral PVG spool is drained to tank, `p_x = p_T`
     /// (the thesis does not state the neutral case).
-    pub fn ls_pressure(u: f64, p2: f64, p4: f64, p_t: f64) -> f64 {
+    pub fn ls_pressure<T: Scalar>(u: T, p2: T, p4: T, p_t: f64) -> T {
         if u > 0.0 {
             p2
         } else if u < 0.0 {
             p4
         } else {
-            p_t
+            T::from(p_t)
         }
     }
 
@@ -101,7 +102,7 @@ impl Dcv {
     ///
     /// The roots are regularised ([`orifice::reg_sqrt`]); a reversed pressure drop gives reverse
     /// flow instead of the thesis' undefined root.
-    pub fn flows(&self, u: f64, p1: f64, p2: f64, p4: f64, p_t: f64, p_tr: f64) -> [f64; 2] {
+    pub fn flows<T: Scalar>(&self, u: T, p1: T, p2: T, p4: T, p_t: f64, p_tr: f64) -> [T; 2] {
         let k1 = self.k1();
         if u >= 0.0 {
             [orifice::flow(k1, u, p1 - p2, p_tr), orifice::flow(k1, u, p4 - p_t, p_tr)]
@@ -112,8 +113,8 @@ impl Dcv {
 
     /// Laminar leakages to tank `[Q_LP, Q_LA, Q_LB]` = `dQ_L * ([p1, p2, p4] - p_T)`
     /// (eq. 2.48, 2.46, 2.47), present at every spool position as in the thesis.
-    pub fn leakages(&self, p1: f64, p2: f64, p4: f64, p_t: f64) -> [f64; 3] {
-        [p1, p2, p4].map(|p| self.dq_leak * (p - p_t))
+    pub fn leakages<T: Scalar>(&self, p1: T, p2: T, p4: T, p_t: f64) -> [T; 3] {
+        [p1, p2, p4].map(|p| (p - p_t) * self.dq_leak)
     }
 }
 

@@ -6,6 +6,7 @@
 //! a `tanh` of the velocity, so the force is smooth (C1) through `v = 0` and zero at rest.
 
 use super::cylinder::Cylinder;
+use crate::scalar::Scalar;
 
 /// Which friction law [`Friction::force`] uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -76,21 +77,21 @@ impl Friction {
     /// The thesis' 2.63 and 2.65 are magnitudes without a direction; the `tanh` factor gives
     /// them the sign of `v` as 5.4 does. Because the bracket is bounded and `tanh(0) = 0`, the
     /// product is C1 at `v = 0` although `|v|` is not.
-    pub fn force(&self, cyl: &Cylinder, v: f64, x: f64, p3: f64, p4: f64) -> f64 {
+    pub fn force<T: Scalar>(&self, cyl: &Cylinder, v: T, x: T, p3: T, p4: T) -> T {
         match self.model {
             FrictionModel::Bak => {
-                (v / self.v_s).tanh() * (cyl.area_a() * self.p_static + self.c_p_bak * cyl.pressure_force(p3, p4).abs())
+                (v / self.v_s).tanh() * (cyl.pressure_force(p3, p4).abs() * self.c_p_bak + cyl.area_a() * self.p_static)
             }
-            FrictionModel::Ottestad => (v / self.v_s).tanh() * (self.stribeck_viscous(v) + self.c_p * (p4 - p3).abs()),
-            FrictionModel::Fitted => (self.c_tan * v).tanh() * (self.stribeck_viscous(v) + x / self.c_l),
+            FrictionModel::Ottestad => (v / self.v_s).tanh() * (self.stribeck_viscous(v) + (p4 - p3).abs() * self.c_p),
+            FrictionModel::Fitted => (v * self.c_tan).tanh() * (self.stribeck_viscous(v) + x / self.c_l),
         }
     }
 
     /// Coulomb, Stribeck and viscous part shared by 2.63 and 5.4:
     /// `F_c + (F_s - F_c) exp(-|v| / v_0) + C_v |v|`.
-    fn stribeck_viscous(&self, v: f64) -> f64 {
+    fn stribeck_viscous<T: Scalar>(&self, v: T) -> T {
         let s = v.abs();
-        self.f_c + (self.f_s - self.f_c) * (-s / self.v_0).exp() + self.c_v * s
+        T::from(self.f_c) + (-s / self.v_0).exp() * (self.f_s - self.f_c) + s * self.c_v
     }
 }
 

@@ -4,6 +4,7 @@
 //!
 //! Pressures are gauge (Pa); absolute zero is `-P_ATM`.
 
+use crate::scalar::{max, Scalar};
 use crate::units::P_ATM;
 
 /// Lowest absolute pressure used inside the bulk-modulus law (Pa). Only a solver overshoot below
@@ -40,8 +41,8 @@ impl Fluid {
     /// 10 bar, -25 % at 1 bar gauge); as `p_abs -> 0` the free air expands without bound and
     /// `beta_e -> p_abs`, so `dp/dt -> 0` smoothly and a pressure never reaches absolute zero
     /// (vapour pressure of the oil is neglected against it). With `x0 = 0` it is exactly `beta`.
-    pub fn bulk_modulus(&self, p: f64) -> f64 {
-        let p_abs = (p + P_ATM).max(P_ABS_FLOOR);
+    pub fn bulk_modulus<T: Scalar>(&self, p: T) -> T {
+        let p_abs = max(p + P_ATM, P_ABS_FLOOR);
         let e = exp_small(-p / self.beta);
         let a = self.air_fraction * P_ATM;
         p_abs * (e * p_abs + a) / (e * p_abs * p_abs / self.beta + a)
@@ -56,8 +57,8 @@ impl Fluid {
     /// at its pressure, `v0 + c_wall * p`, makes the law conserve oil mass exactly: the state
     /// equation `V(p, x) = m * phi(p)` differentiated in time gives this rate with `dm/dt`
     /// equal to `q_net / phi(p)`.
-    pub fn pressure_rate(&self, p: f64, q_net: f64, v0: f64, dv_dt: f64, c_wall: f64) -> f64 {
-        let v = v0 + c_wall * p;
+    pub fn pressure_rate<T: Scalar>(&self, p: T, q_net: T, v0: T, dv_dt: T, c_wall: f64) -> T {
+        let v = v0 + p * c_wall;
         (q_net - dv_dt) / (v / self.bulk_modulus(p) + c_wall)
     }
 }
@@ -67,11 +68,11 @@ impl Fluid {
 /// two of `f64::exp` there), by `f64::exp` elsewhere. The oil's `exp(-p / beta)` only leaves the
 /// polynomial's range above 81 MPa, so the pressure rates avoid the libm call (a measurable
 /// part of every right-hand side).
-fn exp_small(x: f64) -> f64 {
+fn exp_small<T: Scalar>(x: T) -> T {
     if x.abs() <= 0.0625 {
         const C: [f64; 9] =
             [1.0, 1.0, 1.0 / 2.0, 1.0 / 6.0, 1.0 / 24.0, 1.0 / 120.0, 1.0 / 720.0, 1.0 / 5040.0, 1.0 / 40320.0];
-        C.iter().rev().fold(0.0, |acc, &c| acc * x + c)
+        C.iter().rev().fold(T::from(0.0), |acc, &c| acc * x + c)
     } else {
         x.exp()
     }
@@ -120,7 +121,7 @@ mod tests {
                 assert!((a - b).abs() <= 4.5e-16 * b, "x = {x}: {a} vs {b}");
             }
         }
-        for x in [-1.0, -0.07, 0.07, 3.0] {
+        for x in [-1.0_f64, -0.07, 0.07, 3.0] {
             assert_eq!(exp_small(x), x.exp());
         }
     }

@@ -1,6 +1,8 @@
 //! Turbulent orifice `Q = K * u * sqrt(dp)` (form of eq. 2.40-2.43, 2.50, 2.58, 2.59) with a
 //! regularised square root near `dp = 0`.
 
+use crate::scalar::Scalar;
+
 /// Flow coefficient `K = Q_nom / sqrt(dp_nom)` of an orifice that passes `q_nom` (m^3/s) at the
 /// pressure drop `dp_nom` (Pa) when fully open. This is how the thesis computes K1, K2 and K3
 /// (section 2.2.1, 2.2.2); the coefficient lumps discharge coefficient, area and density.
@@ -18,20 +20,20 @@ pub fn flow_coefficient(q_nom: f64, dp_nom: f64) -> f64 {
 /// `5 / (4 sqrt(p_tr))` at zero, a laminar-like region. Outside the band the result is the exact
 /// root, so the flow at 7 bar is unchanged as long as `p_tr < 7 bar`. Reverse flow through an
 /// open orifice (`dp < 0`) follows the same law with negative sign.
-pub fn reg_sqrt(dp: f64, p_tr: f64) -> f64 {
+pub fn reg_sqrt<T: Scalar>(dp: T, p_tr: f64) -> T {
     let a = dp.abs();
     if a >= p_tr {
         dp.signum() * a.sqrt()
     } else {
         let xi = dp / p_tr;
-        p_tr.sqrt() * xi * (5.0 - xi * xi) * 0.25
+        xi * p_tr.sqrt() * (T::from(5.0) - xi * xi) * 0.25
     }
 }
 
 /// Orifice flow `Q = K * u * reg_sqrt(dp)` (m^3/s) for flow coefficient `k`, opening `u`
 /// and pressure drop `dp` (Pa), positive in the direction of the pressure drop.
-pub fn flow(k: f64, u: f64, dp: f64, p_tr: f64) -> f64 {
-    k * u * reg_sqrt(dp, p_tr)
+pub fn flow<T: Scalar>(k: f64, u: T, dp: T, p_tr: f64) -> T {
+    u * k * reg_sqrt(dp, p_tr)
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 //! `p1 - p_x` close to the spring pressure.
 
 use super::orifice;
+use crate::scalar::{clamp, Scalar};
 
 /// PCV parameters (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,15 +28,15 @@ impl Pcv {
     /// Opening `u_pcv = 1 - (p1 - p_x - p_pcv) / p_fc,pcv` (eq. 2.49), limited to [0, 1]
     /// (the valve cannot open beyond its stops; the thesis states the law without limits).
     /// The PCV dynamics are neglected as in the thesis.
-    pub fn opening(&self, p1: f64, p_x: f64) -> f64 {
-        (1.0 - (p1 - p_x - self.p_spring) / self.p_fc).clamp(0.0, 1.0)
+    pub fn opening<T: Scalar>(&self, p1: T, p_x: T) -> T {
+        clamp(T::from(1.0) - (p1 - p_x - self.p_spring) / self.p_fc, 0.0, 1.0)
     }
 
     /// Flow from the supply into line 1, `Q1 = K3 * u_pcv * sqrt(p_s - p1)` (eq. 2.50), with
     /// the regularised root of [`orifice::reg_sqrt`] (reverse flow if `p1 > p_s`; the thesis has
     /// no check function in the compensator).
-    pub fn flow(&self, u_pcv: f64, p_s: f64, p1: f64, p_tr: f64) -> f64 {
-        orifice::flow(self.k3(), u_pcv, p_s - p1, p_tr)
+    pub fn flow<T: Scalar>(&self, u_pcv: T, p_s: f64, p1: T, p_tr: f64) -> T {
+        orifice::flow(self.k3(), u_pcv, T::from(p_s) - p1, p_tr)
     }
 }
 

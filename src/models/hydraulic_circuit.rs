@@ -15,6 +15,7 @@ use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Valu
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
+use crate::scalar::Dual64;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
@@ -240,6 +241,7 @@ impl Model for HydraulicCircuit {
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
     const EVENT_INDICATORS: usize = super::circuit::EVENT_INDICATORS;
+    const DIRECTIONAL_DERIVATIVES: bool = true;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {
         port::configurations()
@@ -265,6 +267,42 @@ impl Model for HydraulicCircuit {
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         super::circuit::event_indicators(&self.sys.circuit, self.state[circuit::X_V], values.real(vr::U_REF), z);
+    }
+
+    /// The plain port's circuit evaluated once in dual numbers, each state and input carrying
+    /// its seed: the derivatives and outputs carry the directional derivative, exact to
+    /// round-off. The TLM port's outputs are sampled at communication points: not provided.
+    fn directional_derivative(
+        &self,
+        values: &Values,
+        knowns: &[(u32, f64)],
+        unknowns: &[u32],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        if self.sys.coupling != Coupling::Plain {
+            return Err("directional derivatives are provided for the plain port (port.coupling = 0)".into());
+        }
+        let seed = |r: u32, x: f64| Dual64::new(x, knowns.iter().filter(|k| k.0 == r).map(|k| k.1).sum());
+        let c: [Dual64; N_CIRCUIT] = std::array::from_fn(|k| seed(CIRCUIT_STATES[k].state, self.state[k]));
+        let [u_ref, x, v] = [vr::U_REF, vr::X, vr::V].map(|r| seed(r, values.real(r)));
+        let e = self.sys.circuit.evaluate(&c, u_ref, x, v);
+        #[rustfmt::skip]
+        let outputs = [
+            (vr::P1, c[0]), (vr::P2, c[1]), (vr::P3, c[2]), (vr::P4, c[3]), (vr::U, e.u), (vr::U_CV, e.u_cv),
+            (vr::U_CBV, c[5]), (vr::Q1, e.q[0]), (vr::Q2, e.q[1]), (vr::Q3, e.q[2]), (vr::Q4, e.q[3]),
+            (vr::F, e.force), (vr::F_FR, e.f_friction), (vr::C_H, e.force), (port::vr::F, e.force),
+            (vr::PORT_X, x), (vr::PORT_V, v),
+        ];
+        let derivatives = CIRCUIT_STATES.iter().zip(e.dx).map(|(s, d)| (s.derivative, d));
+        let rows: Vec<(u32, Dual64)> = outputs.into_iter().chain(derivatives).collect();
+        for (o, &r) in out.iter_mut().zip(unknowns) {
+            *o = rows
+                .iter()
+                .find(|row| row.0 == r)
+                .map(|row| row.1.eps)
+                .ok_or_else(|| format!("vr {r} is not differentiated"))?;
+        }
+        Ok(())
     }
 
     /// The plain port's circuit at the stroke and velocity inputs.

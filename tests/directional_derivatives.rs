@@ -1,0 +1,152 @@
+//! fmi2GetDirectionalDerivative against central differences: at states along a Co-Simulation
+//! run, for every unknown/known pair ModelStructure declares (outputs and derivatives on states
+//! and inputs), the dual-number derivative agrees with central differences (f(k + h) - f(k - h))
+//! / 2h, Richardson-extrapolated, to 1e-6 relative, wherever the entry exceeds 1e-8 of its row's scale (entries times the knowns'
+//! nominal values or input ranges). Central differences are exact to O(h^2) only where the model
+//! is smooth over the stencil: a pair whose forward and backward quotients disagree by more than
+//! 1e-3, or whose extrapolated quotients at h and h/4 by more than 1e-7, sits at or straddles a kink
+//! (a valve opening at its limit, the dead-band edge; there the dual number gives the one-sided
+//! derivative of the branch taken) and is not compared there; the test counts them and requires
+//! most pairs to be compared.
+
+mod common;
+
+use boomsim::fmi2::api;
+use boomsim::fmi2::instance::Instance;
+use boomsim::fmi2::log::Logger;
+use boomsim::fmi2::state::Interface;
+use boomsim::fmi2::structure::{probe, unknowns};
+use boomsim::fmi2::types::*;
+use boomsim::fmi2::xml::dependencies;
+use boomsim::fmi2::{Causality, Kind, Model, Value, Values};
+use boomsim::models::vr;
+use boomsim::models::HydraulicCircuit;
+
+/// The scale of a known: a state's nominal, an input's range (bounded to 1e3 of its unit).
+fn scale<M: Model>(known: u32) -> f64 {
+    if let Some(s) = M::STATES.iter().find(|s| s.state == known) {
+        return s.nominal;
+    }
+    match M::VARIABLES.iter().find(|v| v.vr == known).map(|v| v.kind) {
+        Some(Kind::Real { min, max, .. }) => (max - min).min(1e3),
+        _ => 1.0,
+    }
+}
+
+/// The unknowns of `model` with the known `k` moved by `d` (a state or an input in `values`).
+fn moved<M: Model>(model: &M, values: &Values, k: u32, d: f64) -> Vec<(u32, f64)> {
+    let mut m = model.clone();
+    let mut v = values.clone();
+    if let Some(j) = M::STATES.iter().position(|s| s.state == k) {
+        let mut x = vec![0.0; M::STATES.len()];
+        m.continuous_states(&mut x);
+        x[j] += d;
+        m.set_continuous_states(&x).unwrap();
+    } else {
+        v.set_real(k, v.real(k) + d);
+    }
+    unknowns(&m, &v)
+}
+
+/// Checks model `M` at `samples` states of a CS run with the inputs `setup`; returns (compared,
+/// skipped at kinks).
+fn check<M: Model>(setup: &[(u32, Value)], steps: usize, samples: usize) -> (usize, usize) {
+    let deps = dependencies::<M>(&probe::<M>());
+    let log = Logger::new(None, std::ptr::null_mut(), "dd", &[], false);
+    let mut inst = Instance::<M>::new(log, boomsim::fmi2::guid::guid::<M>(), Interface::CoSimulation);
+    inst.setup_experiment(None, 0.0, None).unwrap();
+    inst.enter_initialization_mode();
+    for (r, x) in setup {
+        inst.set(&[*r], vec![x.clone()]).unwrap();
+    }
+    inst.exit_initialization_mode().unwrap();
+    let (mut compared, mut skipped, mut worst) = (0, 0, (0.0, String::new()));
+    for k in 0..steps {
+        inst.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+        if (k + 1) % (steps / samples) != 0 {
+            continue;
+        }
+        let (model, values) = (inst.core.model.clone().unwrap(), inst.core.values.clone());
+        let base = unknowns(&model, &values);
+        for (unknown, knowns) in &deps {
+            let row = base.iter().position(|u| u.0 == *unknown).unwrap();
+            // The row: dual-number derivatives, each scaled by its known's scale.
+            let dd: Vec<f64> = knowns
+                .iter()
+                .map(|&kn| {
+                    let mut o = [0.0];
+                    model.directional_derivative(&values, &[(kn, 1.0)], &[*unknown], &mut o).unwrap();
+                    o[0]
+                })
+                .collect();
+            let row_scale = knowns.iter().zip(&dd).map(|(&kn, d)| (d * scale::<M>(kn)).abs()).fold(0.0, f64::max);
+            for (&kn, &d) in knowns.iter().zip(&dd) {
+                if (d * scale::<M>(kn)).abs() <= 1e-8 * row_scale {
+                    continue;
+                }
+                let f = |h: f64| moved(&model, &values, kn, h)[row].1;
+                let central = |h: f64| (f(h) - f(-h)) / (2.0 * h);
+                // Richardson's extrapolation of the central quotient: error O(h^4), so h can be
+                // large enough (1e-4 of the scale) that round-off stays below 1e-9 of the entry.
+                let richardson = |h: f64| (4.0 * central(h / 2.0) - central(h)) / 3.0;
+                let h = 1e-4 * scale::<M>(kn);
+                let (c2, c1) = (richardson(h), richardson(h / 4.0));
+                let (fwd, bwd) = ((f(h / 10.0) - base[row].1) / (h / 10.0), (base[row].1 - f(-h / 10.0)) / (h / 10.0));
+                let smooth = (fwd - bwd).abs() <= 1e-3 * fwd.abs().max(bwd.abs());
+                if !smooth || (c1 - c2).abs() > 1e-7 * c1.abs().max(c2.abs()) {
+                    skipped += 1;
+                    continue;
+                }
+                compared += 1;
+                let err = (d - c1).abs() / d.abs();
+                if err > worst.0 {
+                    worst = (err, format!("d {} / d {} = {d} vs {c1}", name::<M>(*unknown), name::<M>(kn)));
+                }
+            }
+        }
+    }
+    assert!(worst.0 < 1e-6, "{}: relative error {:.2e} at {}", M::INFO.identifier, worst.0, worst.1);
+    (compared, skipped)
+}
+
+fn name<M: Model>(r: u32) -> &'static str {
+    M::VARIABLES.iter().find(|v| v.vr == r).map_or("?", |v| v.name)
+}
+
+#[test]
+fn hydraulic_circuit_derivatives_are_exact() {
+    let (c, s) = check::<HydraulicCircuit>(&[(vr::U_REF, Value::Real(-0.3)), (vr::V, Value::Real(-0.01))], 400, 8);
+    assert!(c > 5 * s && c > 200, "compared {c} entries, {s} at kinks");
+    eprintln!("compared {c} entries, {s} at kinks");
+    let (c, s) = check::<HydraulicCircuit>(&[(vr::U_REF, Value::Real(0.3)), (vr::V, Value::Real(0.01))], 400, 8);
+    assert!(c > 5 * s && c > 200, "compared {c} entries, {s} at kinks");
+    eprintln!("compared {c} entries, {s} at kinks");
+}
+
+/// Through the C ABI: references checked (a local is no unknown, a parameter no known), NaN
+/// seeds refused, and in Co-Simulation the knowns are inputs only.
+#[test]
+fn directional_derivative_arguments_are_checked() {
+    let s = common::Slave::<HydraulicCircuit>::initialized("dd", &[]);
+    let (p3, der_p3) = (vr::P3, HydraulicCircuit::STATES[2].derivative);
+    let x_v = vr::X_V;
+    let mut out = [f64::NAN];
+    let call = |u: u32, k: u32, dv: f64, out: &mut [f64; 1]| unsafe {
+        api::get_directional_derivative::<HydraulicCircuit>(s.c, &u, 1, &k, 1, &dv, out.as_mut_ptr())
+    };
+    assert_eq!(call(vr::F, vr::V, 1.0, &mut out), fmi2Status::OK, "{:?}", s.take_messages());
+    assert!(out[0] < 0.0, "friction opposes the velocity: {}", out[0]);
+    assert_eq!(call(x_v, vr::X, 1.0, &mut out), fmi2Status::Error);
+    assert!(
+        s.last_error().contains("\"valve.x_v\"") && s.last_error().contains("is not an output"),
+        "{}",
+        s.last_error()
+    );
+    assert_eq!(call(vr::F, p3, 1.0, &mut out), fmi2Status::Error, "a state is no known in Co-Simulation");
+    assert!(s.last_error().contains("known \"p3\""), "{}", s.last_error());
+    assert_eq!(call(der_p3, vr::X, 1.0, &mut out), fmi2Status::Error, "a derivative is no unknown in CS");
+    assert_eq!(call(vr::F, vr::X, f64::NAN, &mut out), fmi2Status::Error);
+    assert!(s.last_error().contains("dvKnown of \"cylinder.x\" = NaN"), "{}", s.last_error());
+    let param = HydraulicCircuit::VARIABLES.iter().find(|v| v.causality == Causality::Parameter).unwrap().vr;
+    assert_eq!(call(vr::F, param, 1.0, &mut out), fmi2Status::Error);
+}
