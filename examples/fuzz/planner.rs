@@ -131,7 +131,8 @@ impl Planner {
             }
             83..=84 => Op::GetBoolean { vr: Arr::Items(m.of_type(Type::Boolean).to_vec()), null_values: false },
             85..=96 => state_op(rng, s),
-            97..=98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
+            97 => plausible_directional_derivative(rng, m),
+            98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
             _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
         }
     }
@@ -160,7 +161,8 @@ impl Planner {
             78..=86 => get_reals(rng, m),
             87..=89 => Op::EnterEventMode,
             90..=94 => state_op(rng, s),
-            95..=97 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
+            95..=96 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
+            97 => plausible_directional_derivative(rng, m),
             _ => Op::GetContinuousStates { n: m.states, null: false },
         }
     }
@@ -183,6 +185,21 @@ fn state_op(rng: &mut Rng, s: &Session) -> Op {
         (6, _) if !s.states.saved.is_empty() => Op::DeSerializeFMUstate { bytes: blob(rng, s), null_state: false },
         (7, Some(l)) => Op::FreeFMUstate { state: Slot::Holding(l.ptr) },
         _ => Op::GetFMUstate { state: Slot::Holding(null_mut()) },
+    }
+}
+
+/// fmi2GetDirectionalDerivative of one to three outputs with respect to one or two Real inputs,
+/// with seeds of order one.
+fn plausible_directional_derivative(rng: &mut Rng, m: &Description) -> Op {
+    let unknowns: Vec<u32> = (0..rng.range(1, 3)).filter_map(|_| rng.choose(&m.outputs).copied()).collect();
+    let knowns: Vec<u32> =
+        (0..rng.range(1, 2)).filter_map(|_| rng.choose(&m.real_inputs)).map(|&i| m.variables[i].vr).collect();
+    let dv_known = knowns.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
+    Op::GetDirectionalDerivative {
+        unknowns: Arr::Items(unknowns),
+        knowns: Arr::Items(knowns),
+        dv_known: Arr::Items(dv_known),
+        null_dv_unknown: false,
     }
 }
 

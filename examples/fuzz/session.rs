@@ -4,7 +4,8 @@
 //!   NULL instance;
 //! - fmi2GetReal with fmi2OK or fmi2Warning wrote finite numbers only, and so did
 //!   fmi2GetContinuousStates, fmi2GetNominalsOfContinuousStates (positive, too),
-//!   fmi2GetEventIndicators and fmi2GetDerivatives (Model Exchange);
+//!   fmi2GetEventIndicators and fmi2GetDerivatives (Model Exchange), and
+//!   fmi2GetDirectionalDerivative;
 //!   fmi2GetRealStatus(fmi2LastSuccessfulTime) is the end of the last step the fuzzer saw succeed;
 //! - fmi2GetTypesPlatform is "default" and fmi2GetVersion "2.0";
 //! - the logger gets the componentEnvironment given to fmi2Instantiate, a valid status,
@@ -189,9 +190,17 @@ impl<'a> Session<'a> {
                 (Some(s), Output::State(state[0]))
             }
             Op::GetDirectionalDerivative { unknowns: u, knowns: k, dv_known, null_dv_unknown } => {
-                let (n, mut dv) = (same_len(k, dv_known), vec![0.0; u.len()]);
-                let dv = out(&mut dv, *null_dv_unknown);
-                status(f.fmi2GetDirectionalDerivative(c, u.ptr(), u.len(), k.ptr(), n, dv_known.ptr(), dv))
+                let (n, mut dv) = (same_len(k, dv_known), vec![f64::NAN; u.len()]);
+                let s = f.fmi2GetDirectionalDerivative(
+                    c,
+                    u.ptr(),
+                    u.len(),
+                    k.ptr(),
+                    n,
+                    dv_known.ptr(),
+                    out(&mut dv, *null_dv_unknown),
+                );
+                (Some(s), Output::Reals(if *null_dv_unknown { Vec::new() } else { dv }))
             }
             Op::SetRealInputDerivatives { vr, orders, values } => {
                 same_len(vr, orders);
@@ -293,6 +302,9 @@ impl<'a> Session<'a> {
             (Op::EnterContinuousTimeMode, _) if ok => self.view.phase = Phase::ContinuousTime,
             (Op::SetTime { t }, _) if ok => self.view.time = t,
             (Op::GetDerivatives { .. }, Output::Reals(v)) if ok => finite(&v, "fmi2GetDerivatives")?,
+            (Op::GetDirectionalDerivative { .. }, Output::Reals(v)) if ok => {
+                finite(&v, "fmi2GetDirectionalDerivative")?
+            }
             (Op::GetEventIndicators { .. }, Output::Reals(v)) if ok => finite(&v, "fmi2GetEventIndicators")?,
             (Op::GetContinuousStates { .. }, Output::Reals(v)) if ok => {
                 finite(&v, "fmi2GetContinuousStates")?;
