@@ -224,6 +224,16 @@ class Result:
         return variant_name(self.scenario, self.boom, self.feedback_start)
 
 
+def release(*instances):
+    """Terminates (where the state allows) and frees FMU instances."""
+    for m in instances:
+        try:
+            m.terminate()
+        except Exception:  # noqa: BLE001 - terminate after an error may be refused
+            pass
+        m.freeInstance()
+
+
 def initialize_plant(plant_f: FmuFile, plant, ctrl, scenario: dict, switch, tolerance, t_end: float):
     """Sets both instances up and into Initialization Mode, and initialises the plant with the
     scenario's start stroke, boom and parameters (either interface)."""
@@ -320,12 +330,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
         data = np.array(rows)
         rhs = plant.getReal([vp["solver.rhs_evals"]])[0]
     finally:
-        for s in (plant, ctrl):
-            try:
-                s.terminate()
-            except Exception:  # noqa: BLE001 - terminate after an error may be refused
-                pass
-            s.freeInstance()
+        release(plant, ctrl)
     return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at,
                   fb_start, counts={"rhs": int(rhs)})
 
@@ -453,12 +458,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
                 solver.reset(t)
         data = np.array(rows)
     finally:
-        for m in (plant, ctrl):
-            try:
-                m.terminate()
-            except Exception:  # noqa: BLE001 - terminate after an error may be refused
-                pass
-            m.freeInstance()
+        release(plant, ctrl)
     return Result(scenario, boom, 1e-3, False, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at, fb_start,
                   counts=counts, interface=f"Model Exchange, CVode rtol {tolerance:g}")
 

@@ -6,9 +6,9 @@
 //! every configuration that changes its equations (port coupling, rigid/flexible), and a
 //! dependency must show in at least one of them.
 
+mod common;
+
 use boomsim::fmi2::instance::Instance;
-use boomsim::fmi2::log::Logger;
-use boomsim::fmi2::state::Interface;
 use boomsim::fmi2::variables::BaseType;
 use boomsim::fmi2::xml::initial_dependencies;
 use boomsim::fmi2::{Causality, Initial, Kind, Model, Value};
@@ -19,14 +19,7 @@ use std::collections::{BTreeMap, BTreeSet};
 type Deps = BTreeMap<&'static str, BTreeSet<&'static str>>;
 
 fn instance<M: Model>(setup: &[(u32, Value)]) -> Instance<M> {
-    let log = Logger::new(None, std::ptr::null_mut(), "deps", &[], false);
-    let mut i = Instance::<M>::new(log, boomsim::fmi2::guid::guid::<M>(), Interface::CoSimulation);
-    i.setup_experiment(None, 0.0, None).unwrap();
-    i.enter_initialization_mode();
-    for (r, x) in setup {
-        i.set(&[*r], vec![x.clone()]).unwrap();
-    }
-    i
+    common::in_initialization::<M>(setup)
 }
 
 /// Every Real the importer reads as an unknown (outputs; in Initialization Mode the initial

@@ -12,9 +12,6 @@
 mod common;
 
 use boomsim::fmi2::api;
-use boomsim::fmi2::instance::Instance;
-use boomsim::fmi2::log::Logger;
-use boomsim::fmi2::state::Interface;
 use boomsim::fmi2::structure::{probe, unknowns};
 use boomsim::fmi2::types::*;
 use boomsim::fmi2::xml::dependencies;
@@ -52,13 +49,7 @@ fn moved<M: Model>(model: &M, values: &Values, k: u32, d: f64) -> Vec<(u32, f64)
 /// skipped at kinks).
 fn check<M: Model>(setup: &[(u32, Value)], steps: usize, samples: usize) -> (usize, usize) {
     let deps = dependencies::<M>(&probe::<M>());
-    let log = Logger::new(None, std::ptr::null_mut(), "dd", &[], false);
-    let mut inst = Instance::<M>::new(log, boomsim::fmi2::guid::guid::<M>(), Interface::CoSimulation);
-    inst.setup_experiment(None, 0.0, None).unwrap();
-    inst.enter_initialization_mode();
-    for (r, x) in setup {
-        inst.set(&[*r], vec![x.clone()]).unwrap();
-    }
+    let mut inst = common::in_initialization::<M>(setup);
     inst.exit_initialization_mode().unwrap();
     let (mut compared, mut skipped, mut worst) = (0, 0, (0.0, String::new()));
     for k in 0..steps {

@@ -201,3 +201,17 @@ pub fn serialized<M: Model>(s: &Slave<M>) -> Vec<u8> {
         b
     }
 }
+
+/// A silent in-process Co-Simulation instance of `M` in Initialization Mode with the values of
+/// `setup` set (the safe Rust API under the C ABI).
+pub fn in_initialization<M: Model>(setup: &[(u32, boomsim::fmi2::Value)]) -> boomsim::fmi2::instance::Instance<M> {
+    use boomsim::fmi2::{instance::Instance, log::Logger, state::Interface};
+    let log = Logger::new(None, std::ptr::null_mut(), "test", &[], false);
+    let mut i = Instance::<M>::new(log, guid::<M>(), Interface::CoSimulation);
+    i.setup_experiment(None, 0.0, None).unwrap();
+    i.enter_initialization_mode();
+    for (r, x) in setup {
+        i.set(&[*r], vec![x.clone()]).unwrap();
+    }
+    i
+}
