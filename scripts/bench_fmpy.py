@@ -3,16 +3,22 @@
 
 import math
 import pathlib
+import sys
 import time
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+import cosim  # noqa: E402
 
 
 def main(n=20000):
-    path = str(ROOT / "target" / "fmu" / "PressureFeedbackController.fmu")
+    path = ROOT / "target" / "fmu" / "PressureFeedbackController.fmu"
+    if not path.exists():
+        raise cosim.UsageError(f"{path} is missing: run `cargo build --release && target/release/boomsim pack`")
+    path = str(path)
     md = read_model_description(path)
     vr = {v.name: v.valueReference for v in md.modelVariables}
     s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier=md.coSimulation.modelIdentifier)
@@ -33,4 +39,4 @@ def main(n=20000):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cosim.cli(main))
