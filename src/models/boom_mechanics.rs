@@ -17,6 +17,7 @@ use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Valu
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
+use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
@@ -218,9 +219,10 @@ impl Model for BoomMechanics {
         let b = self.sys.boom.mechanics();
         let (q, qd) = self.state.split_at(b.dof());
         let f = values.real(vr::F);
-        let mut qdd = vec![0.0; b.dof()];
-        b.accelerations(q, qd, &mut |x, v| f + self.sys.cylinder.end_stop_force(x, v), &mut qdd);
-        self.sys.boom.me_derivatives(q, qd, &qdd, dx);
+        let mut qdd = [0.0; MAX_SECTIONS];
+        let qdd = &mut qdd[..b.dof()];
+        b.accelerations(q, qd, &mut |x, v| f + self.sys.cylinder.end_stop_force(x, v), qdd);
+        self.sys.boom.me_derivatives(q, qd, qdd, dx);
     }
 
     /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).

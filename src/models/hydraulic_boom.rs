@@ -19,6 +19,7 @@ use super::table::{
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
+use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
@@ -215,8 +216,10 @@ impl Model for HydraulicBoom {
     }
 
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {
-        let mut ds = vec![0.0; self.state.len()];
-        self.plant.rhs_with(values.real(vr::U_REF), &self.state, &mut ds);
+        // No allocation: Model Exchange calls this for every right-hand side of its integrator.
+        let mut ds = [0.0; N_CIRCUIT + 2 * MAX_SECTIONS];
+        let ds = &mut ds[..self.state.len()];
+        self.plant.rhs_with(values.real(vr::U_REF), &self.state, ds);
         let dof = self.plant.boom.mechanics().dof();
         let (q, qd) = self.state[N_CIRCUIT..].split_at(dof);
         dx[..N_CIRCUIT].copy_from_slice(&ds[..N_CIRCUIT]);
