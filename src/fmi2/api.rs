@@ -650,13 +650,7 @@ pub unsafe fn get_event_indicators<M: Model>(c: fmi2Component, z: *mut f64, ni: 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
     call::<M>(c, "fmi2GetNominalsOfContinuousStates", allowed::GET_NOMINALS, |_| {
         let out = slice_mut(x, nx, "x_nominal")?;
-        if nx != M::STATES.len() {
-            return Err(format!(
-                "nx = {nx}, but {} has {} (modelDescription.xml)",
-                M::INFO.identifier,
-                M::STATES.len()
-            ));
-        }
+        Instance::<M>::check_states(nx)?;
         out.iter_mut().zip(M::STATES).for_each(|(o, s)| *o = s.nominal);
         Ok(fmi2Status::OK)
     })

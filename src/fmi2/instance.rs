@@ -220,18 +220,32 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// The number of continuous states checked against the importer's `nx`.
-    fn check_count(what: &str, n: usize, expected: usize) -> Result<(), String> {
+    /// The importer's `nx` against the number of continuous states.
+    pub(crate) fn check_states(nx: usize) -> Result<(), String> {
+        Self::check_count("nx", nx, M::STATES.len(), "continuous states")
+    }
+
+    /// An array length the importer announces (`what` = `n`) against the model's `expected` `of`.
+    fn check_count(what: &str, n: usize, expected: usize, of: &str) -> Result<(), String> {
         if n == expected {
             return Ok(());
         }
-        let of = if what == "ni" { "event indicators" } else { "continuous states" };
         Err(format!("{what} = {n}, but {} has {expected} {of} (modelDescription.xml)", M::INFO.identifier))
+    }
+
+    /// `f` of the model: the one built at initialisation, or in Initialization Mode one built from
+    /// the values set so far (the one fmi2ExitInitializationMode would start from).
+    fn with_model<R>(&self, f: impl FnOnce(&M, &Values) -> R) -> Result<R, String> {
+        let c = &self.core;
+        match &c.model {
+            Some(model) if c.state != State::InitializationMode => Ok(f(model, &c.values)),
+            _ => Ok(f(&M::initialize(&c.values)?, &c.values)),
+        }
     }
 
     /// fmi2SetContinuousStates: all or nothing.
     pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
-        Self::check_count("nx", x.len(), M::STATES.len())?;
+        Self::check_states(x.len())?;
         if let Some(k) = x.iter().position(|x| !x.is_finite()) {
             return Err(format!("{} = {} is not a finite number", self.state_name(k), num(x[k])));
         }
@@ -248,27 +262,19 @@ impl<M: Model> Instance<M> {
 
     /// fmi2GetContinuousStates (in Initialization Mode: those the values set so far give).
     pub fn continuous_states(&mut self, x: &mut [f64]) -> Result<(), String> {
-        Self::check_count("nx", x.len(), M::STATES.len())?;
-        match &self.core.model {
-            Some(model) if self.core.state != State::InitializationMode => model.continuous_states(x),
-            _ => M::initialize(&self.core.values)?.continuous_states(x),
-        }
-        Ok(())
+        Self::check_states(x.len())?;
+        self.with_model(|m, _| m.continuous_states(x))
     }
 
     /// fmi2GetEventIndicators (in Initialization Mode: those the values set so far give).
     pub fn event_indicators(&mut self, z: &mut [f64]) -> Result<(), String> {
-        Self::check_count("ni", z.len(), M::EVENT_INDICATORS)?;
-        match &self.core.model {
-            Some(model) if self.core.state != State::InitializationMode => model.event_indicators(&self.core.values, z),
-            _ => M::initialize(&self.core.values)?.event_indicators(&self.core.values, z),
-        }
-        Ok(())
+        Self::check_count("ni", z.len(), M::EVENT_INDICATORS, "event indicators")?;
+        self.with_model(|m, values| m.event_indicators(values, z))
     }
 
     /// fmi2GetDerivatives. `Ok(Some(why))`: not finite at these states (fmi2Discard).
     pub fn derivatives(&mut self, dx: &mut [f64]) -> Result<Warning, String> {
-        Self::check_count("nx", dx.len(), M::STATES.len())?;
+        Self::check_states(dx.len())?;
         let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
         model.derivatives(&self.core.values, dx);
         Ok(dx.iter().position(|d| !d.is_finite()).map(|k| {
@@ -294,9 +300,8 @@ impl<M: Model> Instance<M> {
         let me = self.interface == Interface::ModelExchange;
         let what = if me { "an output or a derivative" } else { "an output" };
         for &vr in unknowns {
-            let (_, v) = self.lookup(vr, BaseType::Real)?;
-            let derivative = M::STATES.iter().any(|s| s.derivative == vr);
-            if !(v.causality == Causality::Output || (me && derivative)) {
+            let (i, v) = self.lookup(vr, BaseType::Real)?;
+            if !(v.causality == Causality::Output || (me && self.derivative_rows[i])) {
                 return Err(format!("unknown \"{}\" (vr {vr}) is not {what} of ModelStructure", v.name));
             }
         }
@@ -351,16 +356,12 @@ impl<M: Model> Instance<M> {
     /// Writes the `der()` variables from the current states and inputs (in Initialization Mode,
     /// those the values set so far give).
     fn refresh_derivatives(&mut self) -> Result<(), String> {
-        let c = &mut self.core;
         let mut dx = vec![0.0; M::STATES.len()];
-        match &c.model {
-            Some(model) if c.state != State::InitializationMode => model.derivatives(&c.values, &mut dx),
-            _ => M::initialize(&c.values)?.derivatives(&c.values, &mut dx),
-        }
+        self.with_model(|m, values| m.derivatives(values, &mut dx))?;
         for (s, d) in M::STATES.iter().zip(dx) {
-            c.values.set_real(s.derivative, d);
+            self.core.values.set_real(s.derivative, d);
         }
-        c.derivatives_current = true;
+        self.core.derivatives_current = true;
         Ok(())
     }
 

@@ -159,30 +159,26 @@ fn write<M: Model>() -> io::Result<String> {
         .with_attributes(root.iter().map(|(k, v)| (*k, v.as_str())))
         .write_inner_content(|w| {
             let flag = |b: bool| b.to_string();
-            let me: Attrs = vec![
-                ("modelIdentifier", info.identifier.into()),
-                ("needsExecutionTool", flag(false)),
-                ("completedIntegratorStepNotNeeded", flag(true)),
-                ("canBeInstantiatedOnlyOncePerProcess", flag(false)),
-                ("canNotUseMemoryManagementFunctions", flag(true)),
-                ("canGetAndSetFMUstate", flag(true)),
-                ("canSerializeFMUstate", flag(true)),
-                ("providesDirectionalDerivative", flag(M::DIRECTIONAL_DERIVATIVES)),
-            ];
-            element(w, "ModelExchange", &me)?;
-            let cs: Attrs = vec![
-                ("modelIdentifier", info.identifier.into()),
-                ("needsExecutionTool", flag(false)),
+            // The capabilities both interfaces share, around each one's own (schema order).
+            let interface = |own: Attrs| -> Attrs {
+                let head: Attrs =
+                    vec![("modelIdentifier", info.identifier.into()), ("needsExecutionTool", flag(false))];
+                let tail: Attrs = vec![
+                    ("canBeInstantiatedOnlyOncePerProcess", flag(false)),
+                    ("canNotUseMemoryManagementFunctions", flag(true)),
+                    ("canGetAndSetFMUstate", flag(true)),
+                    ("canSerializeFMUstate", flag(true)),
+                    ("providesDirectionalDerivative", flag(M::DIRECTIONAL_DERIVATIVES)),
+                ];
+                [head, own, tail].concat()
+            };
+            element(w, "ModelExchange", &interface(vec![("completedIntegratorStepNotNeeded", flag(true))]))?;
+            let cs = interface(vec![
                 ("canHandleVariableCommunicationStepSize", flag(true)),
                 ("canInterpolateInputs", flag(info.can_interpolate_inputs())),
                 ("maxOutputDerivativeOrder", "0".into()),
                 ("canRunAsynchronuously", flag(false)),
-                ("canBeInstantiatedOnlyOncePerProcess", flag(false)),
-                ("canNotUseMemoryManagementFunctions", flag(true)),
-                ("canGetAndSetFMUstate", flag(true)),
-                ("canSerializeFMUstate", flag(true)),
-                ("providesDirectionalDerivative", flag(M::DIRECTIONAL_DERIVATIVES)),
-            ];
+            ]);
             element(w, "CoSimulation", &cs)?;
             w.create_element("UnitDefinitions").write_inner_content(|w| {
                 for u in used_units::<M>() {
