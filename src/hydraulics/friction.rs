@@ -6,7 +6,7 @@
 //! a `tanh` of the velocity, so the force is smooth (C1) through `v = 0` and zero at rest.
 
 use super::cylinder::Cylinder;
-use crate::scalar::Scalar;
+use crate::scalar::{tanh, Scalar};
 
 /// Which friction law [`Friction::force`] uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,10 +80,10 @@ impl Friction {
     pub fn force<T: Scalar>(&self, cyl: &Cylinder, v: T, x: T, p3: T, p4: T) -> T {
         match self.model {
             FrictionModel::Bak => {
-                (v / self.v_s).tanh() * (cyl.pressure_force(p3, p4).abs() * self.c_p_bak + cyl.area_a() * self.p_static)
+                tanh(v / self.v_s) * (cyl.pressure_force(p3, p4).abs() * self.c_p_bak + cyl.area_a() * self.p_static)
             }
-            FrictionModel::Ottestad => (v / self.v_s).tanh() * (self.stribeck_viscous(v) + (p4 - p3).abs() * self.c_p),
-            FrictionModel::Fitted => (v * self.c_tan).tanh() * (self.stribeck_viscous(v) + x / self.c_l),
+            FrictionModel::Ottestad => tanh(v / self.v_s) * (self.stribeck_viscous(v) + (p4 - p3).abs() * self.c_p),
+            FrictionModel::Fitted => tanh(v * self.c_tan) * (self.stribeck_viscous(v) + x / self.c_l),
         }
     }
 

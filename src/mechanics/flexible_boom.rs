@@ -80,7 +80,8 @@ use nalgebra::{DMatrix, DVector, Vector2};
 use super::kinematics::{law_of_cosines, Triangle};
 use super::params::{BeamParams, BoomParams};
 use super::rigid_boom::RigidBoom;
-use super::{BoomMechanics, Energy, Equilibrium, MechanicsError};
+use super::{BoomMechanics, Energy, Equilibrium, Kinetics, MechanicsError};
+use crate::scalar::Scalar;
 
 /// Most sections the chain may have: max(n2, 1) + n3.
 pub const MAX_SECTIONS: usize = 32;
@@ -120,36 +121,37 @@ pub struct FlexibleBoom {
 
 /// The cylinder pin C: position, unit vector and length of A -> C (C = B + sum_j r_j over the
 /// sections up to the mount, each lever r_j turning with q_j; see [`FlexibleBoom::lever`]).
-struct Pin {
-    c: Vector2<f64>,
-    u: Vector2<f64>,
-    l: f64,
+struct Pin<T: Scalar> {
+    c: Vector2<T>,
+    u: Vector2<T>,
+    l: T,
 }
 
 /// What the backward sweep keeps of section j for the forward sweep: h_j / d_j and e_j / d_j
 /// (module documentation).
-#[derive(Debug, Clone, Copy, Default)]
-struct Sweep {
-    h: Vector2<f64>,
-    e: f64,
+#[derive(Debug, Clone, Copy)]
+struct Sweep<T> {
+    hx: T,
+    hy: T,
+    e: T,
 }
 
 /// Sine and cosine of the section angles (the first n, or the first n_ii for the pin alone).
-struct Trig {
-    s: Column,
-    c: Column,
+struct Trig<T> {
+    s: [T; MAX_SECTIONS],
+    c: [T; MAX_SECTIONS],
 }
 
 /// sin and cos of |d| <= [`SMALL_ANGLE`] by their Taylor series to d^9 and d^10 (Horner in
 /// d^2): the first omitted terms, d^11 / 11! and d^12 / 12!, are below 3e-18 of the result there,
 /// under a fortieth of an ulp.
-fn sin_cos_small(d: f64) -> (f64, f64) {
+fn sin_cos_small<T: Scalar>(d: T) -> (T, T) {
     const SIN: [f64; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362880.0];
     const COS: [f64; 5] = [-1.0 / 2.0, 1.0 / 24.0, -1.0 / 720.0, 1.0 / 40320.0, -1.0 / 3628800.0];
     let z = d * d;
-    let s = SIN.iter().rev().fold(0.0, |acc, k| z * (k + acc));
-    let c = COS.iter().rev().fold(0.0, |acc, k| z * (k + acc));
-    (d + d * s, 1.0 + c)
+    let s = SIN.iter().rev().fold(T::from(0.0), |acc, &k| z * (acc + k));
+    let c = COS.iter().rev().fold(T::from(0.0), |acc, &k| z * (acc + k));
+    (d + d * s, c + 1.0)
 }
 
 /// Largest angle difference evaluated by [`sin_cos_small`] (the beam's deflections are
@@ -157,8 +159,18 @@ fn sin_cos_small(d: f64) -> (f64, f64) {
 const SMALL_ANGLE: f64 = 0.1;
 
 /// `v` turned by +90 deg: the derivative of a rotating vector with respect to its angle.
-fn perp(v: Vector2<f64>) -> Vector2<f64> {
+fn perp<T: Scalar>(v: Vector2<T>) -> Vector2<T> {
     Vector2::new(-v.y, v.x)
+}
+
+/// |v|, as nalgebra's `norm` (the square root of the dot product) for any [`Scalar`].
+fn norm<T: Scalar>(v: Vector2<T>) -> T {
+    v.dot(&v).sqrt()
+}
+
+/// The constant vector `v` in the number type `T`.
+fn lift<T: Scalar>(v: Vector2<f64>) -> Vector2<T> {
+    Vector2::new(T::from(v.x), T::from(v.y))
 }
 
 /// Series combination of two springs or dampers (2.35, 2.38); infinity is a rigid side.
@@ -260,7 +272,7 @@ impl FlexibleBoom {
         &self.rigid
     }
 
-    fn trig(&self, q: &[f64]) -> Trig {
+    fn trig<T: Scalar>(&self, q: &[T]) -> Trig<T> {
         self.trig_to(q, self.n)
     }
 
@@ -268,7 +280,7 @@ impl FlexibleBoom {
     /// deflection, so one library `sin_cos` of q[0] and the rotation by the small difference
     /// d = q[i] - q[0] ([`sin_cos_small`]) give them to an ulp or two; a difference beyond
     /// [`SMALL_ANGLE`] takes the library call.
-    fn trig_to(&self, q: &[f64], m: usize) -> Trig {
+    fn trig_to<T: Scalar>(&self, q: &[T], m: usize) -> Trig<T> {
         let mut t = self.relative_trig(q, m);
         let (s0, c0) = q[0].sin_cos();
         for (s, c) in t.s[..m].iter_mut().zip(&mut t.c[..m]) {
@@ -278,9 +290,9 @@ impl FlexibleBoom {
     }
 
     /// sin and cos of the first `m` angles relative to the first, q[i] - q[0].
-    fn relative_trig(&self, q: &[f64], m: usize) -> Trig {
-        let mut t = Trig { s: [0.0; MAX_SECTIONS], c: [0.0; MAX_SECTIONS] };
-        for (i, a) in q[..m].iter().enumerate() {
+    fn relative_trig<T: Scalar>(&self, q: &[T], m: usize) -> Trig<T> {
+        let mut t = Trig { s: [T::from(0.0); MAX_SECTIONS], c: [T::from(0.0); MAX_SECTIONS] };
+        for (i, &a) in q[..m].iter().enumerate() {
             let d = a - q[0];
             (t.s[i], t.c[i]) = if d.abs() <= SMALL_ANGLE { sin_cos_small(d) } else { d.sin_cos() };
         }
@@ -289,28 +301,28 @@ impl FlexibleBoom {
 
     /// The lever r_j of section j <= n_ii - 1 towards the pin C: the section itself, or for the
     /// last section of part II its inner node -> C.
-    fn lever(&self, t: &Trig, j: usize) -> Vector2<f64> {
+    fn lever<T: Scalar>(&self, t: &Trig<T>, j: usize) -> Vector2<T> {
         let (s, c) = (t.s[j], t.c[j]);
         if j + 1 < self.n_ii {
-            self.len[j] * Vector2::new(c, s)
+            Vector2::new(c * self.len[j], s * self.len[j])
         } else {
             Vector2::new(c * self.pin.x - s * self.pin.y, s * self.pin.x + c * self.pin.y)
         }
     }
 
-    fn pin_of(&self, t: &Trig) -> Pin {
-        let c = (0..self.n_ii).fold(self.b, |c, j| c + self.lever(t, j));
-        let l = c.norm();
+    fn pin_of<T: Scalar>(&self, t: &Trig<T>) -> Pin<T> {
+        let c = (0..self.n_ii).fold(lift(self.b), |c, j| c + self.lever(t, j));
+        let l = norm(c);
         Pin { c, u: c / l, l }
     }
 
     /// Velocity of the pin C.
-    fn pin_velocity(&self, t: &Trig, qd: &[f64]) -> Vector2<f64> {
+    fn pin_velocity<T: Scalar>(&self, t: &Trig<T>, qd: &[T]) -> Vector2<T> {
         (0..self.n_ii).fold(Vector2::zeros(), |v, j| v + perp(self.lever(t, j)) * qd[j])
     }
 
     /// Generalised forces of gravity, springs and dampers.
-    fn forces(&self, q: &[f64], qd: &[f64], t: &Trig, out: &mut [f64]) {
+    fn forces(&self, q: &[f64], qd: &[f64], t: &Trig<f64>, out: &mut [f64]) {
         for (i, o) in out[..self.n].iter_mut().enumerate() {
             let s = self.first[i];
             *o = -self.g * ((self.m_out[i] * self.len[i] + s.x) * t.c[i] - s.y * t.s[i]);
@@ -323,7 +335,7 @@ impl FlexibleBoom {
     }
 
     /// Cylinder length |A C| for the section angles `q`.
-    pub fn l_cyl(&self, q: &[f64]) -> f64 {
+    pub fn l_cyl<T: Scalar>(&self, q: &[T]) -> T {
         self.pin_of(&self.trig_to(q, self.n_ii)).l
     }
 
@@ -334,20 +346,21 @@ impl FlexibleBoom {
     }
 
     /// [`Self::point`] with the sections' sin and cos.
-    fn point_at(&self, t: &Trig, x_a: f64) -> Vector2<f64> {
+    fn point_at<T: Scalar>(&self, t: &Trig<T>, x_a: f64) -> Vector2<T> {
         let i = self.section_at(x_a);
-        let node = (0..i).fold(self.b, |r, j| r + self.len[j] * Vector2::new(t.c[j], t.s[j]));
-        node + (x_a - self.start[i]) * Vector2::new(t.c[i], t.s[i])
+        let node = (0..i).fold(lift(self.b), |r, j| r + Vector2::new(t.c[j] * self.len[j], t.s[j] * self.len[j]));
+        let d = x_a - self.start[i];
+        node + Vector2::new(t.c[i] * d, t.s[i] * d)
     }
 
     /// Deflection of the arm's end normal to the rigid boom's centre line at the same cylinder
     /// length, positive up in the boom frame (the sign of v in 2.22).
-    pub fn tip_deflection(&self, q: &[f64]) -> f64 {
+    pub fn tip_deflection<T: Scalar>(&self, q: &[T]) -> T {
         let t = self.trig(q);
         let theta2 = self.triangle.theta2(self.pin_of(&t).l);
         let end = self.start[self.n - 1] + self.len[self.n - 1];
         let (s, c) = theta2.sin_cos();
-        Vector2::new(-s, c).dot(&(self.point_at(&t, end) - self.b))
+        Vector2::new(-s, c).dot(&(self.point_at(&t, end) - lift(self.b)))
     }
 
     /// Section angles for the spring deflections `delta` (q[i + 1] - q[i]) at cylinder length
@@ -421,68 +434,65 @@ impl FlexibleBoom {
     }
 }
 
-impl BoomMechanics for FlexibleBoom {
-    fn dof(&self) -> usize {
-        self.n
-    }
-
-    fn stroke(&self, q: &[f64]) -> f64 {
+impl<T: Scalar> Kinetics<T> for FlexibleBoom {
+    fn stroke(&self, q: &[T]) -> T {
         self.l_cyl(q) - self.l_retracted
     }
 
-    fn stroke_rate(&self, q: &[f64], qd: &[f64]) -> f64 {
+    fn stroke_rate(&self, q: &[T], qd: &[T]) -> T {
         let t = self.trig_to(q, self.n_ii);
         self.pin_of(&t).u.dot(&self.pin_velocity(&t, qd))
     }
 
     /// The articulated-body sweeps of the module documentation, in the frame turned by q_0
     /// (where a vector is written (x, y) below, it is in that frame).
-    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64, out: &mut [f64]) {
+    fn accelerations(&self, q: &[T], qd: &[T], f_cyl: &mut dyn FnMut(T, T) -> T, out: &mut [T]) {
+        let zero = T::from(0.0);
         let n = self.n;
         let p = self.n_ii - 1;
         let t = self.relative_trig(q, n);
         let (s0, c0) = q[0].sin_cos();
         // Gravity g_vec and the joint B (from A) turned by -q_0.
-        let (gx, gy) = (-self.g * s0, -self.g * c0);
+        let (gx, gy) = (s0 * -self.g, c0 * -self.g);
         let b0 = Vector2::new(c0 * self.b.x + s0 * self.b.y, c0 * self.b.y - s0 * self.b.x);
         let pin = (0..self.n_ii).fold(b0, |c, j| c + self.lever(&t, j));
-        let l = pin.norm();
+        let l = norm(pin);
         let u = pin / l;
         let c_dot = self.pin_velocity(&t, qd);
         let l_dot = u.dot(&c_dot);
         // F_rod: g_acc sin(theta1) = -u . g_vec.
         let f_rod = f_cyl(l - self.l_retracted, l_dot)
-            - self.m_rod * ((c_dot.norm_squared() - l_dot * l_dot) / l - (u.x * gx + u.y * gy));
-        let mut sweep = [Sweep::default(); MAX_SECTIONS];
+            - ((c_dot.dot(&c_dot) - l_dot * l_dot) / l - (u.x * gx + u.y * gy)) * self.m_rod;
+        let mut sweep = [Sweep { hx: zero, hy: zero, e: zero }; MAX_SECTIONS];
         // K_(j+1) and b_(j+1); zero beyond the free end.
-        let (mut kxx, mut kxy, mut kyy, mut bx, mut by) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut kxx, mut kxy, mut kyy, mut bx, mut by) = (zero, zero, zero, zero, zero);
         // Torque of the joint j, j + 1 on section j (outboard minus inboard neighbour).
-        let mut tau_out = 0.0;
+        let mut tau_out = zero;
         for j in (0..n).rev() {
             let (s, c, l) = (t.s[j], t.c[j], self.len[j]);
             // r_j = (x, y), S_j = (sx, sy).
-            let (x, y) = (l * c, l * s);
+            let (x, y) = (c * l, s * l);
             let f = self.first[j];
             let (sx, sy) = (c * f.x - s * f.y, s * f.x + c * f.y);
             let w2 = qd[j] * qd[j];
             let tau_in =
-                if j > 0 { self.k[j - 1] * (q[j] - q[j - 1]) + self.c[j - 1] * (qd[j] - qd[j - 1]) } else { 0.0 };
+                if j > 0 { (q[j] - q[j - 1]) * self.k[j - 1] + (qd[j] - qd[j - 1]) * self.c[j - 1] } else { zero };
             // K perp(r); d = J + perp(r)^T K perp(r) from the squares (off the K -> d path).
             let (kpx, kpy) = (kxy * x - kxx * y, kyy * x - kxy * y);
-            let mut d = self.second[j] + (y * y) * kxx + ((x * x) * kyy - (2.0 * x * y) * kxy);
+            let mut d = (y * y) * kxx + self.second[j] + ((x * x) * kyy - (x * 2.0 * y) * kxy);
             let (mut hx, mut hy) = (kpx - sy, kpy + sx);
             let (betax, betay) = (bx - w2 * (kxx * x + kxy * y), by - w2 * (kxy * x + kyy * y));
             let m = self.mass[j];
             // e without the perp(r) . beta term, and b without beta and h e / d.
             let mut e0 = tau_out - tau_in + (sx * gy - sy * gx);
-            let (mut fx, mut fy) = (-w2 * sx - m * gx, -w2 * sy - m * gy);
+            let (mut fx, mut fy) = (-w2 * sx - gx * m, -w2 * sy - gy * m);
             let (mut ixx, mut ixy, mut iyy) = (kxx + m, kxy, kyy + m);
             if j == p {
                 let rho = self.lever(&t, p);
                 let lever = u.dot(&perp(rho));
                 let load = f_rod + w2 * self.m_rod * u.dot(&rho);
-                let mu = self.m_rod * u;
-                d += self.m_rod * lever * lever;
+                let mu = Vector2::new(u.x * self.m_rod, u.y * self.m_rod);
+                d += lever * self.m_rod * lever;
                 hx += lever * mu.x;
                 hy += lever * mu.y;
                 e0 += lever * load;
@@ -492,39 +502,45 @@ impl BoomMechanics for FlexibleBoom {
                 ixy += mu.x * u.y;
                 iyy += mu.y * u.y;
             }
-            let inv_d = 1.0 / d;
+            let inv_d = T::from(1.0) / d;
             let (hdx, hdy) = (hx * inv_d, hy * inv_d);
             (kxx, kxy, kyy) = (ixx - hx * hdx, ixy - hx * hdy, iyy - hy * hdy);
             let ed = (e0 - (x * betay - y * betax)) * inv_d;
             // b = beta + (fx, fy) + h e / d, written as a linear map of beta (shorter b -> b path).
             (bx, by) = (
-                (betax * (1.0 + hdx * y) - betay * (hdx * x)) + (fx + hdx * e0),
-                (betay * (1.0 - hdy * x) + betax * (hdy * y)) + (fy + hdy * e0),
+                (betax * (hdx * y + 1.0) - betay * (hdx * x)) + (fx + hdx * e0),
+                (betay * (-(hdy * x) + 1.0) + betax * (hdy * y)) + (fy + hdy * e0),
             );
-            sweep[j] = Sweep { h: Vector2::new(hdx, hdy), e: ed };
+            sweep[j] = Sweep { hx: hdx, hy: hdy, e: ed };
             tau_out = tau_in;
         }
         // a_(j+1) = a_j + q_ddot_j perp(r_j) - q_dot_j^2 r_j with q_ddot_j = (e - h . a_j) / d, as
         // the map a_(j+1) = (I - perp(r_j) (h / d)^T) a_j + (e / d) perp(r_j) - q_dot_j^2 r_j.
-        let (mut ax, mut ay) = (0.0, 0.0);
+        let (mut ax, mut ay) = (zero, zero);
         for (j, (o, sw)) in out[..n].iter_mut().zip(&sweep).enumerate() {
-            *o = sw.e - (sw.h.x * ax + sw.h.y * ay);
+            *o = sw.e - (sw.hx * ax + sw.hy * ay);
             let (s, c, l) = (t.s[j], t.c[j], self.len[j]);
-            let (x, y, w2) = (l * c, l * s, qd[j] * qd[j]);
+            let (x, y, w2) = (c * l, s * l, qd[j] * qd[j]);
             let (cx, cy) = (-y * sw.e - w2 * x, x * sw.e - w2 * y);
-            let (txx, txy, tyx, tyy) = (1.0 + y * sw.h.x, y * sw.h.y, -x * sw.h.x, 1.0 - x * sw.h.y);
+            let (txx, txy, tyx, tyy) = (y * sw.hx + 1.0, y * sw.hy, -x * sw.hx, -(x * sw.hy) + 1.0);
             (ax, ay) = (txx * ax + (txy * ay + cx), tyx * ax + (tyy * ay + cy));
         }
     }
 
-    fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError> {
-        self.equilibrium_at(self.l_retracted + x)
-    }
-
-    fn payload(&self, q: &[f64]) -> Vector2<f64> {
+    fn payload(&self, q: &[T]) -> Vector2<T> {
         let (i, t) = (self.payload_section, self.trig(q));
         let (s, c, p) = (t.s[i], t.c[i], self.payload);
         self.point_at(&t, self.start[i]) + Vector2::new(c * p.x - s * p.y, s * p.x + c * p.y)
+    }
+}
+
+impl BoomMechanics for FlexibleBoom {
+    fn dof(&self) -> usize {
+        self.n
+    }
+
+    fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError> {
+        self.equilibrium_at(self.l_retracted + x)
     }
 
     /// Kinetic energy of the sections and payload (node velocity v and angular velocity w of each:

@@ -10,11 +10,12 @@ use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
 use super::params::BoomParams;
 use super::MechanicsError;
+use crate::scalar::Scalar;
 
 /// Angle opposite the side `opp` of a triangle whose other sides are `adj1`, `adj2` (law of
 /// cosines).
-pub(crate) fn law_of_cosines(adj1: f64, adj2: f64, opp: f64) -> f64 {
-    ((adj1 * adj1 + adj2 * adj2 - opp * opp) / (2.0 * adj1 * adj2)).acos()
+pub(crate) fn law_of_cosines<T: Scalar>(adj1: T, adj2: T, opp: T) -> T {
+    ((adj1 * adj1 + adj2 * adj2 - opp * opp) / (adj1 * 2.0 * adj2)).acos()
 }
 
 /// Rotation matrix A_2 of the boom frame (below eq. 2.10).
@@ -65,17 +66,17 @@ impl Triangle {
     /// Boom angle theta2 in closed form: the angle at B, beta = acos((w1^2 + w2^2 - l^2) /
     /// (2 w1 w2)), turns B -> A (at -phi1) into B -> C (at theta2 - phi2), so
     /// theta2 = beta - phi1 + phi2. The thesis solves (2.11) numerically instead.
-    pub fn theta2(&self, l_cyl: f64) -> f64 {
-        law_of_cosines(self.w1, self.w2, l_cyl) - self.phi1 + self.phi2
+    pub fn theta2<T: Scalar>(&self, l_cyl: T) -> T {
+        law_of_cosines(T::from(self.w1), T::from(self.w2), l_cyl) - self.phi1 + self.phi2
     }
 
     /// The cylinder length at boom angle `theta2`, the inverse of [`Self::theta2`] by the law of
     /// cosines (eq. 2.3): l^2 = w1^2 + w2^2 - 2 w1 w2 cos beta with beta = theta2 + phi1 - phi2.
     /// `None` unless 0 < beta < pi, where the triangle closes.
-    pub fn l_cyl(&self, theta2: f64) -> Option<f64> {
+    pub fn l_cyl<T: Scalar>(&self, theta2: T) -> Option<T> {
         let beta = theta2 + self.phi1 - self.phi2;
         (beta > 0.0 && beta < std::f64::consts::PI)
-            .then(|| (self.w1 * self.w1 + self.w2 * self.w2 - 2.0 * self.w1 * self.w2 * beta.cos()).sqrt())
+            .then(|| (T::from(self.w1 * self.w1 + self.w2 * self.w2) - beta.cos() * (2.0 * self.w1 * self.w2)).sqrt())
     }
 
     /// The boom angles in which the triangle closes, (phi2 - phi1, pi + phi2 - phi1).
@@ -87,12 +88,12 @@ impl Triangle {
     /// dtheta2/dl = l / (w1 w2 sin beta) (the inverse of the cylinder's moment arm about B,
     /// w1 sin(theta1 - theta2 + phi2) of eq. 2.18) and
     /// d2theta2/dl2 = (sin beta - l cos beta dtheta2/dl) / (w1 w2 sin^2 beta).
-    pub fn theta2_derivatives(&self, l_cyl: f64) -> (f64, f64, f64) {
-        let beta = law_of_cosines(self.w1, self.w2, l_cyl);
+    pub fn theta2_derivatives<T: Scalar>(&self, l_cyl: T) -> (T, T, T) {
+        let beta = law_of_cosines(T::from(self.w1), T::from(self.w2), l_cyl);
         let (s, c) = beta.sin_cos();
         let ww = self.w1 * self.w2;
-        let d1 = l_cyl / (ww * s);
-        let d2 = (s - l_cyl * c * d1) / (ww * s * s);
+        let d1 = l_cyl / (s * ww);
+        let d2 = (s - l_cyl * c * d1) / (s * ww * s);
         (beta - self.phi1 + self.phi2, d1, d2)
     }
 }
@@ -169,8 +170,9 @@ impl BoomKinematics {
 
     /// Global position of the point `local` given in the boom frame relative to the joint B
     /// (B + A_2 local, from eq. 2.9).
-    pub fn point(&self, theta2: f64, local: Vector2<f64>) -> Vector2<f64> {
-        self.s_ab + rotation(theta2) * local
+    pub fn point<T: Scalar>(&self, theta2: T, local: Vector2<f64>) -> Vector2<T> {
+        let (s, c) = theta2.sin_cos();
+        Vector2::new(c * local.x - s * local.y + self.s_ab.x, s * local.x + c * local.y + self.s_ab.y)
     }
 
     /// q = (x_D, y_D, theta2) in closed form: theta2 from [`Triangle::theta2`], r_D from the

@@ -8,7 +8,7 @@
 //! - [`flexible_boom`]: the lumped flexible beam (2.34-2.39, 3.1.2);
 //! - [`deflection_study`]: the static deflection study of 3.1.2 (`boomsim deflection`).
 //!
-//! [`BoomMechanics`] is what a hydraulic model needs from either boom.
+//! [`BoomMechanics`] and [`Kinetics`] are what a hydraulic model needs from either boom.
 
 pub mod deflection;
 pub mod deflection_study;
@@ -21,25 +21,32 @@ use std::fmt;
 
 use nalgebra::Vector2;
 
-/// A boom driven by the cylinder: generalised coordinates q (velocities q_dot) from which the
-/// cylinder stroke follows, and the accelerations under a cylinder force. The cylinder force
+use crate::scalar::Scalar;
+
+/// The kinetics of a boom driven by the cylinder, in the number type `T` ([`Scalar`]: `f64`, or
+/// dual numbers for exact derivatives): generalised coordinates q (velocities q_dot) from which
+/// the cylinder stroke follows, and the accelerations under a cylinder force. The cylinder force
 /// `f_cyl` is the net force on the rod (pressure forces minus friction); the boom adds the rod
 /// mass and weight itself.
-pub trait BoomMechanics {
-    /// Number of generalised coordinates.
-    fn dof(&self) -> usize;
+pub trait Kinetics<T: Scalar> {
     /// Cylinder stroke x = l_cyl(q) - l_retracted.
-    fn stroke(&self, q: &[f64]) -> f64;
+    fn stroke(&self, q: &[T]) -> T;
     /// Stroke rate dx/dt = (dl_cyl/dq) q_dot.
-    fn stroke_rate(&self, q: &[f64], qd: &[f64]) -> f64;
-    /// Writes q_ddot into `out` (length [`dof`](Self::dof)) under the cylinder force
+    fn stroke_rate(&self, q: &[T], qd: &[T]) -> T;
+    /// Writes q_ddot into `out` (length [`BoomMechanics::dof`]) under the cylinder force
     /// `f_cyl(x, x_dot)`, called once with the stroke and stroke rate at (q, q_dot) (a hydraulic
     /// model evaluates its circuit there, so the geometry is computed once); allocation-free.
-    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64, out: &mut [f64]);
+    fn accelerations(&self, q: &[T], qd: &[T], f_cyl: &mut dyn FnMut(T, T) -> T, out: &mut [T]);
+    /// Payload mass centre in the global frame (origin: lower cylinder pin A).
+    fn payload(&self, q: &[T]) -> Vector2<T>;
+}
+
+/// A boom driven by the cylinder: its kinetics in `f64`, its size, rest and energy.
+pub trait BoomMechanics: Kinetics<f64> {
+    /// Number of generalised coordinates.
+    fn dof(&self) -> usize;
     /// Rest configuration at stroke `x` and the cylinder force that holds it.
     fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError>;
-    /// Payload mass centre in the global frame (origin: lower cylinder pin A).
-    fn payload(&self, q: &[f64]) -> Vector2<f64>;
     /// Kinetic and potential energy (J), see the implementations for what they include.
     fn energy(&self, q: &[f64], qd: &[f64]) -> Energy;
 }

@@ -24,7 +24,8 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 use super::kinematics::BoomKinematics;
 use super::params::BoomParams;
-use super::{BoomMechanics, Energy, Equilibrium, MechanicsError};
+use super::{BoomMechanics, Energy, Equilibrium, Kinetics, MechanicsError};
+use crate::scalar::Scalar;
 
 /// The rigid boom driven by the cylinder stroke.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,8 +96,8 @@ impl Geometry {
 
 /// `sin` of an angle in [0, pi] from its cosine, `sqrt((1 - c)(1 + c))` (accurate also near
 /// c = ±1, where `1 - c²` would cancel).
-fn sin_from_cos(c: f64) -> f64 {
-    ((1.0 - c) * (1.0 + c)).sqrt()
+fn sin_from_cos<T: Scalar>(c: T) -> T {
+    ((-c + 1.0) * (c + 1.0)).sqrt()
 }
 
 /// Positions and angles of the boom at one stroke position.
@@ -127,12 +128,12 @@ pub struct Reactions {
 }
 
 /// The coefficients of the equation of motion at one stroke position.
-struct Eom {
-    m_eff: f64,
+struct Eom<T> {
+    m_eff: T,
     /// J_B theta2' theta2'', multiplies x_dot^2.
-    c_v2: f64,
+    c_v2: T,
     /// dV/dl, gravity on boom and rod.
-    f_gravity: f64,
+    f_gravity: T,
 }
 
 impl RigidBoom {
@@ -162,28 +163,28 @@ impl RigidBoom {
     }
 
     /// Pin-to-pin cylinder length at stroke `x`.
-    pub fn l_cyl(&self, x: f64) -> f64 {
-        self.l_retracted + x
+    pub fn l_cyl<T: Scalar>(&self, x: T) -> T {
+        x + self.l_retracted
     }
 
     /// The coefficients at stroke `x`: theta2' and theta2'' as in
     /// [`Triangle::theta2_derivatives`](super::kinematics::Triangle::theta2_derivatives), the
     /// lever and sin theta1 by the algebra of [`Geometry`] (no transcendental functions).
-    fn eom(&self, x: f64) -> Eom {
+    fn eom<T: Scalar>(&self, x: T) -> Eom<T> {
         let l = self.l_cyl(x);
         let g = &self.geo;
         let body = self.kin.body();
-        let c = (g.w_sq - l * l) / (2.0 * g.ww);
+        let c = (-(l * l) + g.w_sq) / (2.0 * g.ww);
         let s = sin_from_cos(c);
-        let d1 = l / (g.ww * s);
-        let d2 = (s - l * c * d1) / (g.ww * s * s);
-        let ca = (g.w21 + l * l) / (2.0 * g.w2 * l);
-        let sin_theta1 = g.sin_phi1 * ca + g.cos_phi1 * sin_from_cos(ca);
+        let d1 = l / (s * g.ww);
+        let d2 = (s - l * c * d1) / (s * g.ww * s);
+        let ca = (l * l + g.w21) / (l * (2.0 * g.w2));
+        let sin_theta1 = ca * g.sin_phi1 + sin_from_cos(ca) * g.cos_phi1;
         let lever = c * g.lc - s * g.ls;
         Eom {
-            m_eff: body.j_b * d1 * d1 + self.m_rod,
-            c_v2: body.j_b * d1 * d2,
-            f_gravity: self.g * (body.m_d * lever * d1 + self.m_rod * sin_theta1),
+            m_eff: d1 * body.j_b * d1 + self.m_rod,
+            c_v2: d1 * body.j_b * d2,
+            f_gravity: (lever * body.m_d * d1 + sin_theta1 * self.m_rod) * self.g,
         }
     }
 
@@ -207,7 +208,7 @@ impl RigidBoom {
 
     /// Stroke acceleration for the net cylinder force `f_cyl` (pressure forces minus friction)
     /// at stroke `x` and velocity `v`: (f_cyl - F_L) / m_eff. Allocation-free, no iteration.
-    pub fn acceleration(&self, x: f64, v: f64, f_cyl: f64) -> f64 {
+    pub fn acceleration<T: Scalar>(&self, x: T, v: T, f_cyl: T) -> T {
         let e = self.eom(x);
         (f_cyl - e.f_gravity - e.c_v2 * v * v) / e.m_eff
     }
@@ -250,29 +251,31 @@ impl RigidBoom {
 }
 
 /// The rigid boom with q = [stroke x], q_dot = [v].
+impl<T: Scalar> Kinetics<T> for RigidBoom {
+    fn stroke(&self, q: &[T]) -> T {
+        q[0]
+    }
+
+    fn stroke_rate(&self, _q: &[T], qd: &[T]) -> T {
+        qd[0]
+    }
+
+    fn accelerations(&self, q: &[T], qd: &[T], f_cyl: &mut dyn FnMut(T, T) -> T, out: &mut [T]) {
+        out[0] = self.acceleration(q[0], qd[0], f_cyl(q[0], qd[0]));
+    }
+
+    fn payload(&self, q: &[T]) -> Vector2<T> {
+        self.kin.point(self.kin.triangle().theta2(self.l_cyl(q[0])), self.payload)
+    }
+}
+
 impl BoomMechanics for RigidBoom {
     fn dof(&self) -> usize {
         1
     }
 
-    fn stroke(&self, q: &[f64]) -> f64 {
-        q[0]
-    }
-
-    fn stroke_rate(&self, _q: &[f64], qd: &[f64]) -> f64 {
-        qd[0]
-    }
-
-    fn accelerations(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64, out: &mut [f64]) {
-        out[0] = self.acceleration(q[0], qd[0], f_cyl(q[0], qd[0]));
-    }
-
     fn equilibrium(&self, x: f64) -> Result<Equilibrium, MechanicsError> {
         Ok(Equilibrium { q: vec![x], f_cyl: self.static_force(x) })
-    }
-
-    fn payload(&self, q: &[f64]) -> Vector2<f64> {
-        self.state(q[0], 0.0).payload
     }
 
     /// J_B theta2_dot^2 / 2 + m_rod v^2 / 2 and m_D g y_D (module doc; the rod weight has no

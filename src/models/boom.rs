@@ -8,8 +8,13 @@ use crate::fmi2::{Value, Values};
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
 use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
 use crate::mechanics::rigid_boom::RigidBoom;
-use crate::mechanics::BoomMechanics;
+use crate::mechanics::{BoomMechanics, Kinetics};
 use crate::params::ParamSpec;
+use crate::scalar::Scalar;
+
+/// Rows of [`Boom::output_rows`]: angle, rate, payload x and y, tip deflection, the section
+/// angles and rates.
+pub(crate) const N_OUTPUT_ROWS: usize = 5 + 2 * MAX_SECTIONS;
 
 /// The parameter settings that change a boom model's equations: rigid, the default flexible
 /// arm (4 + 5 sections), and the most sections (16 + 16, every Model Exchange slot live).
@@ -54,6 +59,14 @@ impl Boom {
         }
     }
 
+    /// The boom's kinetics in the number type `T` (dual numbers for directional derivatives).
+    pub fn kinetics<T: Scalar>(&self) -> &dyn Kinetics<T> {
+        match self {
+            Boom::Rigid(b) => b,
+            Boom::Flexible(b) => b,
+        }
+    }
+
     /// Typical magnitudes of q and q_dot (atol = rtol x scale). Rigid: 1 mm and 1 mm/s of
     /// stroke. Flexible: 2 mrad for the section angles (1 mm of stroke through the cylinder's
     /// lever about B, dx/dtheta2 = 0.55 m at 465 mm; away from the horizontal rtol |q| binds
@@ -73,7 +86,7 @@ impl Boom {
     /// velocities `qd`: the section angles and rates, the slots beyond the last section the last
     /// one's. Rigid: the boom angle theta2(l_cyl) and its rate theta2' v (eq. 2.7 in closed form,
     /// [`crate::mechanics::kinematics::Triangle::theta2_derivatives`]) in every slot.
-    pub(crate) fn me_states(&self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+    pub(crate) fn me_states<T: Scalar>(&self, q: &[T], qd: &[T], out: &mut [T]) {
         let (phi, omega) = out.split_at_mut(MAX_SECTIONS);
         match self {
             Boom::Rigid(b) => {
@@ -92,7 +105,7 @@ impl Boom {
 
     /// Coordinates `q` and velocities `qd` from the boom's Model Exchange states `x` (the slots
     /// of the sections the boom has; the others are the importer's copies of the last one).
-    pub(crate) fn read_me_states(&self, x: &[f64], q: &mut [f64], qd: &mut [f64]) -> Result<(), String> {
+    pub(crate) fn read_me_states<T: Scalar>(&self, x: &[T], q: &mut [T], qd: &mut [T]) -> Result<(), String> {
         let (phi, omega) = x.split_at(MAX_SECTIONS);
         match self {
             Boom::Rigid(b) => {
@@ -101,7 +114,7 @@ impl Boom {
                     let (lo, hi) = t.theta2_range();
                     format!(
                         "boom.section[1].phi = {} rad is outside ({}, {}) rad, where the cylinder triangle closes (rigid boom)",
-                        num(phi[0]),
+                        num(phi[0].re()),
                         num(lo),
                         num(hi)
                     )
@@ -120,7 +133,7 @@ impl Boom {
 
     /// The derivatives of the Model Exchange states from the velocities `qd` and accelerations
     /// `qdd` at `q`. Rigid: dtheta2/dt = theta2' v, domega/dt = theta2'' v^2 + theta2' a.
-    pub(crate) fn me_derivatives(&self, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    pub(crate) fn me_derivatives<T: Scalar>(&self, q: &[T], qd: &[T], qdd: &[T], out: &mut [T]) {
         let (dphi, domega) = out.split_at_mut(MAX_SECTIONS);
         match self {
             Boom::Rigid(b) => {
@@ -138,22 +151,30 @@ impl Boom {
         }
     }
 
-    /// Writes the boom outputs (angle, angular velocity, payload, tip deflection, section angles)
-    /// at coordinates `q`, velocities `qd`; `theta`, `omega` and the payload use the value
-    /// references `r = [theta, omega, payload.x, payload.y]` of the model.
-    pub(crate) fn outputs(&self, q: &[f64], qd: &[f64], r: [u32; 4], values: &mut Values) {
+    /// The boom outputs (angle, angular velocity, payload, tip deflection, section angles and
+    /// rates) at coordinates `q`, velocities `qd` as (value reference, value); `theta`, `omega`
+    /// and the payload use the value references `r = [theta, omega, payload.x, payload.y]` of the
+    /// model.
+    pub(crate) fn output_rows<T: Scalar>(&self, q: &[T], qd: &[T], r: [u32; 4]) -> [(u32, T); N_OUTPUT_ROWS] {
         // The section angles and rates; the first is the boom angle and rate, rigid or flexible.
-        let mut sections = [0.0; 2 * MAX_SECTIONS];
+        let mut sections = [T::from(0.0); 2 * MAX_SECTIONS];
         self.me_states(q, qd, &mut sections);
         let (theta, omega) = (sections[0], sections[MAX_SECTIONS]);
-        let tip = if let Boom::Flexible(f) = self { f.tip_deflection(q) } else { 0.0 };
-        let payload = self.mechanics().payload(q);
-        for (r, x) in r.into_iter().zip([theta, omega, payload.x, payload.y]) {
-            values.set_real(r, x);
+        let tip = if let Boom::Flexible(f) = self { f.tip_deflection(q) } else { T::from(0.0) };
+        let payload = self.kinetics().payload(q);
+        let mut rows = [(0, T::from(0.0)); N_OUTPUT_ROWS];
+        let head = [theta, omega, payload.x, payload.y, tip];
+        let refs = r.into_iter().chain([vr::TIP_DEFLECTION]);
+        let refs = refs.chain((vr::SECTIONS..).take(MAX_SECTIONS)).chain((vr::SECTION_RATES..).take(MAX_SECTIONS));
+        for (row, x) in rows.iter_mut().zip(refs.zip(head.into_iter().chain(sections))) {
+            *row = x;
         }
-        values.set_real(vr::TIP_DEFLECTION, tip);
-        let refs = (vr::SECTIONS..).take(MAX_SECTIONS).chain((vr::SECTION_RATES..).take(MAX_SECTIONS));
-        for (r, x) in refs.zip(sections) {
+        rows
+    }
+
+    /// Writes [`Self::output_rows`] into `values`.
+    pub(crate) fn outputs(&self, q: &[f64], qd: &[f64], r: [u32; 4], values: &mut Values) {
+        for (r, x) in self.output_rows(q, qd, r) {
             values.set_real(r, x);
         }
     }

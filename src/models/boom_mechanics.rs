@@ -18,6 +18,7 @@ use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::scalar::{Dual64, Scalar};
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
@@ -109,6 +110,17 @@ impl PortedBoom {
     /// Everything that pushes the rod out at `t`, stroke `x`, rate `v`: port and end stops.
     fn rod_force(&self, t: f64, x: f64, v: f64) -> f64 {
         self.force(t, v) + self.cylinder.end_stop_force(x, v)
+    }
+}
+
+impl PortedBoom {
+    /// The derivatives `dx` of the Model Exchange states at `q`, `qd` under the plain port's
+    /// force `f` and the end stops; allocation-free.
+    fn me_rhs<T: Scalar>(&self, q: &[T], qd: &[T], f: T, dx: &mut [T]) {
+        let mut qdd = [T::from(0.0); MAX_SECTIONS];
+        let qdd = &mut qdd[..q.len()];
+        self.boom.kinetics().accelerations(q, qd, &mut |x, v| f + self.cylinder.end_stop_force(x, v), qdd);
+        self.boom.me_derivatives(q, qd, qdd, dx);
     }
 }
 
@@ -216,13 +228,46 @@ impl Model for BoomMechanics {
 
     /// The plain port: pushed by the input cylinder.F and the end stops.
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {
-        let b = self.sys.boom.mechanics();
-        let (q, qd) = self.state.split_at(b.dof());
-        let f = values.real(vr::F);
-        let mut qdd = [0.0; MAX_SECTIONS];
-        let qdd = &mut qdd[..b.dof()];
-        b.accelerations(q, qd, &mut |x, v| f + self.sys.cylinder.end_stop_force(x, v), qdd);
-        self.sys.boom.me_derivatives(q, qd, qdd, dx);
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        self.sys.me_rhs(q, qd, values.real(vr::F), dx);
+    }
+
+    const DIRECTIONAL_DERIVATIVES: bool = true;
+
+    /// The plain port's boom evaluated once in dual numbers from its Model Exchange states and
+    /// the input cylinder.F, each carrying its seed: the derivatives and outputs carry the
+    /// directional derivative, exact to round-off. The TLM port's wave is sampled at
+    /// communication points: not provided.
+    fn directional_derivative(
+        &self,
+        values: &Values,
+        knowns: &[(u32, f64)],
+        unknowns: &[u32],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        port::directional_derivative_check(self.sys.coupling)?;
+        let mut x = [0.0; BOOM_STATES.len()];
+        self.continuous_states(&mut x);
+        let x = super::states::seeded_states(&BOOM_STATES, &x, knowns);
+        let f = super::states::seeded(knowns, vr::F, values.real(vr::F));
+        let dof = self.sys.boom.mechanics().dof();
+        let (mut q, mut qd) = ([Dual64::from(0.0); MAX_SECTIONS], [Dual64::from(0.0); MAX_SECTIONS]);
+        let (q, qd) = (&mut q[..dof], &mut qd[..dof]);
+        self.sys.boom.read_me_states(&x, q, qd)?;
+        let mut dx = [Dual64::from(0.0); BOOM_STATES.len()];
+        self.sys.me_rhs(q, qd, f, &mut dx);
+        let k = self.sys.boom.kinetics();
+        let port = [
+            (vr::X, k.stroke(q)),
+            (vr::V, k.stroke_rate(q, qd)),
+            (vr::START_F, Dual64::from(self.f_start)),
+            (vr::C_M, f),
+            (port::vr::F, f),
+        ];
+        let boom = self.sys.boom.output_rows(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y]);
+        let derivatives = BOOM_STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d));
+        let rows: Vec<(u32, Dual64)> = port.into_iter().chain(boom).chain(derivatives).collect();
+        super::states::pick_derivatives(&rows, unknowns, out)
     }
 
     /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).

@@ -5,6 +5,7 @@ use super::table::param_value;
 use super::vr;
 use crate::fmi2::Values;
 use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
+use crate::scalar::Scalar;
 
 /// The circuit from the parameter values at [`vr::HYDRAULICS`]; refuses inconsistent combinations.
 pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
@@ -26,10 +27,10 @@ pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
 /// 1 mm of spool travel, full valve opening.
 pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e5, 1e-3, 1.0];
 
-/// Writes the circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
-/// load-sensing pressure) for state `c` and its evaluation `e`.
-pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values) {
-    let outputs = [
+/// The circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
+/// load-sensing pressure) for state `c` and its evaluation `e`, as (value reference, value).
+pub(crate) fn circuit_rows<T: Scalar>(c: &[T; N_CIRCUIT], e: &Eval<T>) -> [(u32, T); 16] {
+    [
         (vr::P1, c[circuit::P1]),
         (vr::P2, c[circuit::P2]),
         (vr::P3, c[circuit::P3]),
@@ -46,8 +47,12 @@ pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values)
         (vr::X_V, c[circuit::X_V]),
         (vr::U_PCV, e.u_pcv),
         (vr::P_X, e.p_x),
-    ];
-    for (r, x) in outputs {
+    ]
+}
+
+/// Writes [`circuit_rows`] into `values`.
+pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values) {
+    for (r, x) in circuit_rows(c, e) {
         values.set_real(r, x);
     }
 }

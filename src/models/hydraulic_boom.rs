@@ -20,6 +20,7 @@ use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Valu
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::scalar::{Dual64, Scalar};
 use crate::solver::{OdeSystem, Radau5, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
@@ -77,9 +78,10 @@ spool has dynamics), so the FMU can be coupled to a controller without an algebr
 <p>Model Exchange: the importer's integrator gets the same states in every configuration (FMI 2.0 fixes their number;
 the table above lists them): the circuit's six, then the section angles <code>boom.section[k].phi</code> and their rates
 <code>boom.section[k].omega</code>. Slots beyond the last section repeat it, with its derivative; the rigid boom is
-its angle theta2 in every slot (Co-Simulation integrates it in the stroke). The models are smooth where the
-importer integrates (regularised orifices and friction, end stops as stiff springs), so there are no event
-indicators.</p>"#;
+its angle theta2 in every slot (Co-Simulation integrates it in the stroke). Three event indicators mark where the
+right-hand side jumps: the spool reference through zero (the dead band) and the spool at either edge of the dead
+band (the load-sensing switch); elsewhere the model is continuous (regularised orifices and friction, end stops as
+stiff springs). Directional derivatives are exact (forward-mode dual numbers through the same equations).</p>"#;
 
 /// Circuit + boom as one ODE, with the operator's reference held.
 #[derive(Debug, Clone)]
@@ -108,20 +110,47 @@ impl OdeSystem for Plant {
 
 impl Plant {
     /// The right-hand side with the operator's reference `u_ref`.
-    fn rhs_with(&self, u_ref: f64, s: &[f64], dx: &mut [f64]) {
-        let b = self.boom.mechanics();
+    fn rhs_with<T: Scalar>(&self, u_ref: T, s: &[T], dx: &mut [T]) {
+        let dof = self.boom.mechanics().dof();
         let (c, boom) = s.split_at(N_CIRCUIT);
-        let (q, qd) = boom.split_at(b.dof());
-        let c: &circuit::State = c.try_into().expect("circuit slice");
+        let (q, qd) = boom.split_at(dof);
+        let c: &[T; N_CIRCUIT] = c.try_into().expect("circuit slice");
         let (dc, dboom) = dx.split_at_mut(N_CIRCUIT);
-        let (dq, dqd) = dboom.split_at_mut(b.dof());
+        let (dq, dqd) = dboom.split_at_mut(dof);
         dq.copy_from_slice(qd);
         let mut force = |x, v| {
             let e = self.circuit.evaluate(c, u_ref, x, v);
             dc.copy_from_slice(&e.dx);
             e.force
         };
-        b.accelerations(q, qd, &mut force, dqd);
+        self.boom.kinetics().accelerations(q, qd, &mut force, dqd);
+    }
+
+    /// The derivatives `dx` of the Model Exchange states at the plant state `s` (native
+    /// coordinates) with the reference `u_ref`. No allocation: Model Exchange calls this for
+    /// every right-hand side of its integrator.
+    fn me_rhs<T: Scalar>(&self, u_ref: T, s: &[T], dx: &mut [T]) {
+        let mut ds = [T::from(0.0); N_CIRCUIT + 2 * MAX_SECTIONS];
+        let ds = &mut ds[..s.len()];
+        self.rhs_with(u_ref, s, ds);
+        let dof = self.boom.mechanics().dof();
+        let (q, qd) = s[N_CIRCUIT..].split_at(dof);
+        dx[..N_CIRCUIT].copy_from_slice(&ds[..N_CIRCUIT]);
+        self.boom.me_derivatives(q, qd, &ds[N_CIRCUIT + dof..], &mut dx[N_CIRCUIT..]);
+    }
+
+    /// The outputs (circuit, stroke and velocity, boom) at the plant state `s` with the
+    /// reference `u_ref`, as (value reference, value).
+    fn output_rows<T: Scalar>(&self, u_ref: T, s: &[T]) -> impl Iterator<Item = (u32, T)> {
+        let k = self.boom.kinetics();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(self.boom.mechanics().dof());
+        let c: &[T; N_CIRCUIT] = c.try_into().expect("circuit slice");
+        let (x, v) = (k.stroke(q), k.stroke_rate(q, qd));
+        let e = self.circuit.evaluate(c, u_ref, x, v);
+        let stroke = [(vr::X, x), (vr::V, v)];
+        let boom = self.boom.output_rows(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y]);
+        super::circuit::circuit_rows(c, &e).into_iter().chain(stroke).chain(boom)
     }
 
     /// The plant from the FMU's parameter values; refuses inconsistent combinations.
@@ -216,14 +245,35 @@ impl Model for HydraulicBoom {
     }
 
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {
-        // No allocation: Model Exchange calls this for every right-hand side of its integrator.
-        let mut ds = [0.0; N_CIRCUIT + 2 * MAX_SECTIONS];
-        let ds = &mut ds[..self.state.len()];
-        self.plant.rhs_with(values.real(vr::U_REF), &self.state, ds);
-        let dof = self.plant.boom.mechanics().dof();
-        let (q, qd) = self.state[N_CIRCUIT..].split_at(dof);
-        dx[..N_CIRCUIT].copy_from_slice(&ds[..N_CIRCUIT]);
-        self.plant.boom.me_derivatives(q, qd, &ds[N_CIRCUIT + dof..], &mut dx[N_CIRCUIT..]);
+        self.plant.me_rhs(values.real(vr::U_REF), &self.state, dx);
+    }
+
+    const DIRECTIONAL_DERIVATIVES: bool = true;
+
+    /// The plant evaluated once in dual numbers from its Model Exchange states and the input,
+    /// each carrying its seed: the derivatives and outputs carry the directional derivative,
+    /// exact to round-off (padded state slots are copies the model does not read: zero).
+    fn directional_derivative(
+        &self,
+        values: &Values,
+        knowns: &[(u32, f64)],
+        unknowns: &[u32],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let mut x = [0.0; PLANT_STATES.len()];
+        self.continuous_states(&mut x);
+        let x = super::states::seeded_states(&PLANT_STATES, &x, knowns);
+        let u_ref = super::states::seeded(knowns, vr::U_REF, values.real(vr::U_REF));
+        let mut s = [Dual64::from(0.0); N_CIRCUIT + 2 * MAX_SECTIONS];
+        let s = &mut s[..self.state.len()];
+        s[..N_CIRCUIT].copy_from_slice(&x[..N_CIRCUIT]);
+        let (q, qd) = s[N_CIRCUIT..].split_at_mut(self.plant.boom.mechanics().dof());
+        self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)?;
+        let mut dx = [Dual64::from(0.0); PLANT_STATES.len()];
+        self.plant.me_rhs(u_ref, s, &mut dx);
+        let derivatives = PLANT_STATES.iter().zip(dx).map(|(st, d)| (st.derivative, d));
+        let rows: Vec<(u32, Dual64)> = self.plant.output_rows(u_ref, s).chain(derivatives).collect();
+        super::states::pick_derivatives(&rows, unknowns, out)
     }
 
     fn retune(&mut self, _values: &Values) -> Result<(), String> {
@@ -231,18 +281,10 @@ impl Model for HydraulicBoom {
     }
 
     fn outputs(&self, values: &mut Values) {
-        let s = &self.state;
-        let b = self.plant.boom.mechanics();
-        let (c, boom) = s.split_at(N_CIRCUIT);
-        let (q, qd) = boom.split_at(b.dof());
-        let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
-        let e = self.plant.circuit.evaluate(c.try_into().expect("circuit slice"), values.real(vr::U_REF), x, v);
-        super::circuit::circuit_outputs(c.try_into().expect("circuit slice"), &e, values);
-        super::stepping::solver_outputs(self.solver.stats(), values);
-        for (r, y) in [(vr::X, x), (vr::V, v)] {
+        for (r, y) in self.plant.output_rows(values.real(vr::U_REF), &self.state) {
             values.set_real(r, y);
         }
-        self.plant.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
+        super::stepping::solver_outputs(self.solver.stats(), values);
     }
 
     fn do_step(

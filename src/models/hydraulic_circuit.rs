@@ -279,30 +279,17 @@ impl Model for HydraulicCircuit {
         unknowns: &[u32],
         out: &mut [f64],
     ) -> Result<(), String> {
-        if self.sys.coupling != Coupling::Plain {
-            return Err("directional derivatives are provided for the plain port (port.coupling = 0)".into());
-        }
-        let seed = |r: u32, x: f64| Dual64::new(x, knowns.iter().filter(|k| k.0 == r).map(|k| k.1).sum());
-        let c: [Dual64; N_CIRCUIT] = std::array::from_fn(|k| seed(CIRCUIT_STATES[k].state, self.state[k]));
+        port::directional_derivative_check(self.sys.coupling)?;
+        let seed = |r: u32, x: f64| super::states::seeded(knowns, r, x);
+        let c =
+            super::states::seeded_states(&CIRCUIT_STATES, self.state[..N_CIRCUIT].try_into().expect("circuit"), knowns);
         let [u_ref, x, v] = [vr::U_REF, vr::X, vr::V].map(|r| seed(r, values.real(r)));
         let e = self.sys.circuit.evaluate(&c, u_ref, x, v);
-        #[rustfmt::skip]
-        let outputs = [
-            (vr::P1, c[0]), (vr::P2, c[1]), (vr::P3, c[2]), (vr::P4, c[3]), (vr::U, e.u), (vr::U_CV, e.u_cv),
-            (vr::U_CBV, c[5]), (vr::Q1, e.q[0]), (vr::Q2, e.q[1]), (vr::Q3, e.q[2]), (vr::Q4, e.q[3]),
-            (vr::F, e.force), (vr::F_FR, e.f_friction), (vr::C_H, e.force), (port::vr::F, e.force),
-            (vr::PORT_X, x), (vr::PORT_V, v),
-        ];
+        let port = [(vr::C_H, e.force), (port::vr::F, e.force), (vr::PORT_X, x), (vr::PORT_V, v)];
         let derivatives = CIRCUIT_STATES.iter().zip(e.dx).map(|(s, d)| (s.derivative, d));
-        let rows: Vec<(u32, Dual64)> = outputs.into_iter().chain(derivatives).collect();
-        for (o, &r) in out.iter_mut().zip(unknowns) {
-            *o = rows
-                .iter()
-                .find(|row| row.0 == r)
-                .map(|row| row.1.eps)
-                .ok_or_else(|| format!("vr {r} is not differentiated"))?;
-        }
-        Ok(())
+        let rows: Vec<(u32, Dual64)> =
+            super::circuit::circuit_rows(&c, &e).into_iter().chain(port).chain(derivatives).collect();
+        super::states::pick_derivatives(&rows, unknowns, out)
     }
 
     /// The plain port's circuit at the stroke and velocity inputs.

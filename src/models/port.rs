@@ -49,6 +49,17 @@ pub(crate) fn configurations() -> Vec<Vec<(u32, Value)>> {
     vec![vec![(vr::COUPLING, Value::Integer(0))], vec![(vr::COUPLING, Value::Integer(1))]]
 }
 
+/// Directional derivatives are provided for the plain port only: the TLM port's wave is sampled at
+/// communication points.
+pub(crate) fn directional_derivative_check(coupling: Coupling) -> Result<(), String> {
+    match coupling {
+        Coupling::Plain => Ok(()),
+        Coupling::Tlm { .. } => {
+            Err("directional derivatives are provided for the plain port (port.coupling = 0)".into())
+        }
+    }
+}
+
 /// Model Exchange runs the plain port only: the TLM port is a delay line of one communication
 /// step, which Model Exchange does not have; without it the two waves form an algebraic loop
 /// (c_h depends on c_m and c_m on c_h).

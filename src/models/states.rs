@@ -11,6 +11,7 @@ use super::table::out;
 use super::vr;
 use crate::fmi2::{ContinuousState, Variable};
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::scalar::Dual64;
 
 /// Typical magnitudes of the boom states (see [`super::boom::Boom::scale`]): 2 mrad, 0.1 rad/s.
 const PHI_NOMINAL: f64 = 2e-3;
@@ -180,4 +181,31 @@ pub(crate) const BOOM_DERIVATIVES: [Variable; 2 * MAX_SECTIONS] = [
 /// The derivative variable of state `k`.
 const fn der(name: &'static str, k: usize, unit: &'static str, display: &'static str) -> Variable {
     Variable::real_local(name, der_vr(k), unit, display, "Time derivative of the continuous state (Model Exchange)")
+}
+
+/// The dual number of the value `x` of the variable `r` seeded with the sum of the seeds the
+/// importer gave `r` among `knowns` (zero if it is none of them).
+pub(crate) fn seeded(knowns: &[(u32, f64)], r: u32, x: f64) -> Dual64 {
+    Dual64::new(x, knowns.iter().filter(|k| k.0 == r).map(|k| k.1).sum())
+}
+
+/// The continuous states `x` of `states` as dual numbers with their seeds among `knowns`.
+pub(crate) fn seeded_states<const N: usize>(
+    states: &[ContinuousState; N],
+    x: &[f64; N],
+    knowns: &[(u32, f64)],
+) -> [Dual64; N] {
+    std::array::from_fn(|k| seeded(knowns, states[k].state, x[k]))
+}
+
+/// Writes the directional derivative of each of `unknowns` from the differentiated `rows`.
+pub(crate) fn pick_derivatives(rows: &[(u32, Dual64)], unknowns: &[u32], out: &mut [f64]) -> Result<(), String> {
+    for (o, &r) in out.iter_mut().zip(unknowns) {
+        *o = rows
+            .iter()
+            .find(|row| row.0 == r)
+            .map(|row| row.1.eps)
+            .ok_or_else(|| format!("vr {r} is not differentiated"))?;
+    }
+    Ok(())
 }
