@@ -39,6 +39,11 @@ enum Cmd {
         /// Simulated time per case [s], > 0.
         #[arg(long, default_value_t = 10.0, value_parser = positive)]
         duration: f64,
+        /// Then Model Exchange (fmpy + CVode) against Co-Simulation on the same cases, with RHS
+        /// counts and the error against an rtol 1e-9 reference (scripts/bench_interfaces.py
+        /// --only interfaces, about 7 minutes; needs the venv of scripts/setup and `boomsim pack`).
+        #[arg(long)]
+        model_exchange: bool,
     },
     /// Modes of the HydraulicBoom linearised at rest with the boom horizontal (full payload,
     /// spool closed): the flexible boom (default n2 = 4, n3 = 5) and, for comparison, the rigid one.
@@ -113,6 +118,17 @@ fn pack(out: &Path, platforms: &str) -> Result<(), String> {
         println!("{}", fmu.display());
     }
     Ok(())
+}
+
+/// The Model Exchange rows of the benchmark: fmpy's CVode against the FMUs' Co-Simulation.
+fn bench_interfaces() -> Result<(), String> {
+    let python = root().join(".venv/bin/python");
+    let status = std::process::Command::new(&python)
+        .arg(root().join("scripts/bench_interfaces.py"))
+        .args(["--only", "interfaces"])
+        .status()
+        .map_err(|e| format!("{}: {e} (run scripts/setup first)", python.display()))?;
+    status.success().then_some(()).ok_or_else(|| format!("scripts/bench_interfaces.py: {status}"))
 }
 
 fn bench(json: bool, duration: f64) -> Result<(), String> {
@@ -229,7 +245,9 @@ fn main() -> ExitCode {
     }
     let result = match Cli::parse().command {
         Cmd::Pack { out, platforms } => pack(&out, &platforms),
-        Cmd::Bench { json, duration } => bench(json, duration),
+        Cmd::Bench { json, duration, model_exchange } => {
+            bench(json, duration).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
+        }
         Cmd::Eigen { json, count } => eigen(json, count),
         Cmd::Xml { check } => xml(check),
         Cmd::Deflection { json } => deflection(json),
