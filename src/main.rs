@@ -41,7 +41,7 @@ enum Cmd {
         duration: f64,
         /// Then Model Exchange (fmpy + CVode) against Co-Simulation on the same cases, with RHS
         /// counts and the error against an rtol 1e-9 reference (scripts/bench_interfaces.py
-        /// --only interfaces, about 7 minutes; needs the venv of scripts/setup and `boomsim pack`).
+        /// --only interfaces, 7 to 10 minutes; needs the venv of scripts/setup and `boomsim pack`).
         #[arg(long)]
         model_exchange: bool,
     },
