@@ -2,6 +2,10 @@
 //! FMI 2.0 (shared parts in [`crate::fmu::xml`]): `<Float64>`/`<Int32>`/`<Boolean>`/`<String>`
 //! variables with the same value references, ModelStructure by value reference.
 //!
+//! Units are declared as `<Float64Type>`s, one per unit and display unit, which the variables
+//! name in `declaredType` (the Reference FMUs' style; FMI 3.0 allows `unit` on the variable too,
+//! but importers such as the `fmi` crate 0.8 read units only from type definitions).
+//!
 //! The 32 section angles and velocities of the boom stay 32 scalars each rather than FMI 3.0
 //! arrays: the value references, names and get/set calls are then the same in both versions
 //! (one table, one FMU state format, and a master can switch version without remapping), and
@@ -13,8 +17,8 @@ use crate::fmu::model::Model;
 use crate::fmu::structure::probe;
 use crate::fmu::variables::{Causality, Kind, Variable};
 use crate::fmu::xml::{
-    default_experiment, dependencies, document, element, flag, initial_unknowns, log_categories, real_attrs,
-    root_attrs, unit_definitions, variable_attrs, Attrs, Xml,
+    default_experiment, dependencies, document, element, flag, initial_unknowns, log_categories, range_attrs,
+    root_attrs, unit_attrs, unit_definitions, variable_attrs, Attrs, Xml,
 };
 use std::io;
 
@@ -31,13 +35,44 @@ fn references(vrs: &[u32]) -> String {
     v.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
 }
 
+/// The name of the `<Float64Type>` of a unit and display unit.
+fn type_name(unit: &str, display_unit: &str) -> String {
+    if display_unit.is_empty() {
+        unit.to_owned()
+    } else {
+        format!("{unit} [{display_unit}]")
+    }
+}
+
+/// `<TypeDefinitions>`: a `<Float64Type>` per unit and display unit of the table (first use
+/// order), and the independent variable's seconds.
+fn type_definitions<M: Model>(w: &mut Xml) -> io::Result<()> {
+    let mut pairs: Vec<(&str, &str)> = vec![("s", "")];
+    for v in M::VARIABLES {
+        if let Kind::Real { unit, display_unit, .. } = v.kind {
+            if !pairs.contains(&(unit, display_unit)) {
+                pairs.push((unit, display_unit));
+            }
+        }
+    }
+    w.create_element("TypeDefinitions").write_inner_content(|w| {
+        for (unit, display_unit) in pairs {
+            let a: Attrs = [vec![("name", type_name(unit, display_unit))], unit_attrs(unit, display_unit)].concat();
+            element(w, "Float64Type", &a)?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
 /// The element name and attributes of one variable (FMI 3.0, 2.4.7).
 fn variable<M: Model>(v: &Variable) -> (&'static str, Attrs, Option<String>) {
     let mut a = variable_attrs(v);
     let start = v.has_start();
     let (name, string_start) = match v.kind {
         Kind::Real { start: s, unit, display_unit, min, max } => {
-            a.extend(real_attrs(unit, display_unit, (min, max), start.then_some(s)));
+            a.push(("declaredType", type_name(unit, display_unit)));
+            a.extend(range_attrs((min, max), start.then_some(s)));
             if let Some(state) = M::STATES.iter().find(|x| x.derivative == v.vr) {
                 a.push(("derivative", state.state.to_string()));
             }
@@ -97,6 +132,7 @@ fn write<M: Model>() -> io::Result<String> {
         ]);
         element(w, "CoSimulation", &cs)?;
         unit_definitions::<M>(w, &["s"])?;
+        type_definitions::<M>(w)?;
         log_categories::<M>(w, |d| d.replace("fmi2", "fmi3"))?;
         default_experiment::<M>(w)?;
         w.create_element("ModelVariables").write_inner_content(|w| {
@@ -106,7 +142,7 @@ fn write<M: Model>() -> io::Result<String> {
                 ("description", "Simulation time".into()),
                 ("causality", "independent".into()),
                 ("variability", "continuous".into()),
-                ("unit", "s".into()),
+                ("declaredType", "s".into()),
             ];
             element(w, "Float64", &time)?;
             for v in M::VARIABLES {

@@ -130,11 +130,22 @@ pub fn variable_attrs(v: &Variable) -> Attrs {
 }
 
 /// The attributes of a Real (FMI 3.0: Float64) with a start value if it has one.
-pub fn real_attrs(unit: &str, display_unit: &str, (min, max): (f64, f64), start: Option<f64>) -> Attrs {
+pub fn real_attrs(unit: &str, display_unit: &str, range: (f64, f64), start: Option<f64>) -> Attrs {
+    [unit_attrs(unit, display_unit), range_attrs(range, start)].concat()
+}
+
+/// `unit` and, if there is one, `displayUnit`.
+pub fn unit_attrs(unit: &str, display_unit: &str) -> Attrs {
     let mut a: Attrs = vec![("unit", unit.into())];
     if !display_unit.is_empty() {
         a.push(("displayUnit", display_unit.into()));
     }
+    a
+}
+
+/// The finite bounds and the start value, if any.
+pub fn range_attrs((min, max): (f64, f64), start: Option<f64>) -> Attrs {
+    let mut a = Attrs::new();
     if min.is_finite() {
         a.push(("min", num(min)));
     }
