@@ -13,7 +13,9 @@ importer that cannot be imported or run says why in the matrix; it is never skip
 
 Importers: fmpy (simulate_fmu, fmpy.validation.validate_fmu), libcosimpy (a CosimLocalSlave in
 a fixed-step execution), ecospy (EcosSimulationStructure.add_model), fmu-manipulation-toolbox
-(`fmutool -check`: checker only, no simulation), the Rust `fmi` crate (examples/fmi_import.rs).
+(`fmutool -check`: checker only, no simulation), the Rust `fmi` crate (examples/fmi_import.rs);
+and fmpy again with the FMI 3.0 .fmu of the same binary (target/fmu/fmi3), matched against fmpy's
+FMI 2.0 run (the `fmi` crate's FMI 3.0 import is tested in tests/fmi3_crate.rs).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ CASES = {
     "HydraulicCircuit": {"valve.u_ref": 0.2, "cylinder.x": 0.3, "cylinder.v": 0.01},
     "BoomMechanics": {"cylinder.F": 2.0e4, "boom.flexible": False},
 }
-IMPORTERS = ["fmpy", "libcosimpy", "ecospy", "fmu-manipulation-toolbox", "fmi (Rust crate)"]
+IMPORTERS = ["fmpy", "libcosimpy", "ecospy", "fmu-manipulation-toolbox", "fmi (Rust crate)", "fmpy (FMI 3.0)"]
 
 
 class Cell(dict):
@@ -56,7 +58,8 @@ def model_description(path):
 
 
 def real_outputs(md) -> dict:
-    return {v.name: v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"}
+    return {v.name: v.valueReference for v in md.modelVariables
+            if v.causality == "output" and v.type in ("Real", "Float64")}
 
 
 def run_fmpy(path, case) -> tuple[Cell, dict]:
@@ -137,7 +140,8 @@ def run_rust(path, case) -> tuple[Cell, dict]:
 
 
 RUNNERS = {"fmpy": run_fmpy, "libcosimpy": run_libcosim, "ecospy": run_ecos,
-           "fmu-manipulation-toolbox": run_fmutool, "fmi (Rust crate)": run_rust}
+           "fmu-manipulation-toolbox": run_fmutool, "fmi (Rust crate)": run_rust,
+           "fmpy (FMI 3.0)": lambda path, case: run_fmpy(path.parent / "fmi3" / path.name, case)}
 
 
 def matches(values: dict, reference: dict) -> tuple[bool, str]:

@@ -1,4 +1,5 @@
-"""Coupled co-simulation of the two boomsim FMUs through fmpy (FMI 2.0 Co-Simulation).
+"""Coupled co-simulation of the two boomsim FMUs through fmpy (FMI 2.0 Co-Simulation; FMI 3.0
+with --fmi 3).
 
     HydraulicBoom.p4 --> PressureFeedbackController.p
     operator reference u_ref(t) (time table) --> PressureFeedbackController.u_ref
@@ -6,7 +7,7 @@
 
 Usage:
     .venv/bin/python scripts/cosim.py scripts/scenarios/B.toml [--boom rigid] [--step 1e-3]
-        [--stop-time 15] [--hold] [--interface cs|me] [--out out/cosim]
+        [--stop-time 15] [--hold] [--interface cs|me] [--fmi 2|3] [--out out/cosim]
 writes <out>/<scenario>-<boom>.csv and .png (p3, p4, cylinder velocity, u_ref / u_comp / u).
 
 Coupling (Gauss-Seidel, loop-free). The plant's outputs do not depend directly on valve.u_ref
@@ -24,6 +25,10 @@ piecewise-linear p4. What the coupling cannot remove is the hold of u: the comma
 [t_k, t_k+1] is computed from p4(t_k), i.e. the feedback acts with up to one communication step of
 delay (h/2 on average, a phase lag of omega*h/2). That limits the usable step (see
 scripts/README.md and `scripts/regress --step-sweep`).
+
+FMI 3.0 (`--fmi 3`, the .fmu files of target/fmu/fmi3: the same binaries) has no input
+derivatives, so its Co-Simulation runs with `--hold`; with the same hold, FMI 2.0 and FMI 3.0
+give bit-identical results (tests/python/test_fmi3.py).
 
 The scenario files (scripts/scenarios/*.toml) are documented in scripts/scenarios/README.md.
 """
@@ -130,15 +135,56 @@ def reference(table: np.ndarray, t: float) -> float:
 # --------------------------------------------------------------------------- FMUs
 
 
+class Fmi3:
+    """An fmpy FMI 3.0 instance (FMU3Slave or FMU3Model) under the FMI 2.0 names this runner
+    calls: the experiment goes with enterInitializationMode, Real is Float64, Integer is Int32."""
+
+    def __init__(self, instance):
+        self.m = instance
+        self._experiment = {}
+
+    def __getattr__(self, name):
+        return getattr(self.m, name)
+
+    def setupExperiment(self, tolerance=None, startTime=0.0, stopTime=None):
+        self._experiment = dict(tolerance=tolerance, startTime=startTime, stopTime=stopTime)
+
+    def enterInitializationMode(self):
+        return self.m.enterInitializationMode(**self._experiment)
+
+    def getReal(self, vrs):
+        return self.m.getFloat64(vrs)
+
+    def setReal(self, vrs, values):
+        return self.m.setFloat64(vrs, values)
+
+    def setInteger(self, vrs, values):
+        return self.m.setInt32(vrs, values)
+
+    def doStep(self, t, h):
+        return self.m.doStep(t, h)
+
+    def setRealInputDerivatives(self, *_):
+        raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
+
+    def getDerivatives(self, p, n):
+        return self.m.getContinuousStateDerivatives(p, n)
+
+    def newDiscreteStates(self):
+        return self.m.updateDiscreteStates()
+
+
 class FmuFile:
-    """An extracted FMU: model description and value references by name."""
+    """An extracted FMU (FMI `fmi` 2 or 3): model description and value references by name."""
 
-    _cache: dict[str, "FmuFile"] = {}
+    _cache: dict[tuple[str, int], "FmuFile"] = {}
 
-    def __init__(self, identifier: str, fmu_dir=FMU_DIR):
+    def __init__(self, identifier: str, fmu_dir=FMU_DIR, fmi: int = 2):
         from fmpy import extract, read_model_description
 
-        self.path = str(pathlib.Path(fmu_dir) / f"{identifier}.fmu")
+        self.fmi = fmi
+        fmu_dir = pathlib.Path(fmu_dir) / ("fmi3" if fmi == 3 else "")
+        self.path = str(fmu_dir / f"{identifier}.fmu")
         if not pathlib.Path(self.path).exists():
             raise UsageError(f"{self.path} is missing: run `cargo build --release && target/release/boomsim pack`")
         self.md = read_model_description(self.path)
@@ -147,12 +193,19 @@ class FmuFile:
         self.vr = {n: v.valueReference for n, v in self.vars.items()}
 
     @classmethod
-    def get(cls, identifier: str) -> "FmuFile":
-        if identifier not in cls._cache:
-            cls._cache[identifier] = FmuFile(identifier)
-        return cls._cache[identifier]
+    def get(cls, identifier: str, fmi: int = 2) -> "FmuFile":
+        if (identifier, fmi) not in cls._cache:
+            cls._cache[identifier, fmi] = FmuFile(identifier, fmi=fmi)
+        return cls._cache[identifier, fmi]
 
     def slave(self, name: str):
+        if self.fmi == 3:
+            from fmpy.fmi3 import FMU3Slave
+
+            s = FMU3Slave(guid=self.md.guid, unzipDirectory=self.dir,
+                          modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+            s.instantiate()
+            return Fmi3(s)
         from fmpy.fmi2 import FMU2Slave
 
         s = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
@@ -162,6 +215,13 @@ class FmuFile:
 
     def model(self, name: str):
         """A Model Exchange instance."""
+        if self.fmi == 3:
+            from fmpy.fmi3 import FMU3Model
+
+            m = FMU3Model(guid=self.md.guid, unzipDirectory=self.dir,
+                          modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=name)
+            m.instantiate()
+            return Fmi3(m)
         from fmpy.fmi2 import FMU2Model
 
         m = FMU2Model(guid=self.md.guid, unzipDirectory=self.dir,
@@ -171,11 +231,11 @@ class FmuFile:
 
     def set(self, slave, name: str, value):
         v = self.vars[name]
-        if v.type == "Real":
+        if v.type in ("Real", "Float64"):
             slave.setReal([v.valueReference], [float(value)])
         elif v.type == "Boolean":
             slave.setBoolean([v.valueReference], [bool(value)])
-        elif v.type in ("Integer", "Enumeration"):
+        elif v.type in ("Integer", "Int32", "Enumeration"):
             slave.setInteger([v.valueReference], [int(value)])
         else:
             raise TypeError(f"{name}: unsupported type {v.type}")
@@ -257,10 +317,13 @@ def set_filter(ctrl_f: FmuFile, ctrl, cfg: dict):
 
 def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
         interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
-        tolerance: float | None = None) -> Result:
+        tolerance: float | None = None, fmi: int = 2) -> Result:
     """Co-simulate one scenario variant. `record_every` thins the recorded rows (default: one
-    row per millisecond or per step, whichever is coarser)."""
-    plant_f, ctrl_f = FmuFile.get("HydraulicBoom"), FmuFile.get("PressureFeedbackController")
+    row per millisecond or per step, whichever is coarser); `fmi`: the FMUs' FMI version (3: no
+    input derivatives, so `interpolate` must be False)."""
+    if fmi == 3 and interpolate:
+        raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
+    plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     step = scenario["step"] if step is None else step
@@ -336,7 +399,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
 
 
 def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
-           feedback_start: str | None = None, events: bool = True) -> Result:
+           feedback_start: str | None = None, events: bool = True, fmi: int = 2) -> Result:
     """The scenario variant with both FMUs as Model Exchange, integrated together by fmpy's CVode
     (BDF, dense Newton with difference-quotient Jacobian, rtol `tolerance`, atol = rtol x the
     FMUs' nominal values): one ODE of the plant's and the controller's states, with
@@ -346,11 +409,11 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     and, with `events`, where one of the plant's event indicators changes sign (CVode's root
     finding: the dead-band jump of the spool demand, the load-sensing switch).
     `counts`: CVode's right-hand-side evaluations (`rhs`, fmi2GetDerivatives of each FMU) and the
-    state events (`events`)."""
+    state events (`events`). `fmi` 3: the FMI 3.0 FMUs, which declare no event indicators."""
     from ctypes import POINTER, c_double
     from fmpy.sundials import CVodeSolver
 
-    plant_f, ctrl_f = FmuFile.get("HydraulicBoom"), FmuFile.get("PressureFeedbackController")
+    plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     ctrl_cfg = scenario["controller"]
@@ -553,6 +616,8 @@ def main(argv=None):
     ap.add_argument("--hold", action="store_true", help="hold p4 over a step in the controller (no slope)")
     ap.add_argument("--interface", choices=("cs", "me"), default="cs",
                     help="cs: both FMUs' fmi2DoStep (default); me: both as Model Exchange under fmpy's CVode, one ODE")
+    ap.add_argument("--fmi", type=int, choices=(2, 3), default=2,
+                    help="FMI version of the FMUs: 2 (target/fmu, default) or 3 (target/fmu/fmi3; CS needs --hold)")
     ap.add_argument("--feedback-start", choices=("t0", "cbv_open"), default=None,
                     help="only this feedback start (default: every start listed by the scenario)")
     ap.add_argument("--out", default=str(ROOT / "out" / "cosim"))
@@ -576,9 +641,9 @@ def main(argv=None):
     for boom, fb in variants:
         try:
             if args.interface == "me":
-                res = run_me(sc, boom, args.stop_time, feedback_start=fb)
+                res = run_me(sc, boom, args.stop_time, feedback_start=fb, fmi=args.fmi)
             else:
-                res = run(sc, boom, args.step, args.stop_time, not args.hold, feedback_start=fb)
+                res = run(sc, boom, args.step, args.stop_time, not args.hold, feedback_start=fb, fmi=args.fmi)
         except UsageError as e:
             ap.error(str(e))
         except Skip as e:

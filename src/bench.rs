@@ -32,8 +32,8 @@ pub struct InProcess<M: Model>(Instance<M>);
 impl<M: Model> InProcess<M> {
     /// Instantiated, set up with `rtol`, initialised with the given Real and Boolean values.
     pub fn new(rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
-        let log = Logger::new(None, std::ptr::null_mut(), "bench", &[], false);
-        let mut i = Instance::<M>::new(log, guid::<M>(), Interface::CoSimulation);
+        let log = Logger::new(None, "bench", &[], false);
+        let mut i = Instance::<M>::new(log, guid::<M>(), crate::fmu::Version::Fmi2, Interface::CoSimulation);
         i.setup_experiment(Some(rtol), 0.0, None)?;
         i.enter_initialization_mode();
         for (r, x) in start {

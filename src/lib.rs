@@ -10,6 +10,8 @@ pub mod analysis;
 pub mod bench;
 pub mod control;
 pub mod fmi2;
+pub mod fmi3;
+pub mod fmu;
 pub mod hydraulics;
 pub mod mechanics;
 pub mod models;

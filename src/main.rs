@@ -1,6 +1,7 @@
 //! The boomsim command line: build and pack the FMUs, keep modelDescription files current,
 //! analyse the linearised stability.
 
+use boomsim::fmu::Version;
 use boomsim::models;
 use boomsim::platform::Platform;
 use clap::{Parser, Subcommand};
@@ -11,7 +12,7 @@ use std::process::ExitCode;
 #[command(
     name = "boomsim",
     version,
-    about = "FMI 2.0 FMUs of a hydraulic boom with counterbalance valve and pressure feedback"
+    about = "FMI 2.0 and 3.0 FMUs of a hydraulic boom with counterbalance valve and pressure feedback"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -20,7 +21,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Build every FMU crate in release mode and write target/fmu/<ModelIdentifier>.fmu.
+    /// Build every FMU crate in release mode and write target/fmu/<ModelIdentifier>.fmu (FMI 2.0)
+    /// and target/fmu/fmi3/<ModelIdentifier>.fmu (FMI 3.0, the same binaries).
     Pack {
         /// Output directory.
         #[arg(long, default_value = "target/fmu")]
@@ -55,7 +57,8 @@ enum Cmd {
         #[arg(long, default_value_t = 6)]
         count: usize,
     },
-    /// Write modelDescription/<ModelIdentifier>.xml from the variable tables.
+    /// Write modelDescription/<ModelIdentifier>.xml (FMI 2.0) and
+    /// modelDescription/fmi3/<ModelIdentifier>.xml (FMI 3.0) from the variable tables.
     Xml {
         /// Compare instead of writing; fail if a committed file differs from the generator.
         #[arg(long)]
@@ -110,12 +113,14 @@ fn pack(out: &Path, platforms: &str) -> Result<(), String> {
         eprintln!("pack: {} built in {:.0} s", p.name, start.elapsed().as_secs_f64());
     }
     let out = if out.is_absolute() { out.to_path_buf() } else { root().join(out) };
-    std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    for f in &models::all() {
-        let libs: Vec<_> = platforms.iter().map(|p| (*p, p.library(&target_dir(), f.identifier))).collect();
-        let fmu = out.join(format!("{}.fmu", f.identifier));
-        f.write(&libs, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
-        println!("{}", fmu.display());
+    for (version, dir) in [(Version::Fmi2, out.clone()), (Version::Fmi3, out.join("fmi3"))] {
+        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        for f in &models::all() {
+            let libs: Vec<_> = platforms.iter().map(|p| (*p, p.library(&target_dir(), f.identifier))).collect();
+            let fmu = dir.join(format!("{}.fmu", f.identifier));
+            f.write(version, &libs, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
+            println!("{}", fmu.display());
+        }
     }
     Ok(())
 }
@@ -204,19 +209,21 @@ fn eigen(json: bool, count: usize) -> Result<(), String> {
 }
 
 fn xml(check: bool) -> Result<(), String> {
-    let dir = root().join("modelDescription");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let mut stale = Vec::new();
-    for f in models::all() {
-        let path = dir.join(format!("{}.xml", f.identifier));
-        let xml = (f.model_description)();
-        if check {
-            if std::fs::read_to_string(&path).ok().as_deref() != Some(xml.as_str()) {
-                stale.push(path.display().to_string());
+    let dir = root().join("modelDescription");
+    for (version, dir) in [(Version::Fmi2, dir.clone()), (Version::Fmi3, dir.join("fmi3"))] {
+        std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+        for f in models::all() {
+            let path = dir.join(format!("{}.xml", f.identifier));
+            let xml = (f.model_description)(version);
+            if check {
+                if std::fs::read_to_string(&path).ok().as_deref() != Some(xml.as_str()) {
+                    stale.push(path.display().to_string());
+                }
+            } else {
+                std::fs::write(&path, xml).map_err(|e| format!("{}: {e}", path.display()))?;
+                println!("{}", path.display());
             }
-        } else {
-            std::fs::write(&path, xml).map_err(|e| format!("{}: {e}", path.display()))?;
-            println!("{}", path.display());
         }
     }
     if stale.is_empty() {

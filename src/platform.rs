@@ -4,14 +4,18 @@
 //! (`-Zbuild-std`, accepted by that stable compiler with `RUSTC_BOOTSTRAP=1`) and link with
 //! MinGW-w64 and aarch64 GCC (`scripts/setup-cross` installs them, all from apt).
 
+use crate::fmu::Version;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// One binary platform of an FMU.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Platform {
-    /// The folder under `binaries/` (FMI 2.0, section 2.1; fmpy's name for aarch64 Linux).
+    /// The folder under `binaries/` in FMI 2.0 (section 2.1; fmpy's name for aarch64 Linux),
+    /// and the platform's name on the command line.
     pub name: &'static str,
+    /// The folder under `binaries/` in FMI 3.0: the platform tuple (FMI 3.0, 2.5.1.1).
+    pub tuple: &'static str,
     /// Rust target triple; `None`: the host.
     pub target: Option<&'static str>,
     /// The linker's prefix of a cdylib's file name (`lib` on Linux) and the library suffix.
@@ -23,9 +27,10 @@ pub struct Platform {
 
 /// Every platform boomsim ships, the host first.
 pub const PLATFORMS: [Platform; 3] = [
-    Platform { name: "linux64", target: None, prefix: "lib", suffix: ".so", linker: "" },
+    Platform { name: "linux64", tuple: "x86_64-linux", target: None, prefix: "lib", suffix: ".so", linker: "" },
     Platform {
         name: "win64",
+        tuple: "x86_64-windows",
         target: Some("x86_64-pc-windows-gnu"),
         prefix: "",
         suffix: ".dll",
@@ -33,6 +38,7 @@ pub const PLATFORMS: [Platform; 3] = [
     },
     Platform {
         name: "aarch64-linux",
+        tuple: "aarch64-linux",
         target: Some("aarch64-unknown-linux-gnu"),
         prefix: "lib",
         suffix: ".so",
@@ -60,9 +66,17 @@ impl Platform {
             .collect()
     }
 
-    /// The binary's path inside the .fmu for model `id`.
-    pub fn entry(&self, id: &str) -> String {
-        format!("binaries/{}/{id}{}", self.name, self.suffix)
+    /// The folder under `binaries/` in FMI `version`.
+    pub fn folder(&self, version: Version) -> &'static str {
+        match version {
+            Version::Fmi2 => self.name,
+            Version::Fmi3 => self.tuple,
+        }
+    }
+
+    /// The binary's path inside the .fmu of FMI `version` for model `id`.
+    pub fn entry(&self, version: Version, id: &str) -> String {
+        format!("binaries/{}/{id}{}", self.folder(version), self.suffix)
     }
 
     /// Where the build of this platform leaves the library of `id` under the target dir `target`.
@@ -115,7 +129,9 @@ mod tests {
         let p = Platform::parse_list("linux64,win64").unwrap();
         assert_eq!(p.iter().map(|p| p.name).collect::<Vec<_>>(), ["linux64", "win64"]);
         assert!(Platform::parse_list("darwin64").unwrap_err().contains("linux64, win64, aarch64-linux"));
-        assert_eq!(PLATFORMS[1].entry("X"), "binaries/win64/X.dll");
+        assert_eq!(PLATFORMS[1].entry(Version::Fmi2, "X"), "binaries/win64/X.dll");
+        assert_eq!(PLATFORMS[1].entry(Version::Fmi3, "X"), "binaries/x86_64-windows/X.dll");
+        assert_eq!(PLATFORMS[0].entry(Version::Fmi3, "X"), "binaries/x86_64-linux/X.so");
         let lib = PLATFORMS[2].library(Path::new("t"), "X");
         assert_eq!(lib, Path::new("t/cross/aarch64-unknown-linux-gnu/release/libX.so"));
     }

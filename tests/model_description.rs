@@ -2,16 +2,20 @@
 //! table obeys the FMI 2.0 rules the generator relies on.
 
 use boomsim::fmi2::{Causality, Kind, Variable};
+use boomsim::fmu::Version;
 use boomsim::models;
 use boomsim::units::unit;
 use std::path::Path;
 
 #[test]
 fn committed_model_descriptions_are_current() {
-    for f in models::all() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("modelDescription/{}.xml", f.identifier));
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(committed == (f.model_description)(), "{} is out of date: run `boomsim xml`", path.display());
+    for (version, dir) in [(Version::Fmi2, "modelDescription"), (Version::Fmi3, "modelDescription/fmi3")] {
+        for f in models::all() {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("{dir}/{}.xml", f.identifier));
+            let committed = std::fs::read_to_string(&path).unwrap_or_default();
+            let current = (f.model_description)(version);
+            assert!(committed == current, "{} is out of date: run `boomsim xml`", path.display());
+        }
     }
 }
 
@@ -50,7 +54,7 @@ fn the_documentation_names_the_default_boom() {
     use boomsim::models::HydraulicBoom;
     let flexible = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "boom.flexible").unwrap();
     let Kind::Boolean { start } = flexible.kind else { panic!("boom.flexible is a Boolean") };
-    let doc = boomsim::fmi2::pack::documentation::<HydraulicBoom>(&boomsim::platform::PLATFORMS);
+    let doc = boomsim::fmi2::pack::documentation::<HydraulicBoom>(Version::Fmi2, &boomsim::platform::PLATFORMS);
     let says = if start { "by default the lumped flexible" } else { "by default the rigid" };
     assert!(doc.contains(says), "the documentation does not say \"{says}\"");
     assert!(!doc.contains("eight states"));
@@ -60,10 +64,14 @@ fn the_documentation_names_the_default_boom() {
 #[test]
 fn every_fmu_carries_the_project_version() {
     for f in models::all() {
-        let xml = (f.model_description)();
+        let xml = (f.model_description)(Version::Fmi2);
         let version = format!("version=\"{}\"", env!("CARGO_PKG_VERSION"));
         assert!(xml.contains(&version), "{} lacks {version}", f.identifier);
-        assert!((f.documentation)(&[]).contains(&format!("{} {}", f.identifier, env!("CARGO_PKG_VERSION"))));
+        assert!((f.documentation)(Version::Fmi2, &[]).contains(&format!(
+            "{} {}",
+            f.identifier,
+            env!("CARGO_PKG_VERSION")
+        )));
     }
 }
 
@@ -75,7 +83,7 @@ fn the_page_states_generated_facts() {
     use boomsim::fmi2::{guid::guid, Model};
     use boomsim::models::PressureFeedbackController as Pfc;
     let platforms = &boomsim::platform::PLATFORMS[..2];
-    let page = boomsim::fmi2::pack::documentation::<Pfc>(platforms);
+    let page = boomsim::fmi2::pack::documentation::<Pfc>(Version::Fmi2, platforms);
     assert!(page.contains(&guid::<Pfc>()));
     assert!(page.contains("<td>linux64, win64</td>"), "platforms");
     assert!(page.contains("(25 l/min)"), "Q_rated in l/min");
@@ -88,7 +96,9 @@ fn the_page_states_generated_facts() {
 fn the_split_models_pages_carry_the_coupling_recipe() {
     use boomsim::fmi2::pack::documentation;
     use boomsim::models::{BoomMechanics, HydraulicCircuit};
-    for page in [documentation::<HydraulicCircuit>(&[]), documentation::<BoomMechanics>(&[])] {
+    for page in
+        [documentation::<HydraulicCircuit>(Version::Fmi2, &[]), documentation::<BoomMechanics>(Version::Fmi2, &[])]
+    {
         assert!(page.contains("<h2>Coupling recipe</h2>") && page.contains("start.F") && page.contains("port.Z_c"));
     }
 }

@@ -1,10 +1,13 @@
-//! `export_fmu!`: emits the 44 FMI 2.0 symbols (Model Exchange and Co-Simulation) for one model. A cdylib crate under
-//! `fmu/<ModelIdentifier>/` consists of this one invocation.
+//! `export_fmu!`: emits the 44 FMI 2.0 symbols (Model Exchange and Co-Simulation) for one model,
+//! and the FMI 3.0 ones ([`crate::export_fmi3`]). A cdylib crate under `fmu/<ModelIdentifier>/`
+//! consists of this one invocation.
 
-/// Exports the FMI 2.0 C ABI (25 common + 9 Co-Simulation + 10 Model Exchange functions) for a [`Model`](crate::fmi2::Model).
+/// Exports the FMI 2.0 C ABI (25 common + 9 Co-Simulation + 10 Model Exchange functions) and the
+/// FMI 3.0 C ABI for a [`Model`](crate::fmu::Model).
 #[macro_export]
 macro_rules! export_fmu {
     ($model:ty) => {
+        $crate::export_fmi3!($model);
         mod fmi2_exports {
             use super::*;
             use std::os::raw::{c_char, c_int};

@@ -1,20 +1,13 @@
-//! The generic FMI 2.0 layer (Model Exchange and Co-Simulation): any [`Model`] becomes an FMU through
-//! [`export_fmu!`](crate::export_fmu). It knows nothing about the physics it exposes.
+//! The FMI 2.0 adapter (Model Exchange and Co-Simulation): any [`Model`] becomes an FMU through
+//! [`export_fmu!`](crate::export_fmu). It knows nothing about the physics it exposes; what it
+//! shares with FMI 3.0 lives in [`crate::fmu`] (re-exported here under its old paths).
 
 pub mod api;
 mod export;
-pub mod fmu_state;
-pub mod guid;
-pub mod instance;
-pub mod log;
-pub mod model;
-pub mod pack;
 pub mod state;
-pub mod structure;
 pub mod types;
-pub mod variables;
 pub mod xml;
 
-pub use model::{ContinuousState, Log, Model, ModelInfo, StepError};
-pub use pack::Fmu;
-pub use variables::{Causality, Initial, Kind, Value, Values, Variability, Variable};
+pub use crate::fmu::{fmu_state, guid, instance, log, model, pack, structure, variables};
+pub use crate::fmu::{Causality, ContinuousState, Fmu, Initial, Kind, Log, Model, ModelInfo, StepError, Value};
+pub use crate::fmu::{Values, Variability, Variable};

@@ -14,17 +14,8 @@ pub type fmi2Char = c_char;
 pub type fmi2String = *const c_char;
 pub type fmi2Byte = c_char;
 
-/// fmi2Status. Incoming statuses and enums are read as `c_int`, never transmuted.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum fmi2Status {
-    OK = 0,
-    Warning = 1,
-    Discard = 2,
-    Error = 3,
-    Fatal = 4,
-    Pending = 5,
-}
+/// fmi2Status: the status both versions share (fmi2Pending is never returned).
+pub type fmi2Status = crate::fmu::Status;
 
 /// fmi2Type values as they arrive through the ABI.
 pub const FMI2_MODEL_EXCHANGE: c_int = 0;

@@ -206,8 +206,8 @@ pub fn serialized<M: Model>(s: &Slave<M>) -> Vec<u8> {
 /// `setup` set (the safe Rust API under the C ABI).
 pub fn in_initialization<M: Model>(setup: &[(u32, boomsim::fmi2::Value)]) -> boomsim::fmi2::instance::Instance<M> {
     use boomsim::fmi2::{instance::Instance, log::Logger, state::Interface};
-    let log = Logger::new(None, std::ptr::null_mut(), "test", &[], false);
-    let mut i = Instance::<M>::new(log, guid::<M>(), Interface::CoSimulation);
+    let log = Logger::new(None, "test", &[], false);
+    let mut i = Instance::<M>::new(log, guid::<M>(), boomsim::fmu::Version::Fmi2, Interface::CoSimulation);
     i.setup_experiment(None, 0.0, None).unwrap();
     i.enter_initialization_mode();
     for (r, x) in setup {

@@ -35,6 +35,26 @@ SetContinuousStates GetDerivatives GetEventIndicators GetContinuousStates GetNom
 #: Every function a boomsim FMU exports: both interfaces.
 FMI2_FUNCTIONS = FMI2_CS_FUNCTIONS + FMI2_ME_FUNCTIONS
 
+#: The 75 functions of fmi3FunctionTypes.h (FMI 3.0), without "fmi3": the same binary exports
+#: them beside the FMI 2.0 ones (Scheduled Execution, clocks and the types no variable has are
+#: exported too and answer fmi3Error with a message).
+FMI3_FUNCTIONS = """GetVersion SetDebugLogging InstantiateModelExchange InstantiateCoSimulation
+InstantiateScheduledExecution FreeInstance EnterInitializationMode ExitInitializationMode EnterEventMode
+Terminate Reset GetFloat32 GetFloat64 GetInt8 GetUInt8 GetInt16 GetUInt16 GetInt32 GetUInt32 GetInt64
+GetUInt64 GetBoolean GetString GetBinary GetClock SetFloat32 SetFloat64 SetInt8 SetUInt8 SetInt16 SetUInt16
+SetInt32 SetUInt32 SetInt64 SetUInt64 SetBoolean SetString SetBinary SetClock GetNumberOfVariableDependencies
+GetVariableDependencies GetFMUState SetFMUState FreeFMUState SerializedFMUStateSize SerializeFMUState
+DeserializeFMUState GetDirectionalDerivative GetAdjointDerivative EnterConfigurationMode
+ExitConfigurationMode GetIntervalDecimal GetIntervalFraction GetShiftDecimal GetShiftFraction
+SetIntervalDecimal SetIntervalFraction SetShiftDecimal SetShiftFraction EvaluateDiscreteStates
+UpdateDiscreteStates EnterContinuousTimeMode CompletedIntegratorStep SetTime SetContinuousStates
+GetContinuousStateDerivatives GetEventIndicators GetContinuousStates GetNominalsOfContinuousStates
+GetNumberOfEventIndicators GetNumberOfContinuousStates EnterStepMode GetOutputDerivatives DoStep
+ActivateModelPartition""".split()
+
+#: Every symbol of a boomsim FMU library.
+EXPORTED = {"fmi2" + f for f in FMI2_FUNCTIONS} | {"fmi3" + f for f in FMI3_FUNCTIONS}
+
 
 def fmu_path(identifier):
     path = FMU_DIR / f"{identifier}.fmu"

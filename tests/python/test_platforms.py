@@ -26,7 +26,7 @@ import fmpy
 from fmpy.validation import validate_fmu
 import pytest
 
-from conftest import FMI2_FUNCTIONS, fmu_path
+from conftest import EXPORTED, fmu_path
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HOST_SOURCE = ROOT / "tests" / "host" / "fmu_host.c"
@@ -113,15 +113,15 @@ def test_every_platform_is_in_the_fmu(ident):
 
 
 def exports_and_imports(platform, lib):
-    """(exported fmi2 symbols, imported libraries) of a binary, read with the platform's binutils."""
+    """(exported fmi2/fmi3 symbols, imported libraries) of a binary, read with the platform's binutils."""
     if platform == "win64":
         text = subprocess.run(["x86_64-w64-mingw32-objdump", "-p", str(lib)], capture_output=True, text=True).stdout
-        exports = {w for w in text.split() if w.startswith("fmi2")}
+        exports = {w for w in text.split() if w.startswith(("fmi2", "fmi3"))}
         imports = {line.split(":")[1].strip().lower() for line in text.splitlines() if "DLL Name:" in line}
         return exports, imports
     prefix = "aarch64-linux-gnu-" if platform == "aarch64-linux" else ""
     nm = subprocess.run([prefix + "nm", "-D", "--defined-only", str(lib)], capture_output=True, text=True).stdout
-    exports = {line.split()[-1] for line in nm.splitlines() if line.split()[-1].startswith("fmi2")}
+    exports = {line.split()[-1] for line in nm.splitlines() if line.split()[-1].startswith(("fmi2", "fmi3"))}
     dyn = subprocess.run([prefix + "readelf", "-d", str(lib)], capture_output=True, text=True).stdout
     imports = {line.split("[")[1].rstrip("]") for line in dyn.splitlines() if "(NEEDED)" in line}
     return exports, imports
@@ -130,11 +130,12 @@ def exports_and_imports(platform, lib):
 @pytest.mark.parametrize("ident", IDS)
 @pytest.mark.parametrize("platform", PLATFORMS)
 def test_exports_and_dependencies(unpacked, ident, platform):
-    """fmpy loads all 34 functions: each binary exports exactly them, and imports nothing a plain
+    """fmpy loads all 34 functions: each binary exports exactly the FMI 2.0 and FMI 3.0 functions
+    (one library for both versions' .fmu), and imports nothing a plain
     Windows 10 or glibc Linux lacks (no libgcc_s_seh, libwinpthread, libstdc++)."""
     lib = unpacked[ident][0] / "binaries" / platform / (ident + SUFFIX[platform])
     exports, imports = exports_and_imports(platform, lib)
-    assert exports == {"fmi2" + f for f in FMI2_FUNCTIONS}
+    assert exports == EXPORTED
     allowed = ALLOWED_DLLS if platform == "win64" else ALLOWED_SO
     extra = {i for i in imports if i not in allowed and not i.startswith("api-ms-win-core-")}
     assert not extra, f"{ident} on {platform} imports {sorted(extra)}"

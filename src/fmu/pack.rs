@@ -1,12 +1,13 @@
-//! The .fmu archive: modelDescription.xml at the root, the shared library of every platform
-//! under `binaries/<platform>/<modelIdentifier>.<so|dll>` ([`crate::platform`]), and
-//! `documentation/index.html`.
+//! The .fmu archive of either FMI version: modelDescription.xml at the root, the shared library
+//! of every platform under `binaries/<platform>/<modelIdentifier>.<so|dll>` (the version's
+//! platform names, [`crate::platform`]), and `documentation/index.html`. The same library goes
+//! into both versions' archives: it exports the fmi2* and the fmi3* symbols.
 
+use super::guid::{guid, token};
+use super::log::{num, GENERIC_CATEGORIES};
 use super::model::Model;
 use super::variables::{Kind, Variable};
-use super::guid::guid;
-use super::log::{num, GENERIC_CATEGORIES};
-use super::xml::model_description;
+use super::version::Version;
 use crate::platform::Platform;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -18,9 +19,10 @@ pub struct Fmu {
     pub identifier: &'static str,
     /// Cargo package of the cdylib crate under `fmu/<identifier>/`.
     pub package: &'static str,
-    pub model_description: fn() -> String,
-    /// documentation/index.html for the platforms packed.
-    pub documentation: fn(&[Platform]) -> String,
+    /// modelDescription.xml of each version.
+    pub model_description: fn(Version) -> String,
+    /// documentation/index.html of a version for the platforms packed.
+    pub documentation: fn(Version, &[Platform]) -> String,
 }
 
 impl Fmu {
@@ -34,20 +36,20 @@ impl Fmu {
         }
     }
 
-    /// Writes the .fmu from the built shared library of each platform. Entries carry a fixed
-    /// timestamp, so the archive is reproducible.
-    pub fn write(&self, libraries: &[(Platform, PathBuf)], out: &Path) -> zip::result::ZipResult<()> {
+    /// Writes the .fmu of `version` from the built shared library of each platform. Entries carry
+    /// a fixed timestamp, so the archive is reproducible.
+    pub fn write(&self, version: Version, libraries: &[(Platform, PathBuf)], out: &Path) -> zip::result::ZipResult<()> {
         let mut zip = zip::ZipWriter::new(std::fs::File::create(out)?);
         let deflate = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         zip.start_file("modelDescription.xml", deflate)?;
-        zip.write_all((self.model_description)().as_bytes())?;
+        zip.write_all((self.model_description)(version).as_bytes())?;
         for (platform, library) in libraries {
-            zip.start_file(platform.entry(self.identifier), deflate.unix_permissions(0o755))?;
+            zip.start_file(platform.entry(version, self.identifier), deflate.unix_permissions(0o755))?;
             zip.write_all(&std::fs::read(library)?)?;
         }
         zip.start_file("documentation/index.html", deflate)?;
         let platforms: Vec<Platform> = libraries.iter().map(|(p, _)| *p).collect();
-        zip.write_all((self.documentation)(&platforms).as_bytes())?;
+        zip.write_all((self.documentation)(version, &platforms).as_bytes())?;
         zip.finish()?;
         Ok(())
     }
@@ -93,24 +95,39 @@ fn in_display_unit(x: f64, unit: &str, display_unit: &str) -> Option<String> {
     Some(format!("{} {display_unit}", num(y)))
 }
 
+/// modelDescription.xml of model `M` in FMI `version`.
+pub fn model_description<M: Model>(version: Version) -> String {
+    match version {
+        Version::Fmi2 => crate::fmi2::xml::model_description::<M>(),
+        Version::Fmi3 => crate::fmi3::xml::model_description::<M>(),
+    }
+}
+
 /// The facts of the FMU, generated so that they cannot go stale: interface, version, GUID,
 /// default experiment, interpolated inputs, log categories, platforms.
-fn facts<M: Model>(platforms: &[Platform]) -> String {
+fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
     let i = &M::INFO;
     let name = |r: &u32| M::VARIABLES.iter().find(|v| v.vr == *r).map_or("?", |v| v.name);
     let interpolated: Vec<&str> = i.interpolated_inputs.iter().map(name).collect();
     let categories: Vec<&str> = GENERIC_CATEGORIES.iter().chain(i.log_categories).map(|c| c.0).collect();
-    let platforms: Vec<&str> = platforms.iter().map(|p| p.name).collect();
+    let platforms: Vec<&str> = platforms.iter().map(|p| p.folder(version)).collect();
     let states: Vec<&str> = M::STATES.iter().map(|s| name(&s.state)).collect();
-    let rows = [
-        ("Interfaces", "FMI 2.0 Model Exchange and Co-Simulation".to_owned()),
-        (
-            "Continuous states (Model Exchange, in fmi2GetContinuousStates order)",
-            format!("{}: {}", states.len(), states.join(", ")),
+    let (fmi, identity, interpolation) = match version {
+        Version::Fmi2 => ("FMI 2.0", ("GUID", guid::<M>()), "Inputs linear over a step (fmi2SetRealInputDerivatives)"),
+        Version::Fmi3 => (
+            "FMI 3.0",
+            ("Instantiation token", token::<M>()),
+            "Inputs linear over a step (FMI 2.0's fmi2SetRealInputDerivatives; FMI 3.0 holds inputs over a step)",
         ),
+    };
+    let states_label =
+        format!("Continuous states (Model Exchange, in {} order)", version.function("fmi2GetContinuousStates"));
+    let rows = [
+        ("Interfaces", format!("{fmi} Model Exchange and Co-Simulation")),
+        (states_label.as_str(), format!("{}: {}", states.len(), states.join(", "))),
         ("Model identifier", i.identifier.to_owned()),
         ("Version", i.version.to_owned()),
-        ("GUID", guid::<M>()),
+        identity,
         ("Platforms", platforms.join(", ")),
         (
             "Default experiment",
@@ -122,10 +139,7 @@ fn facts<M: Model>(platforms: &[Platform]) -> String {
                 num(i.default_tolerance)
             ),
         ),
-        (
-            "Inputs linear over a step (fmi2SetRealInputDerivatives)",
-            if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") },
-        ),
+        (interpolation, if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") }),
         ("Log categories", categories.join(", ")),
         ("Variables", M::VARIABLES.len().to_string()),
     ];
@@ -139,8 +153,9 @@ const STYLE: &str = "body{font-family:sans-serif;max-width:70em;margin:2em auto;
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #bbb;padding:0.2em 0.5em;text-align:left;\
 vertical-align:top}th{background:#eee}code{font-size:95%}table.facts th{width:18em}";
 
-/// documentation/index.html: the model's facts, equations and notes, and every variable.
-pub fn documentation<M: Model>(platforms: &[Platform]) -> String {
+/// documentation/index.html of FMI `version`: the model's facts, equations and notes, and every
+/// variable.
+pub fn documentation<M: Model>(version: Version, platforms: &[Platform]) -> String {
     let i = &M::INFO;
     let rows: String = M::VARIABLES.iter().map(row).collect();
     format!(
@@ -148,7 +163,7 @@ pub fn documentation<M: Model>(platforms: &[Platform]) -> String {
         id = i.identifier,
         version = i.version,
         desc = html_escape(i.description),
-        facts = facts::<M>(platforms),
+        facts = facts::<M>(version, platforms),
         doc = i.documentation,
     )
 }

@@ -1,7 +1,25 @@
-//! Logging through the importer's callback, with FMI 2.0 log categories.
+//! Logging through the importer's callback (either FMI version's, behind [`Sink`]), with the
+//! log categories every boomsim FMU declares.
 
-use super::types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
-use std::ffi::CString;
+use std::ffi::{CStr, CString};
+
+/// Status and fmi3Status: the same values 0 to 4 in both versions (FMI 2.0's fmi2Pending is
+/// never returned: doStep is synchronous). Incoming statuses are read as `c_int`, never transmuted.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    OK = 0,
+    Warning = 1,
+    Discard = 2,
+    Error = 3,
+    Fatal = 4,
+}
+
+/// The importer's logging callback of one FMI version.
+pub trait Sink: Send {
+    /// Delivers one message of `instance` (its name) with `status` in `category`.
+    fn emit(&self, instance: &CStr, status: Status, category: &CStr, message: &CStr);
+}
 
 /// Categories every boomsim FMU declares, in this order, before the model's own.
 pub const GENERIC_CATEGORIES: &[(&str, &str)] = &[
@@ -18,38 +36,32 @@ pub const LOG_FMI_CALLS: usize = 5;
 
 /// The instance's connection to the importer's logger.
 pub struct Logger {
-    callback: fmi2CallbackLogger,
-    environment: fmi2ComponentEnvironment,
+    sink: Option<Box<dyn Sink>>,
     instance_name: CString,
     categories: Vec<(&'static str, &'static str)>,
     enabled: Vec<bool>,
 }
 
-// SAFETY: the environment pointer is only handed back to the importer's callback, which FMI
-// requires to be callable for this instance from whichever thread uses the instance.
-unsafe impl Send for Logger {}
-
 impl Logger {
-    /// A logger for one instance. With `logging_on`, every category is enabled; otherwise only
-    /// warnings, discards and errors are.
+    /// A logger for one instance (silent without a sink). With `logging_on`, every category is
+    /// enabled; otherwise only warnings, discards and errors are.
     pub fn new(
-        callback: fmi2CallbackLogger,
-        environment: fmi2ComponentEnvironment,
+        sink: Option<Box<dyn Sink>>,
         instance_name: &str,
         model_categories: &'static [(&'static str, &'static str)],
         logging_on: bool,
     ) -> Self {
         let categories: Vec<_> = GENERIC_CATEGORIES.iter().chain(model_categories).copied().collect();
         let enabled = (0..categories.len()).map(|i| logging_on || i < LOG_ALL).collect();
-        Logger { callback, environment, instance_name: c_string(instance_name), categories, enabled }
+        Logger { sink, instance_name: c_string(instance_name), categories, enabled }
     }
 
-    /// The instance name given to fmi2Instantiate.
+    /// The instance name given at instantiation.
     pub fn instance_name(&self) -> &str {
         self.instance_name.to_str().unwrap_or("?")
     }
 
-    /// fmi2SetDebugLogging: no categories = all of them; an unknown name is an error naming it.
+    /// fmi2SetDebugLogging / fmi3SetDebugLogging: no categories = all of them; an unknown name is an error naming it.
     pub fn set_debug_logging(&mut self, on: bool, names: &[&str]) -> Result<(), String> {
         if names.is_empty() {
             self.enabled.iter_mut().for_each(|e| *e = on);
@@ -75,15 +87,15 @@ impl Logger {
     }
 
     /// Logs `message` with `status`; the category follows from the status.
-    pub fn status(&self, status: fmi2Status, message: &str) {
+    pub fn status(&self, status: Status, message: &str) {
         let category = match status {
-            fmi2Status::Warning => 0,
-            fmi2Status::Discard => 1,
-            fmi2Status::Error => 2,
-            fmi2Status::Fatal => 3,
+            Status::Warning => 0,
+            Status::Discard => 1,
+            Status::Error => 2,
+            Status::Fatal => 3,
             _ => LOG_FMI_CALLS,
         };
-        let always = matches!(status, fmi2Status::Error | fmi2Status::Fatal);
+        let always = matches!(status, Status::Error | Status::Fatal);
         if always || self.is_enabled(category) {
             self.emit(status, self.categories[category].0, message);
         }
@@ -94,28 +106,16 @@ impl Logger {
         self.categories.iter().position(|(c, _)| *c == category).is_some_and(|i| self.is_enabled(i))
     }
 
-    /// Logs an fmi2OK message in a category given by name (the model's own or `logFmiCalls`).
+    /// Logs an OK message in a category given by name (the model's own or `logFmiCalls`).
     pub fn info(&self, category: &str, message: &str) {
         if self.category_enabled(category) {
-            self.emit(fmi2Status::OK, category, message);
+            self.emit(Status::OK, category, message);
         }
     }
 
-    fn emit(&self, status: fmi2Status, category: &str, message: &str) {
-        if let Some(log) = self.callback {
-            let category = c_string(category);
-            let message = c_string(message);
-            // SAFETY: a printf-style callback with a "%s" format and one NUL-terminated string.
-            unsafe {
-                log(
-                    self.environment,
-                    self.instance_name.as_ptr(),
-                    status as i32,
-                    category.as_ptr(),
-                    c"%s".as_ptr(),
-                    message.as_ptr(),
-                )
-            };
+    fn emit(&self, status: Status, category: &str, message: &str) {
+        if let Some(sink) = &self.sink {
+            sink.emit(&self.instance_name, status, &c_string(category), &c_string(message));
         }
     }
 }

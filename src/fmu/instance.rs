@@ -1,23 +1,29 @@
 //! One FMU instance: variable values, model, time and state machine, in safe Rust.
 //! [`super::api`] wraps these methods in the C ABI.
 
-use super::log::{num, Logger};
+use super::log::{num, Logger, Status};
 use super::model::{Log, Model};
 use super::state::{Interface, State};
-use super::types::fmi2Status;
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
+use super::version::Version;
 use std::borrow::Cow;
 
 /// Relative tolerance for matching the master's communication point with the instance time.
 pub const TIME_MATCH_RTOL: f64 = 1e-9;
 
 /// Relative tolerances the plants' integrator is used with: a tolerance of fmi2SetupExperiment
+/// (fmi3EnterInitializationMode)
 /// outside is clamped into it with a warning. Below 1e-12 the error estimates of a stiff solver
 /// in f64 (unit round-off 1.1e-16, times the condition of the Newton matrices) are round-off;
 /// above 1e-2 the error control no longer bounds a relative error worth the name.
 pub const TOLERANCE_RANGE: (f64, f64) = (1e-12, 1e-2);
 
-/// What a call did besides succeeding: a warning to log with fmi2Warning.
+/// The value reference of the independent variable `time` of FMI 3.0 (FMI 3.0, 2.4.7.4: exactly
+/// one variable has causality="independent"). It is not a row of the tables (FMI 2.0 declares
+/// no independent variable), so it lies far above every table's references.
+pub const INDEPENDENT_VR: u32 = 1_000_000;
+
+/// What a call did besides succeeding: a warning to log with status Warning.
 pub type Warning = Option<String>;
 
 /// A live instance. `#[repr(C)]` so that `magic` is first: it tells a boomsim instance of this
@@ -26,17 +32,20 @@ pub type Warning = Option<String>;
 pub struct Instance<M: Model> {
     pub(crate) magic: u64,
     pub log: Logger,
+    /// The FMI version the instance was created through (its function and type names).
+    pub version: Version,
     /// Model Exchange or Co-Simulation, as instantiated.
     pub interface: Interface,
     pub core: Core<M>,
-    /// Storage behind the pointers the last fmi2GetString returned.
+    /// Storage behind the pointers the last fmi2GetString / fmi3GetString returned.
     pub(crate) strings: Vec<std::ffi::CString>,
-    /// The model's GUID, computed once at instantiation (FMU state bytes carry it).
+    /// The model's GUID (FMI 3.0: instantiation token), computed once at instantiation (FMU state
+    /// bytes carry it, so a state of one version is refused by the other).
     pub guid: String,
     /// Per table row: whether it is the `der()` variable of a continuous state.
     pub(crate) derivative_rows: Vec<bool>,
     /// The FMU states this instance allocated and the importer has not freed yet; freed with the
-    /// instance (FMI 2.0, 2.1.5: fmi2FreeInstance frees all memory the instance allocated).
+    /// instance (FMI 2.0, 2.1.5; FMI 3.0, 2.3.1: freeing the instance frees all its memory).
     pub(crate) fmu_states: Vec<*mut Core<M>>,
 }
 
@@ -97,7 +106,7 @@ impl Log for ModelLog<'_> {
         self.0.info(category, message);
     }
     fn warning(&mut self, message: &str) {
-        self.0.status(fmi2Status::Warning, message);
+        self.0.status(Status::Warning, message);
     }
 }
 
@@ -114,14 +123,22 @@ const fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
 }
 
 impl<M: Model> Instance<M> {
-    /// Tag of a live instance of model `M`.
-    pub const MAGIC: u64 = fnv1a(M::INFO.identifier.as_bytes(), 0x1157);
+    /// Tag of a live instance of model `M` created through FMI `version`: an instance of one
+    /// version passed to the other's functions is refused like any foreign pointer.
+    pub const fn magic(version: Version) -> u64 {
+        let seed = match version {
+            Version::Fmi2 => 0x1157,
+            Version::Fmi3 => 0x3157,
+        };
+        fnv1a(M::INFO.identifier.as_bytes(), seed)
+    }
 
-    /// A freshly instantiated slave.
-    pub fn new(log: Logger, guid: String, interface: Interface) -> Self {
+    /// A freshly instantiated instance.
+    pub fn new(log: Logger, guid: String, version: Version, interface: Interface) -> Self {
         Instance {
-            magic: Self::MAGIC,
+            magic: Self::magic(version),
             log,
+            version,
             interface,
             core: Core::new(),
             strings: Vec::new(),
@@ -268,15 +285,31 @@ impl<M: Model> Instance<M> {
 
     /// fmi2GetEventIndicators (in Initialization Mode: those the values set so far give).
     pub fn event_indicators(&mut self, z: &mut [f64]) -> Result<(), String> {
-        Self::check_count("ni", z.len(), M::EVENT_INDICATORS, "event indicators")?;
+        Self::check_count("ni", z.len(), self.event_indicator_count(), "event indicators")?;
         self.with_model(|m, values| m.event_indicators(values, z))
     }
 
-    /// fmi2GetDerivatives. `Ok(Some(why))`: not finite at these states (fmi2Discard).
+    /// The number of event indicators this version's modelDescription.xml declares. FMI 3.0
+    /// declares event indicators as variables (ModelStructure `<EventIndicator>`), which the
+    /// tables do not have: the FMI 3.0 FMUs declare none (the importer's integrator steps over
+    /// the kinks of the right-hand side, as it does for any FMU without event indicators).
+    pub fn event_indicator_count(&self) -> usize {
+        match self.version {
+            Version::Fmi2 => M::EVENT_INDICATORS,
+            Version::Fmi3 => 0,
+        }
+    }
+
+    /// fmi2GetDerivatives (FMI 3.0 also in Initialization Mode: those the values set so far give).
+    /// `Ok(Some(why))`: not finite at these states (status Discard).
     pub fn derivatives(&mut self, dx: &mut [f64]) -> Result<Warning, String> {
         Self::check_states(dx.len())?;
-        let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
-        model.derivatives(&self.core.values, dx);
+        if self.core.state == State::InitializationMode {
+            self.with_model(|m, values| m.derivatives(values, dx))?;
+        } else {
+            let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
+            model.derivatives(&self.core.values, dx);
+        }
         Ok(dx.iter().position(|d| !d.is_finite()).map(|k| {
             format!(
                 "der({}) = {} at t = {}: the states are outside the model's valid range; retry with a smaller step",
@@ -331,6 +364,28 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
+    /// fmi3GetAdjointDerivative: `out[j]` = sum over the unknowns `i` of `seeds[i]` times the
+    /// partial derivative of unknown `i` by known `j` (the transposed Jacobian times the seeds),
+    /// one forward-mode column per known; the references are checked as for
+    /// [`Instance::directional_derivative`].
+    pub fn adjoint_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seeds: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        if let Some(i) = seeds.iter().position(|s| !s.is_finite()) {
+            return Err(format!("seed[{i}] = {} is not a finite number", num(seeds[i])));
+        }
+        let mut column = vec![0.0; unknowns.len()];
+        for (o, &known) in out.iter_mut().zip(knowns) {
+            self.directional_derivative(unknowns, &[known], &[1.0], &mut column)?;
+            *o = column.iter().zip(seeds).map(|(c, s)| c * s).sum();
+        }
+        Ok(())
+    }
+
     /// The name of the `k`-th continuous state.
     fn state_name(&self, k: usize) -> &'static str {
         self.name(M::STATES[k].state).unwrap_or("?")
@@ -367,16 +422,41 @@ impl<M: Model> Instance<M> {
 
     /// Looks up a value reference and checks its type.
     fn lookup(&self, vr: u32, wanted: BaseType) -> Result<(usize, &'static Variable), String> {
+        let (i, v) = self.variable(vr)?;
+        if v.base_type() != wanted {
+            return Err(self.type_mismatch(vr, self.version.type_name(wanted)));
+        }
+        Ok((i, v))
+    }
+
+    /// The table row of a value reference.
+    fn variable(&self, vr: u32) -> Result<(usize, &'static Variable), String> {
+        if self.version == Version::Fmi3 && vr == INDEPENDENT_VR {
+            return Err(format!(
+                "\"time\" (vr {vr}) is the independent variable, a Float64 that can only be read (fmi3EnterInitializationMode, fmi3SetTime and fmi3DoStep move it)"
+            ));
+        }
         let i = self
             .core
             .values
             .position(vr)
             .ok_or_else(|| format!("unknown value reference {vr}: {} has no such variable", M::INFO.identifier))?;
-        let v = &M::VARIABLES[i];
-        if v.base_type() != wanted {
-            return Err(format!("variable \"{}\" (vr {vr}) is a {:?}, not a {wanted:?}", v.name, v.base_type()));
+        Ok((i, &M::VARIABLES[i]))
+    }
+
+    /// Why `vr` cannot be accessed as a `wanted` (a type name of this version): unknown, or of
+    /// another type.
+    pub fn type_mismatch(&self, vr: u32, wanted: &str) -> String {
+        match self.variable(vr) {
+            Err(e) => e,
+            Ok((_, v)) => {
+                format!(
+                    "variable \"{}\" (vr {vr}) is a {}, not a {wanted}",
+                    v.name,
+                    self.version.type_name(v.base_type())
+                )
+            }
         }
-        Ok((i, v))
     }
 
     /// Reads values of one type: `read` converts a stored value.
@@ -389,6 +469,10 @@ impl<M: Model> Instance<M> {
     ) -> Result<(), String> {
         self.refresh_outputs()?;
         for (k, &vr) in vrs.iter().enumerate() {
+            if self.version == Version::Fmi3 && vr == INDEPENDENT_VR && wanted == BaseType::Real {
+                out[k] = read(&Value::Real(self.core.time));
+                continue;
+            }
             let (i, v) = self.lookup(vr, wanted)?;
             if self.derivative_rows[i] && !self.core.derivatives_current {
                 self.refresh_derivatives()?;
@@ -497,9 +581,10 @@ impl<M: Model> Instance<M> {
         if let Some(stop) = c.stop_time {
             if t + h > stop + TIME_MATCH_RTOL * stop.abs().max(1.0) {
                 return Err(format!(
-                    "a step to t = {} would pass the stop time {} set in fmi2SetupExperiment",
+                    "a step to t = {} would pass the stop time {} set in {}",
                     num(t + h),
-                    num(stop)
+                    num(stop),
+                    self.version.function("fmi2SetupExperiment")
                 ));
             }
         }
@@ -548,10 +633,13 @@ impl<M: Model> Instance<M> {
             c.state = State::Error;
             let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
             return Err(format!(
-                "{} = {} at t = {}: the model left its valid range; the instance is now in the Error state (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
+                "{} = {} at t = {}: the model left its valid range; the instance is now in the Error state ({}, {} or {})",
                 M::VARIABLES[i].name,
                 num(x),
-                num(end)
+                num(end),
+                self.version.function("fmi2Reset"),
+                self.version.function("fmi2SetFMUstate"),
+                self.version.function("fmi2FreeInstance")
             ));
         }
         Ok(Step::Done(warning))

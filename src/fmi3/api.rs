@@ -1,0 +1,531 @@
+//! The FMI 3.0 functions of Model Exchange and Co-Simulation (and, refused, those of Scheduled
+//! Execution, clocks and early return), generic over the model. The export macro
+//! ([`crate::export_fmi3`]) forwards each symbol here; what FMI 2.0 does alike is in
+//! [`crate::fmu::abi`], called with the function's FMI 3.0 name and its rule of [`allowed`].
+#![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
+
+use super::state::{allowed, Interface, Rule, State};
+use super::types::*;
+use crate::fmu::abi::{self, call, slice, slice_mut, Call};
+use crate::fmu::guid::token;
+use crate::fmu::instance::Instance;
+use crate::fmu::log::Logger;
+use crate::fmu::model::Model;
+use crate::fmu::variables::{BaseType, Value};
+use crate::fmu::version::Version;
+use std::ffi::CStr;
+use std::os::raw::c_char;
+use std::panic::catch_unwind;
+
+/// The FMI 3.0 function `function` with its rule.
+const fn at(function: &'static str, rule: Rule) -> Call {
+    Call { version: Version::Fmi3, function, rule }
+}
+
+/// The importer's fmi3LogMessageCallback and its instance environment.
+struct Sink(fmi3LogMessageCallback, fmi3InstanceEnvironment);
+
+// SAFETY: the environment pointer is only handed back to the importer's callback, which FMI
+// requires to be callable for this instance from whichever thread uses the instance.
+unsafe impl Send for Sink {}
+
+impl crate::fmu::log::Sink for Sink {
+    fn emit(&self, _instance: &CStr, status: fmi3Status, category: &CStr, message: &CStr) {
+        if let Some(log) = self.0 {
+            // SAFETY: the callback of fmi3FunctionTypes.h with two NUL-terminated strings.
+            unsafe { log(self.1, status, category.as_ptr(), message.as_ptr()) };
+        }
+    }
+}
+
+pub fn get_version() -> *const c_char {
+    c"3.0".as_ptr()
+}
+
+/// The checks and the logger both instantiation functions share; `more` checks the rest.
+/// A NULL `logMessage` is accepted: the instance runs silently, its statuses still tell every
+/// failure.
+unsafe fn instantiate<M: Model>(
+    function: &str,
+    interface: Interface,
+    (name, instantiation_token): (fmi3String, fmi3String),
+    logging_on: bool,
+    (environment, log_message): (fmi3InstanceEnvironment, fmi3LogMessageCallback),
+    more: impl FnOnce() -> Result<(), String>,
+) -> fmi3Instance {
+    catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let sink = Box::new(Sink(log_message, environment));
+        let logger = Logger::new(Some(sink), abi::text(name).unwrap_or(""), M::INFO.log_categories, logging_on);
+        let expected = token::<M>();
+        let checked = abi::instance_name(name)
+            .and_then(|_| {
+                abi::check_identity(instantiation_token, "instantiationToken", "instantiationToken", &expected)
+            })
+            .and_then(|_| more());
+        match checked {
+            Ok(()) => abi::new_instance::<M>(logger, expected, Version::Fmi3, interface),
+            Err(message) => {
+                logger.status(fmi3Status::Error, &format!("{function}: {message}"));
+                std::ptr::null_mut()
+            }
+        }
+    }))
+    .unwrap_or(std::ptr::null_mut())
+}
+
+pub unsafe fn instantiate_model_exchange<M: Model>(
+    name: fmi3String,
+    instantiation_token: fmi3String,
+    _resource_path: fmi3String,
+    _visible: fmi3Boolean,
+    logging_on: fmi3Boolean,
+    environment: fmi3InstanceEnvironment,
+    log_message: fmi3LogMessageCallback,
+) -> fmi3Instance {
+    let f = "fmi3InstantiateModelExchange";
+    instantiate::<M>(
+        f,
+        Interface::ModelExchange,
+        (name, instantiation_token),
+        logging_on,
+        (environment, log_message),
+        || Ok(()),
+    )
+}
+
+/// fmi3InstantiateCoSimulation: `eventModeUsed` is refused (`hasEventMode="false"`), and so are
+/// required intermediate variables (`providesIntermediateUpdate="false"`); `earlyReturnAllowed`
+/// is accepted (doStep never returns early).
+pub unsafe fn instantiate_co_simulation<M: Model>(
+    name: fmi3String,
+    instantiation_token: fmi3String,
+    _resource_path: fmi3String,
+    _visible: fmi3Boolean,
+    logging_on: fmi3Boolean,
+    event_mode_used: fmi3Boolean,
+    _early_return_allowed: fmi3Boolean,
+    _required_intermediate_variables: *const fmi3ValueReference,
+    n_required_intermediate_variables: usize,
+    environment: fmi3InstanceEnvironment,
+    log_message: fmi3LogMessageCallback,
+    _intermediate_update: fmi3IntermediateUpdateCallback,
+) -> fmi3Instance {
+    let more = || {
+        if event_mode_used {
+            return Err(
+                "eventModeUsed = true, but the FMU has no event mode in Co-Simulation (hasEventMode=\"false\")".into(),
+            );
+        }
+        if n_required_intermediate_variables != 0 {
+            return Err(format!(
+                "nRequiredIntermediateVariables = {n_required_intermediate_variables}, but the FMU provides no intermediate update (providesIntermediateUpdate=\"false\"); valid: 0"
+            ));
+        }
+        Ok(())
+    };
+    let f = "fmi3InstantiateCoSimulation";
+    instantiate::<M>(
+        f,
+        Interface::CoSimulation,
+        (name, instantiation_token),
+        logging_on,
+        (environment, log_message),
+        more,
+    )
+}
+
+/// fmi3InstantiateScheduledExecution: not provided (no `<ScheduledExecution>` element); NULL.
+pub unsafe fn instantiate_scheduled_execution<M: Model>(
+    name: fmi3String,
+    logging_on: fmi3Boolean,
+    environment: fmi3InstanceEnvironment,
+    log_message: fmi3LogMessageCallback,
+) -> fmi3Instance {
+    let sink = Box::new(Sink(log_message, environment));
+    let logger = Logger::new(Some(sink), abi::text(name).unwrap_or(""), M::INFO.log_categories, logging_on);
+    logger.status(
+        fmi3Status::Error,
+        "fmi3InstantiateScheduledExecution: not supported: the FMU provides Model Exchange and Co-Simulation only",
+    );
+    std::ptr::null_mut()
+}
+
+pub unsafe fn free_instance<M: Model>(c: fmi3Instance) {
+    abi::free_instance::<M>(c, at("fmi3FreeInstance", allowed::FREE_INSTANCE))
+}
+
+pub unsafe fn set_debug_logging<M: Model>(
+    c: fmi3Instance,
+    on: fmi3Boolean,
+    n: usize,
+    categories: *const fmi3String,
+) -> fmi3Status {
+    abi::set_debug_logging::<M>(c, at("fmi3SetDebugLogging", allowed::SET_DEBUG_LOGGING), on, n, categories)
+}
+
+/// fmi3EnterInitializationMode: the experiment (FMI 2.0's fmi2SetupExperiment) and the mode.
+pub unsafe fn enter_initialization_mode<M: Model>(
+    c: fmi3Instance,
+    tolerance_defined: fmi3Boolean,
+    tolerance: f64,
+    start: f64,
+    stop_defined: fmi3Boolean,
+    stop: f64,
+) -> fmi3Status {
+    let f = at("fmi3EnterInitializationMode", allowed::ENTER_INITIALIZATION_MODE);
+    call::<M>(c, f, |inst| {
+        let status = abi::setup_experiment(
+            inst,
+            f.function,
+            tolerance_defined.then_some(tolerance),
+            start,
+            stop_defined.then_some(stop),
+        )?;
+        inst.enter_initialization_mode();
+        Ok(status)
+    })
+}
+
+pub unsafe fn exit_initialization_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
+    abi::exit_initialization_mode::<M>(c, at("fmi3ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE))
+}
+
+pub unsafe fn enter_event_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
+    abi::enter::<M>(c, at("fmi3EnterEventMode", allowed::ENTER_EVENT_MODE), State::EventMode)
+}
+
+pub unsafe fn terminate<M: Model>(c: fmi3Instance) -> fmi3Status {
+    abi::enter::<M>(c, at("fmi3Terminate", allowed::TERMINATE), State::Terminated)
+}
+
+pub unsafe fn reset<M: Model>(c: fmi3Instance) -> fmi3Status {
+    abi::reset::<M>(c, at("fmi3Reset", allowed::RESET))
+}
+
+/// The variables are scalars: `nValues` must equal `nValueReferences`.
+fn scalar_count(n_vr: usize, n_values: usize) -> Result<(), String> {
+    if n_vr == n_values {
+        return Ok(());
+    }
+    Err(format!(
+        "nValues = {n_values}, but the {n_vr} value references name {n_vr} values (every variable is a scalar)"
+    ))
+}
+
+/// A getter whose `nValues` is checked first.
+unsafe fn get<M: Model, T>(
+    c: fmi3Instance,
+    f: Call,
+    (vr, n, out, n_values): (*const u32, usize, *mut T, usize),
+    wanted: BaseType,
+    read: impl Fn(&Value) -> T,
+) -> fmi3Status {
+    if let Err(e) = scalar_count(n, n_values) {
+        return call::<M>(c, f, |_| Err(e));
+    }
+    abi::get::<M, T>(c, f, vr, n, out, wanted, read)
+}
+
+/// A setter whose `nValues` is checked first.
+unsafe fn set<M: Model, T: Copy>(
+    c: fmi3Instance,
+    f: Call,
+    (vr, n, value, n_values): (*const u32, usize, *const T, usize),
+    convert: impl Fn(T) -> Result<Value, String>,
+) -> fmi3Status {
+    if let Err(e) = scalar_count(n, n_values) {
+        return call::<M>(c, f, |_| Err(e));
+    }
+    abi::set::<M, T>(c, f, vr, n, value, convert)
+}
+
+pub unsafe fn get_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut f64, nv: usize) -> fmi3Status {
+    get::<M, f64>(c, at("fmi3GetFloat64", allowed::GET), (vr, n, v, nv), BaseType::Real, abi::real)
+}
+
+pub unsafe fn get_int32<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut i32, nv: usize) -> fmi3Status {
+    get::<M, i32>(c, at("fmi3GetInt32", allowed::GET), (vr, n, v, nv), BaseType::Integer, abi::integer)
+}
+
+pub unsafe fn get_boolean<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut bool, nv: usize) -> fmi3Status {
+    get::<M, bool>(c, at("fmi3GetBoolean", allowed::GET), (vr, n, v, nv), BaseType::Boolean, |v| {
+        matches!(v, Value::Boolean(true))
+    })
+}
+
+pub unsafe fn get_string<M: Model>(
+    c: fmi3Instance,
+    vr: *const u32,
+    n: usize,
+    v: *mut fmi3String,
+    nv: usize,
+) -> fmi3Status {
+    let f = at("fmi3GetString", allowed::GET);
+    if let Err(e) = scalar_count(n, nv) {
+        return call::<M>(c, f, |_| Err(e));
+    }
+    abi::get_string::<M>(c, f, vr, n, v)
+}
+
+pub unsafe fn set_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const f64, nv: usize) -> fmi3Status {
+    set::<M, f64>(c, at("fmi3SetFloat64", allowed::SET_FLOAT64), (vr, n, v, nv), |x| Ok(Value::Real(x)))
+}
+
+pub unsafe fn set_int32<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const i32, nv: usize) -> fmi3Status {
+    set::<M, i32>(c, at("fmi3SetInt32", allowed::SET_DISCRETE), (vr, n, v, nv), |x| Ok(Value::Integer(x)))
+}
+
+/// fmi3SetBoolean: the C `bool`s are read as bytes, so a value other than 0 or 1 is refused
+/// instead of being undefined behaviour.
+pub unsafe fn set_boolean<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const u8, nv: usize) -> fmi3Status {
+    set::<M, u8>(c, at("fmi3SetBoolean", allowed::SET_DISCRETE), (vr, n, v, nv), |x| match x {
+        0 => Ok(Value::Boolean(false)),
+        1 => Ok(Value::Boolean(true)),
+        _ => Err(format!("{x} is not an fmi3Boolean; valid values are false (0) and true (1)")),
+    })
+}
+
+pub unsafe fn set_string<M: Model>(
+    c: fmi3Instance,
+    vr: *const u32,
+    n: usize,
+    v: *const fmi3String,
+    nv: usize,
+) -> fmi3Status {
+    set::<M, fmi3String>(c, at("fmi3SetString", allowed::SET_DISCRETE), (vr, n, v, nv), |p| abi::string_value(p))
+}
+
+/// The get and set functions of the types no variable has (Float32, Int8 ... UInt64, Binary,
+/// Clock): the first value reference is named with its variable's actual type; none is OK.
+pub unsafe fn other_type<M: Model>(
+    c: fmi3Instance,
+    function: &'static str,
+    set: bool,
+    vr: *const u32,
+    n: usize,
+    ty: &str,
+) -> fmi3Status {
+    let rule = if set { allowed::SET_DISCRETE } else { allowed::GET };
+    call::<M>(c, at(function, rule), |inst: &mut Instance<M>| match slice(vr, n, "valueReferences")?.first() {
+        Some(&r) => Err(inst.type_mismatch(r, ty)),
+        None => Ok(fmi3Status::OK),
+    })
+}
+
+/// Functions boomsim does not provide, in any state.
+pub fn unsupported<M: Model>(c: fmi3Instance, function: &'static str, why: &str) -> fmi3Status {
+    abi::unsupported::<M>(c, at(function, allowed::UNSUPPORTED), why)
+}
+
+pub unsafe fn get_fmu_state<M: Model>(c: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status {
+    abi::get_fmu_state::<M>(c, at("fmi3GetFMUState", allowed::FMU_STATE), state)
+}
+
+pub unsafe fn set_fmu_state<M: Model>(c: fmi3Instance, state: fmi3FMUState) -> fmi3Status {
+    abi::set_fmu_state::<M>(c, at("fmi3SetFMUState", allowed::FMU_STATE), state)
+}
+
+pub unsafe fn free_fmu_state<M: Model>(c: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status {
+    abi::free_fmu_state::<M>(c, at("fmi3FreeFMUState", allowed::FMU_STATE), state)
+}
+
+pub unsafe fn serialized_fmu_state_size<M: Model>(
+    c: fmi3Instance,
+    state: fmi3FMUState,
+    size: *mut usize,
+) -> fmi3Status {
+    abi::serialized_fmu_state_size::<M>(c, at("fmi3SerializedFMUStateSize", allowed::FMU_STATE), state, size)
+}
+
+pub unsafe fn serialize_fmu_state<M: Model>(
+    c: fmi3Instance,
+    state: fmi3FMUState,
+    bytes: *mut u8,
+    size: usize,
+) -> fmi3Status {
+    abi::serialize_fmu_state::<M>(c, at("fmi3SerializeFMUState", allowed::FMU_STATE), state, bytes, size)
+}
+
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    c: fmi3Instance,
+    bytes: *const u8,
+    size: usize,
+    state: *mut fmi3FMUState,
+) -> fmi3Status {
+    abi::deserialize_fmu_state::<M>(c, at("fmi3DeserializeFMUState", allowed::FMU_STATE), bytes, size, state)
+}
+
+/// The scalar counts of the derivative functions: `nSeed` and `nSensitivity` against the
+/// references they go with.
+fn derivative_counts(
+    n_seed: usize,
+    seeds_for: usize,
+    n_sensitivity: usize,
+    sensitivities_for: usize,
+) -> Result<(), String> {
+    if n_seed != seeds_for || n_sensitivity != sensitivities_for {
+        return Err(format!(
+            "nSeed = {n_seed} and nSensitivity = {n_sensitivity}, but the references name {seeds_for} and {sensitivities_for} scalars"
+        ));
+    }
+    Ok(())
+}
+
+/// fmi3GetDirectionalDerivative: the sensitivities of the unknowns to the seeded knowns.
+pub unsafe fn get_directional_derivative<M: Model>(
+    c: fmi3Instance,
+    (unknowns, n_unknowns): (*const u32, usize),
+    (knowns, n_knowns): (*const u32, usize),
+    (seed, n_seed): (*const f64, usize),
+    (sensitivity, n_sensitivity): (*mut f64, usize),
+) -> fmi3Status {
+    let f = at("fmi3GetDirectionalDerivative", allowed::DERIVATIVES);
+    if let Err(e) = derivative_counts(n_seed, n_knowns, n_sensitivity, n_unknowns) {
+        return call::<M>(c, f, |_| Err(e));
+    }
+    abi::get_directional_derivative::<M>(c, f, (unknowns, n_unknowns), (knowns, n_knowns), seed, sensitivity)
+}
+
+/// fmi3GetAdjointDerivative: the seeds weight the unknowns, the sensitivities are per known
+/// (the transposed Jacobian), from the same exact forward-mode derivatives, one column per known.
+pub unsafe fn get_adjoint_derivative<M: Model>(
+    c: fmi3Instance,
+    (unknowns, n_unknowns): (*const u32, usize),
+    (knowns, n_knowns): (*const u32, usize),
+    (seed, n_seed): (*const f64, usize),
+    (sensitivity, n_sensitivity): (*mut f64, usize),
+) -> fmi3Status {
+    let f = at("fmi3GetAdjointDerivative", allowed::DERIVATIVES);
+    if !M::DIRECTIONAL_DERIVATIVES {
+        return abi::unsupported::<M>(c, f, "providesAdjointDerivatives=\"false\"");
+    }
+    call::<M>(c, f, |inst| {
+        derivative_counts(n_seed, n_unknowns, n_sensitivity, n_knowns)?;
+        let unknowns = slice(unknowns, n_unknowns, "unknowns")?;
+        let knowns = slice(knowns, n_knowns, "knowns")?;
+        let seeds = slice(seed, n_seed, "seed")?;
+        let out = slice_mut(sensitivity, n_sensitivity, "sensitivity")?;
+        inst.adjoint_derivative(unknowns, knowns, seeds, out)?;
+        Ok(fmi3Status::OK)
+    })
+}
+
+/// fmi3UpdateDiscreteStates: no discrete states and no time events (see FMI 2.0's
+/// fmi2NewDiscreteStates), so the event iteration ends at once and nothing changed.
+pub unsafe fn update_discrete_states<M: Model>(
+    c: fmi3Instance,
+    (need_update, terminate, nominals_changed, values_changed, time_defined): (
+        *mut bool,
+        *mut bool,
+        *mut bool,
+        *mut bool,
+        *mut bool,
+    ),
+    next_event_time: *mut f64,
+) -> fmi3Status {
+    call::<M>(c, at("fmi3UpdateDiscreteStates", allowed::UPDATE_DISCRETE_STATES), |_| {
+        let flags = [
+            (need_update, "discreteStatesNeedUpdate"),
+            (terminate, "terminateSimulation"),
+            (nominals_changed, "nominalsOfContinuousStatesChanged"),
+            (values_changed, "valuesOfContinuousStatesChanged"),
+            (time_defined, "nextEventTimeDefined"),
+        ];
+        if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
+            return Err(format!("{name} is NULL"));
+        }
+        let time = next_event_time.as_mut().ok_or("nextEventTime is NULL")?;
+        flags.iter().for_each(|(p, _)| **p = false);
+        *time = 0.0;
+        Ok(fmi3Status::OK)
+    })
+}
+
+pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
+    let f = at("fmi3EnterContinuousTimeMode", allowed::ENTER_CONTINUOUS_TIME_MODE);
+    abi::enter::<M>(c, f, State::ContinuousTimeMode)
+}
+
+pub unsafe fn completed_integrator_step<M: Model>(
+    c: fmi3Instance,
+    enter_event_mode: *mut bool,
+    terminate: *mut bool,
+) -> fmi3Status {
+    let f = at("fmi3CompletedIntegratorStep", allowed::COMPLETED_INTEGRATOR_STEP);
+    abi::completed_integrator_step::<M, bool>(c, f, enter_event_mode, terminate)
+}
+
+pub unsafe fn set_time<M: Model>(c: fmi3Instance, time: f64) -> fmi3Status {
+    abi::set_time::<M>(c, at("fmi3SetTime", allowed::SET_TIME), time)
+}
+
+pub unsafe fn set_continuous_states<M: Model>(c: fmi3Instance, x: *const f64, nx: usize) -> fmi3Status {
+    abi::set_continuous_states::<M>(c, at("fmi3SetContinuousStates", allowed::SET_CONTINUOUS_STATES), x, nx)
+}
+
+pub unsafe fn get_continuous_states<M: Model>(c: fmi3Instance, x: *mut f64, nx: usize) -> fmi3Status {
+    abi::get_continuous_states::<M>(c, at("fmi3GetContinuousStates", allowed::GET_CONTINUOUS_STATES), x, nx)
+}
+
+pub unsafe fn get_continuous_state_derivatives<M: Model>(c: fmi3Instance, dx: *mut f64, nx: usize) -> fmi3Status {
+    let f = at("fmi3GetContinuousStateDerivatives", allowed::GET_CONTINUOUS_STATE_DERIVATIVES);
+    abi::get_derivatives::<M>(c, f, dx, nx)
+}
+
+pub unsafe fn get_event_indicators<M: Model>(c: fmi3Instance, z: *mut f64, ni: usize) -> fmi3Status {
+    abi::get_event_indicators::<M>(c, at("fmi3GetEventIndicators", allowed::GET_EVENT_INDICATORS), z, ni)
+}
+
+pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: fmi3Instance, x: *mut f64, nx: usize) -> fmi3Status {
+    let f = at("fmi3GetNominalsOfContinuousStates", allowed::GET_NOMINALS);
+    abi::get_nominals_of_continuous_states::<M>(c, f, x, nx)
+}
+
+pub unsafe fn get_number_of_event_indicators<M: Model>(c: fmi3Instance, n: *mut usize) -> fmi3Status {
+    call::<M>(c, at("fmi3GetNumberOfEventIndicators", allowed::GET_NUMBER_OF), |inst| {
+        *n.as_mut().ok_or("nEventIndicators is NULL")? = inst.event_indicator_count();
+        Ok(fmi3Status::OK)
+    })
+}
+
+pub unsafe fn get_number_of_continuous_states<M: Model>(c: fmi3Instance, n: *mut usize) -> fmi3Status {
+    call::<M>(c, at("fmi3GetNumberOfContinuousStates", allowed::GET_NUMBER_OF), |_| {
+        *n.as_mut().ok_or("nContinuousStates is NULL")? = M::STATES.len();
+        Ok(fmi3Status::OK)
+    })
+}
+
+/// fmi3EnterStepMode: only from Event Mode, which these Co-Simulation instances never enter.
+pub unsafe fn enter_step_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
+    abi::enter::<M>(c, at("fmi3EnterStepMode", allowed::ENTER_STEP_MODE), State::StepComplete)
+}
+
+pub unsafe fn get_output_derivatives<M: Model>(c: fmi3Instance) -> fmi3Status {
+    let f = at("fmi3GetOutputDerivatives", allowed::GET_OUTPUT_DERIVATIVES);
+    abi::unsupported::<M>(c, f, "maxOutputDerivativeOrder=\"0\"")
+}
+
+/// fmi3DoStep. The out-arguments are checked before the step: no event handling (no event
+/// mode), never an early return, `terminateSimulation` once a step was discarded (the instance
+/// is then in Step Discarded), and the time the instance reached.
+pub unsafe fn do_step<M: Model>(
+    c: fmi3Instance,
+    t: f64,
+    h: f64,
+    _no_set_prior: fmi3Boolean,
+    (event_handling_needed, terminate, early_return): (*mut bool, *mut bool, *mut bool),
+    last_successful_time: *mut f64,
+) -> fmi3Status {
+    let f = at("fmi3DoStep", allowed::DO_STEP);
+    call::<M>(c, f, |inst| {
+        let event = event_handling_needed.as_mut().ok_or("eventHandlingNeeded is NULL")?;
+        let term = terminate.as_mut().ok_or("terminateSimulation is NULL")?;
+        let early = early_return.as_mut().ok_or("earlyReturn is NULL")?;
+        let last = last_successful_time.as_mut().ok_or("lastSuccessfulTime is NULL")?;
+        let status = abi::do_step(inst, f.function, t, h);
+        (*event, *early) = (false, false);
+        *term = inst.core.state == State::StepFailed;
+        *last = inst.core.last_successful_time;
+        status
+    })
+}

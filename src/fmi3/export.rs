@@ -1,0 +1,509 @@
+//! `export_fmi3!`: emits the FMI 3.0 symbols for one model: every function of
+//! fmi3FunctionTypes.h (common, Model Exchange, Co-Simulation, and Scheduled Execution and
+//! clocks, which are refused). [`crate::export_fmu`] invokes it beside the FMI 2.0 symbols, so
+//! one cdylib serves both versions' .fmu files (the names differ: fmi2* and fmi3*).
+
+/// Exports the FMI 3.0 C ABI for a [`Model`](crate::fmu::Model).
+#[macro_export]
+macro_rules! export_fmi3 {
+    ($model:ty) => {
+        mod fmi3_exports {
+            use super::*;
+            use std::os::raw::c_char;
+            use $crate::fmi3::api;
+            use $crate::fmi3::types::*;
+            type M = $model;
+
+            $crate::__fmi3_other_types! {
+                fmi3GetFloat32, fmi3SetFloat32, f32, "Float32";
+                fmi3GetInt8, fmi3SetInt8, i8, "Int8";
+                fmi3GetUInt8, fmi3SetUInt8, u8, "UInt8";
+                fmi3GetInt16, fmi3SetInt16, i16, "Int16";
+                fmi3GetUInt16, fmi3SetUInt16, u16, "UInt16";
+                fmi3GetUInt32, fmi3SetUInt32, u32, "UInt32";
+                fmi3GetInt64, fmi3SetInt64, i64, "Int64";
+                fmi3GetUInt64, fmi3SetUInt64, u64, "UInt64";
+            }
+
+            #[no_mangle]
+            pub extern "C" fn fmi3GetVersion() -> *const c_char {
+                api::get_version()
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetDebugLogging(
+                c: fmi3Instance,
+                on: bool,
+                n: usize,
+                cats: *const fmi3String,
+            ) -> fmi3Status {
+                api::set_debug_logging::<M>(c, on, n, cats)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3InstantiateModelExchange(
+                name: fmi3String,
+                token: fmi3String,
+                resources: fmi3String,
+                visible: bool,
+                logging_on: bool,
+                env: fmi3InstanceEnvironment,
+                log: fmi3LogMessageCallback,
+            ) -> fmi3Instance {
+                api::instantiate_model_exchange::<M>(name, token, resources, visible, logging_on, env, log)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
+                name: fmi3String,
+                token: fmi3String,
+                resources: fmi3String,
+                visible: bool,
+                logging_on: bool,
+                event_mode_used: bool,
+                early_return_allowed: bool,
+                required: *const u32,
+                n_required: usize,
+                env: fmi3InstanceEnvironment,
+                log: fmi3LogMessageCallback,
+                intermediate: fmi3IntermediateUpdateCallback,
+            ) -> fmi3Instance {
+                api::instantiate_co_simulation::<M>(
+                    name,
+                    token,
+                    resources,
+                    visible,
+                    logging_on,
+                    event_mode_used,
+                    early_return_allowed,
+                    required,
+                    n_required,
+                    env,
+                    log,
+                    intermediate,
+                )
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
+                name: fmi3String,
+                _token: fmi3String,
+                _resources: fmi3String,
+                _visible: bool,
+                logging_on: bool,
+                env: fmi3InstanceEnvironment,
+                log: fmi3LogMessageCallback,
+                _clock_update: fmi3ClockUpdateCallback,
+                _lock: fmi3PreemptionCallback,
+                _unlock: fmi3PreemptionCallback,
+            ) -> fmi3Instance {
+                api::instantiate_scheduled_execution::<M>(name, logging_on, env, log)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3FreeInstance(c: fmi3Instance) {
+                api::free_instance::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterInitializationMode(
+                c: fmi3Instance,
+                tol_defined: bool,
+                tol: f64,
+                start: f64,
+                stop_defined: bool,
+                stop: f64,
+            ) -> fmi3Status {
+                api::enter_initialization_mode::<M>(c, tol_defined, tol, start, stop_defined, stop)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3ExitInitializationMode(c: fmi3Instance) -> fmi3Status {
+                api::exit_initialization_mode::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterEventMode(c: fmi3Instance) -> fmi3Status {
+                api::enter_event_mode::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3Terminate(c: fmi3Instance) -> fmi3Status {
+                api::terminate::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3Reset(c: fmi3Instance) -> fmi3Status {
+                api::reset::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetFloat64(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *mut f64,
+                nv: usize,
+            ) -> fmi3Status {
+                api::get_float64::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetInt32(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *mut i32,
+                nv: usize,
+            ) -> fmi3Status {
+                api::get_int32::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetBoolean(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *mut bool,
+                nv: usize,
+            ) -> fmi3Status {
+                api::get_boolean::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetString(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *mut fmi3String,
+                nv: usize,
+            ) -> fmi3Status {
+                api::get_string::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetBinary(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                _sizes: *mut usize,
+                _v: *mut fmi3Binary,
+                _nv: usize,
+            ) -> fmi3Status {
+                api::other_type::<M>(c, "fmi3GetBinary", false, vr, n, "Binary")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetClock(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                _v: *mut fmi3Clock,
+            ) -> fmi3Status {
+                api::other_type::<M>(c, "fmi3GetClock", false, vr, n, "Clock")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetFloat64(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *const f64,
+                nv: usize,
+            ) -> fmi3Status {
+                api::set_float64::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetInt32(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *const i32,
+                nv: usize,
+            ) -> fmi3Status {
+                api::set_int32::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetBoolean(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *const u8,
+                nv: usize,
+            ) -> fmi3Status {
+                api::set_boolean::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetString(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                v: *const fmi3String,
+                nv: usize,
+            ) -> fmi3Status {
+                api::set_string::<M>(c, vr, n, v, nv)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetBinary(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                _sizes: *const usize,
+                _v: *const fmi3Binary,
+                _nv: usize,
+            ) -> fmi3Status {
+                api::other_type::<M>(c, "fmi3SetBinary", true, vr, n, "Binary")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetClock(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                _v: *const fmi3Clock,
+            ) -> fmi3Status {
+                api::other_type::<M>(c, "fmi3SetClock", true, vr, n, "Clock")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
+                c: fmi3Instance,
+                _vr: u32,
+                _n: *mut usize,
+            ) -> fmi3Status {
+                api::unsupported::<M>(
+                    c,
+                    "fmi3GetNumberOfVariableDependencies",
+                    "providesPerElementDependencies=\"false\"",
+                )
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetVariableDependencies(
+                c: fmi3Instance,
+                _dependent: u32,
+                _element_of_dependent: *mut usize,
+                _independents: *mut u32,
+                _element_of_independents: *mut usize,
+                _kinds: *mut fmi3DependencyKind,
+                _n: usize,
+            ) -> fmi3Status {
+                api::unsupported::<M>(c, "fmi3GetVariableDependencies", "providesPerElementDependencies=\"false\"")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetFMUState(c: fmi3Instance, s: *mut fmi3FMUState) -> fmi3Status {
+                api::get_fmu_state::<M>(c, s)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetFMUState(c: fmi3Instance, s: fmi3FMUState) -> fmi3Status {
+                api::set_fmu_state::<M>(c, s)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3FreeFMUState(c: fmi3Instance, s: *mut fmi3FMUState) -> fmi3Status {
+                api::free_fmu_state::<M>(c, s)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
+                c: fmi3Instance,
+                s: fmi3FMUState,
+                size: *mut usize,
+            ) -> fmi3Status {
+                api::serialized_fmu_state_size::<M>(c, s, size)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SerializeFMUState(
+                c: fmi3Instance,
+                s: fmi3FMUState,
+                b: *mut u8,
+                size: usize,
+            ) -> fmi3Status {
+                api::serialize_fmu_state::<M>(c, s, b, size)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3DeserializeFMUState(
+                c: fmi3Instance,
+                b: *const u8,
+                size: usize,
+                s: *mut fmi3FMUState,
+            ) -> fmi3Status {
+                api::deserialize_fmu_state::<M>(c, b, size, s)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
+                c: fmi3Instance,
+                unknowns: *const u32,
+                n_unknowns: usize,
+                knowns: *const u32,
+                n_knowns: usize,
+                seed: *const f64,
+                n_seed: usize,
+                sensitivity: *mut f64,
+                n_sensitivity: usize,
+            ) -> fmi3Status {
+                api::get_directional_derivative::<M>(
+                    c,
+                    (unknowns, n_unknowns),
+                    (knowns, n_knowns),
+                    (seed, n_seed),
+                    (sensitivity, n_sensitivity),
+                )
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetAdjointDerivative(
+                c: fmi3Instance,
+                unknowns: *const u32,
+                n_unknowns: usize,
+                knowns: *const u32,
+                n_knowns: usize,
+                seed: *const f64,
+                n_seed: usize,
+                sensitivity: *mut f64,
+                n_sensitivity: usize,
+            ) -> fmi3Status {
+                api::get_adjoint_derivative::<M>(
+                    c,
+                    (unknowns, n_unknowns),
+                    (knowns, n_knowns),
+                    (seed, n_seed),
+                    (sensitivity, n_sensitivity),
+                )
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterConfigurationMode(c: fmi3Instance) -> fmi3Status {
+                api::unsupported::<M>(c, "fmi3EnterConfigurationMode", "the FMU has no structural parameters")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3ExitConfigurationMode(c: fmi3Instance) -> fmi3Status {
+                api::unsupported::<M>(c, "fmi3ExitConfigurationMode", "the FMU has no structural parameters")
+            }
+            $crate::__fmi3_clock_functions! {
+                fmi3GetIntervalDecimal(*const u32, usize, *mut f64, *mut fmi3IntervalQualifier);
+                fmi3GetIntervalFraction(*const u32, usize, *mut u64, *mut u64, *mut fmi3IntervalQualifier);
+                fmi3GetShiftDecimal(*const u32, usize, *mut f64);
+                fmi3GetShiftFraction(*const u32, usize, *mut u64, *mut u64);
+                fmi3SetIntervalDecimal(*const u32, usize, *const f64);
+                fmi3SetIntervalFraction(*const u32, usize, *const u64, *const u64);
+                fmi3SetShiftDecimal(*const u32, usize, *const f64);
+                fmi3SetShiftFraction(*const u32, usize, *const u64, *const u64);
+                fmi3ActivateModelPartition(u32, f64);
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EvaluateDiscreteStates(c: fmi3Instance) -> fmi3Status {
+                api::unsupported::<M>(c, "fmi3EvaluateDiscreteStates", "providesEvaluateDiscreteStates=\"false\"")
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
+                c: fmi3Instance,
+                need_update: *mut bool,
+                terminate: *mut bool,
+                nominals_changed: *mut bool,
+                values_changed: *mut bool,
+                time_defined: *mut bool,
+                next_time: *mut f64,
+            ) -> fmi3Status {
+                api::update_discrete_states::<M>(
+                    c,
+                    (need_update, terminate, nominals_changed, values_changed, time_defined),
+                    next_time,
+                )
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(c: fmi3Instance) -> fmi3Status {
+                api::enter_continuous_time_mode::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
+                c: fmi3Instance,
+                _no_prior: bool,
+                enter_event_mode: *mut bool,
+                terminate: *mut bool,
+            ) -> fmi3Status {
+                api::completed_integrator_step::<M>(c, enter_event_mode, terminate)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetTime(c: fmi3Instance, time: f64) -> fmi3Status {
+                api::set_time::<M>(c, time)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetContinuousStates(c: fmi3Instance, x: *const f64, nx: usize) -> fmi3Status {
+                api::set_continuous_states::<M>(c, x, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(
+                c: fmi3Instance,
+                dx: *mut f64,
+                nx: usize,
+            ) -> fmi3Status {
+                api::get_continuous_state_derivatives::<M>(c, dx, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetEventIndicators(c: fmi3Instance, z: *mut f64, ni: usize) -> fmi3Status {
+                api::get_event_indicators::<M>(c, z, ni)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetContinuousStates(c: fmi3Instance, x: *mut f64, nx: usize) -> fmi3Status {
+                api::get_continuous_states::<M>(c, x, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(
+                c: fmi3Instance,
+                x: *mut f64,
+                nx: usize,
+            ) -> fmi3Status {
+                api::get_nominals_of_continuous_states::<M>(c, x, nx)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNumberOfEventIndicators(c: fmi3Instance, n: *mut usize) -> fmi3Status {
+                api::get_number_of_event_indicators::<M>(c, n)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNumberOfContinuousStates(c: fmi3Instance, n: *mut usize) -> fmi3Status {
+                api::get_number_of_continuous_states::<M>(c, n)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterStepMode(c: fmi3Instance) -> fmi3Status {
+                api::enter_step_mode::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetOutputDerivatives(
+                c: fmi3Instance,
+                _vr: *const u32,
+                _n: usize,
+                _orders: *const i32,
+                _v: *mut f64,
+                _nv: usize,
+            ) -> fmi3Status {
+                api::get_output_derivatives::<M>(c)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3DoStep(
+                c: fmi3Instance,
+                t: f64,
+                h: f64,
+                no_prior: bool,
+                event_handling_needed: *mut bool,
+                terminate: *mut bool,
+                early_return: *mut bool,
+                last_successful_time: *mut f64,
+            ) -> fmi3Status {
+                api::do_step::<M>(
+                    c,
+                    t,
+                    h,
+                    no_prior,
+                    (event_handling_needed, terminate, early_return),
+                    last_successful_time,
+                )
+            }
+        }
+    };
+}
+
+/// The get and set functions of types no variable has (inside [`export_fmi3!`], where `api` and
+/// `M` are in scope): an error naming the variable and its type.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __fmi3_other_types {
+    ($($get:ident, $set:ident, $t:ty, $name:literal;)*) => {$(
+        #[no_mangle]
+        pub unsafe extern "C" fn $get(c: fmi3Instance, vr: *const u32, n: usize, _v: *mut $t, _nv: usize) -> fmi3Status {
+            api::other_type::<M>(c, stringify!($get), false, vr, n, $name)
+        }
+        #[no_mangle]
+        pub unsafe extern "C" fn $set(c: fmi3Instance, vr: *const u32, n: usize, _v: *const $t, _nv: usize) -> fmi3Status {
+            api::other_type::<M>(c, stringify!($set), true, vr, n, $name)
+        }
+    )*};
+}
+
+/// The clock functions (inside [`export_fmi3!`]): the FMU has no clocks.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __fmi3_clock_functions {
+    ($($name:ident($($arg:ty),*);)*) => {$(
+        #[no_mangle]
+        pub unsafe extern "C" fn $name(c: fmi3Instance, $(_: $arg),*) -> fmi3Status {
+            api::unsupported::<M>(c, stringify!($name), "the FMU has no clocks")
+        }
+    )*};
+}

@@ -1,0 +1,54 @@
+//! The C types of the FMI 3.0 API (fmi3PlatformTypes.h, fmi3FunctionTypes.h).
+#![allow(non_camel_case_types)]
+
+use std::os::raw::{c_char, c_void};
+
+pub type fmi3Instance = *mut c_void;
+pub type fmi3InstanceEnvironment = *mut c_void;
+pub type fmi3FMUState = *mut c_void;
+pub type fmi3ValueReference = u32;
+pub type fmi3Float32 = f32;
+pub type fmi3Float64 = f64;
+pub type fmi3Int8 = i8;
+pub type fmi3UInt8 = u8;
+pub type fmi3Int16 = i16;
+pub type fmi3UInt16 = u16;
+pub type fmi3Int32 = i32;
+pub type fmi3UInt32 = u32;
+pub type fmi3Int64 = i64;
+pub type fmi3UInt64 = u64;
+/// C99 `bool` (fmi3PlatformTypes.h).
+pub type fmi3Boolean = bool;
+pub type fmi3Char = c_char;
+pub type fmi3String = *const c_char;
+pub type fmi3Byte = u8;
+pub type fmi3Binary = *const fmi3Byte;
+/// C99 `bool`.
+pub type fmi3Clock = bool;
+/// An enum passed as `int` (read as a number, never transmuted).
+pub type fmi3IntervalQualifier = std::os::raw::c_int;
+pub type fmi3DependencyKind = std::os::raw::c_int;
+
+/// fmi3Status: the status both versions share.
+pub type fmi3Status = crate::fmu::Status;
+
+/// fmi3LogMessageCallback: not variadic (unlike FMI 2.0's logger), no instance name.
+pub type fmi3LogMessageCallback =
+    Option<unsafe extern "C" fn(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String)>;
+/// fmi3IntermediateUpdateCallback (never called: `providesIntermediateUpdate="false"`).
+pub type fmi3IntermediateUpdateCallback = Option<
+    unsafe extern "C" fn(
+        fmi3InstanceEnvironment,
+        fmi3Float64,
+        fmi3Boolean,
+        fmi3Boolean,
+        fmi3Boolean,
+        fmi3Boolean,
+        *mut fmi3Boolean,
+        *mut fmi3Float64,
+    ),
+>;
+/// fmi3ClockUpdateCallback (Scheduled Execution, not supported).
+pub type fmi3ClockUpdateCallback = Option<unsafe extern "C" fn(fmi3InstanceEnvironment)>;
+/// fmi3LockPreemptionCallback / fmi3UnlockPreemptionCallback (Scheduled Execution).
+pub type fmi3PreemptionCallback = Option<unsafe extern "C" fn()>;

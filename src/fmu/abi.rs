@@ -1,0 +1,506 @@
+//! The bodies of the C functions FMI 2.0 and FMI 3.0 have in common, generic over the model:
+//! each adapter (`fmi2::api`, `fmi3::api`) forwards its symbol here with the function's name and
+//! its rule of the adapter's state table ([`Call`]).
+//!
+//! Every function checks its pointers and the state machine, catches panics, and reports
+//! failures through the logger with the instance name (ARCHITECTURE.md, principle 4).
+#![allow(clippy::missing_safety_doc)]
+
+use super::fmu_state;
+use super::instance::{Core, Instance, Step, Warning};
+use super::log::{Logger, Status, LOG_FMI_CALLS};
+use super::model::Model;
+use super::state::{describe, Interface, Rule, State};
+use super::variables::{BaseType, Value};
+use super::version::Version;
+use std::ffi::{CStr, CString};
+use std::os::raw::{c_char, c_void};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// An instance pointer as both versions pass it (fmi2Component, fmi3Instance).
+pub type Handle = *mut c_void;
+/// An FMU state pointer (fmi2FMUstate, fmi3FMUState).
+pub type FmuState = *mut c_void;
+
+/// One C function: the version whose symbol it is, its name and where it may be called.
+#[derive(Debug, Clone, Copy)]
+pub struct Call {
+    pub version: Version,
+    pub function: &'static str,
+    pub rule: Rule,
+}
+
+/// The instance behind a pointer, if it is one of ours for this model and version.
+unsafe fn instance<'a, M: Model>(c: Handle, version: Version) -> Option<&'a mut Instance<M>> {
+    let inst = (c as *mut Instance<M>).as_mut()?;
+    (inst.magic == Instance::<M>::magic(version)).then_some(inst)
+}
+
+fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
+    p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned()).unwrap_or_default()
+}
+
+/// Runs `body` for a valid instance in an allowed state; errors are logged, panics caught.
+pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) -> Result<Status, String>) -> Status {
+    // SAFETY: FMI requires `c` to be a pointer returned by instantiation; a null or foreign
+    // pointer is detected by the magic tag where the memory is readable.
+    let Some(inst) = (unsafe { instance::<M>(c, f.version) }) else {
+        return Status::Error;
+    };
+    let function = f.function;
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        if inst.log.is_enabled(LOG_FMI_CALLS) {
+            inst.log.info("logFmiCalls", function);
+        }
+        if let Some(interface) = f.rule.interface.filter(|&i| i != inst.interface) {
+            return Err(format!(
+                "a {interface:?} function, but this instance was instantiated for {:?}",
+                inst.interface
+            ));
+        }
+        let state = inst.core.state;
+        if f.rule.states & state.bit() == 0 {
+            return Err(format!("illegal call in state {state:?}; it is allowed in: {}", describe(f.rule.states)));
+        }
+        body(inst)
+    }));
+    match result {
+        Ok(Ok(status)) => status,
+        Ok(Err(message)) => {
+            inst.log.status(Status::Error, &format!("{function}: {message}"));
+            Status::Error
+        }
+        Err(p) => {
+            inst.core.state = State::Error;
+            let v = inst.version;
+            let m = format!(
+                "{function}: internal error: {}; the instance is now in the Error state ({} or {})",
+                panic_text(p.as_ref()),
+                v.function("fmi2Reset"),
+                v.function("fmi2FreeInstance")
+            );
+            inst.log.status(Status::Error, &m);
+            Status::Error
+        }
+    }
+}
+
+/// Status Warning with the message logged if there is one, else OK.
+pub fn warn<M: Model>(inst: &Instance<M>, function: &str, warning: Warning) -> Status {
+    match warning {
+        Some(w) => {
+            inst.log.status(Status::Warning, &format!("{function}: {w}"));
+            Status::Warning
+        }
+        None => Status::OK,
+    }
+}
+
+/// A slice from a C array; NULL is an error unless `n` is 0.
+pub unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
+    if n == 0 {
+        Ok(&[])
+    } else if p.is_null() {
+        Err(format!("{what} is NULL but {n} elements were announced"))
+    } else {
+        Ok(std::slice::from_raw_parts(p, n))
+    }
+}
+
+/// A mutable slice from a C array; NULL is an error unless `n` is 0.
+pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mut [T], String> {
+    if n == 0 {
+        Ok(&mut [])
+    } else if p.is_null() {
+        Err(format!("{what} is NULL but {n} elements were announced"))
+    } else {
+        Ok(std::slice::from_raw_parts_mut(p, n))
+    }
+}
+
+/// A C string as UTF-8, if it is one.
+pub unsafe fn text<'a>(p: *const c_char) -> Option<&'a str> {
+    (!p.is_null()).then(|| CStr::from_ptr(p).to_str().ok()).flatten()
+}
+
+/// The instance name given at instantiation: non-empty UTF-8.
+pub unsafe fn instance_name<'a>(name: *const c_char) -> Result<&'a str, String> {
+    match text(name) {
+        Some(n) if !n.is_empty() => Ok(n),
+        _ => Err("instanceName must be a non-empty UTF-8 string".into()),
+    }
+}
+
+/// The GUID (FMI 2.0) or instantiation token (FMI 3.0) the importer passes (`what` names the
+/// argument, `kind` what it is) against the binary's.
+pub unsafe fn check_identity(identity: *const c_char, what: &str, kind: &str, expected: &str) -> Result<(), String> {
+    match text(identity) {
+        Some(g) if g == expected => Ok(()),
+        g => Err(format!(
+            "{what} = {g:?} does not match this binary's {kind} {expected}: modelDescription.xml and binary come from different builds"
+        )),
+    }
+}
+
+/// A new instance on the heap, as the pointer instantiation returns.
+pub fn new_instance<M: Model>(log: Logger, guid: String, version: Version, interface: Interface) -> Handle {
+    Box::into_raw(Box::new(Instance::<M>::new(log, guid, version, interface))) as Handle
+}
+
+/// Frees an instance with every FMU state the importer did not free.
+pub unsafe fn free_instance<M: Model>(c: Handle, f: Call) {
+    if call::<M>(c, f, |_| Ok(Status::OK)) == Status::OK {
+        let mut inst = Box::from_raw(c as *mut Instance<M>);
+        inst.magic = 0;
+        for s in inst.fmu_states.drain(..) {
+            drop(Box::from_raw(s));
+        }
+    }
+}
+
+pub unsafe fn set_debug_logging<M: Model>(
+    c: Handle,
+    f: Call,
+    on: bool,
+    n: usize,
+    categories: *const *const c_char,
+) -> Status {
+    call::<M>(c, f, |inst| {
+        let names = slice(categories, n, "categories")?
+            .iter()
+            .map(|&p| text(p).ok_or_else(|| "a category name is NULL or not UTF-8".to_string()))
+            .collect::<Result<Vec<_>, _>>()?;
+        inst.log.set_debug_logging(on, &names)?;
+        Ok(Status::OK)
+    })
+}
+
+/// The experiment (fmi2SetupExperiment; part of fmi3EnterInitializationMode).
+pub fn setup_experiment<M: Model>(
+    inst: &mut Instance<M>,
+    function: &str,
+    tolerance: Option<f64>,
+    start: f64,
+    stop: Option<f64>,
+) -> Result<Status, String> {
+    let warning = inst.setup_experiment(tolerance, start, stop)?;
+    Ok(warn(inst, function, warning))
+}
+
+pub unsafe fn enter_initialization_mode<M: Model>(c: Handle, f: Call) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.enter_initialization_mode();
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn exit_initialization_mode<M: Model>(c: Handle, f: Call) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.exit_initialization_mode()?;
+        Ok(Status::OK)
+    })
+}
+
+/// Moves to `state` (terminate, enter event mode, enter continuous-time mode).
+pub unsafe fn enter<M: Model>(c: Handle, f: Call, state: State) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.core.state = state;
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn reset<M: Model>(c: Handle, f: Call) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.core = Core::new();
+        Ok(Status::OK)
+    })
+}
+
+/// Shared body of the getters of numbers and Booleans: `read` converts a stored value.
+pub unsafe fn get<M: Model, T>(
+    c: Handle,
+    f: Call,
+    vr: *const u32,
+    n: usize,
+    out: *mut T,
+    wanted: BaseType,
+    read: impl Fn(&Value) -> T,
+) -> Status {
+    call::<M>(c, f, |inst| {
+        let vrs = slice(vr, n, "vr")?;
+        let out = slice_mut(out, n, "value")?;
+        inst.get(vrs, out, wanted, read)?;
+        Ok(Status::OK)
+    })
+}
+
+/// Reads a Real as a number (NaN never leaves: [`Instance::get`] refuses non-finite values).
+pub fn real(v: &Value) -> f64 {
+    if let Value::Real(x) = v {
+        *x
+    } else {
+        f64::NAN
+    }
+}
+
+/// Reads an Integer.
+pub fn integer(v: &Value) -> i32 {
+    if let Value::Integer(x) = v {
+        *x
+    } else {
+        0
+    }
+}
+
+pub unsafe fn get_string<M: Model>(c: Handle, f: Call, vr: *const u32, n: usize, value: *mut *const c_char) -> Status {
+    call::<M>(c, f, |inst| {
+        let vrs = slice(vr, n, "vr")?;
+        let out = slice_mut(value, n, "value")?;
+        let mut texts = vec![CString::default(); n];
+        inst.get(vrs, &mut texts, BaseType::String, |v| match v {
+            Value::String(s) => CString::new(s.replace('\0', " ")).unwrap_or_default(),
+            _ => CString::default(),
+        })?;
+        // The pointers stay valid until the next GetString on this instance (FMI 2.0, 2.1.7).
+        inst.strings = texts;
+        out.iter_mut().zip(&inst.strings).for_each(|(o, s)| *o = s.as_ptr());
+        Ok(Status::OK)
+    })
+}
+
+/// Shared body of the setters: `convert` checks and wraps one C value.
+pub unsafe fn set<M: Model, T: Copy>(
+    c: Handle,
+    f: Call,
+    vr: *const u32,
+    n: usize,
+    value: *const T,
+    convert: impl Fn(T) -> Result<Value, String>,
+) -> Status {
+    call::<M>(c, f, |inst| {
+        let vrs = slice(vr, n, "vr")?;
+        let values = slice(value, n, "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
+        inst.set(vrs, values)?;
+        Ok(Status::OK)
+    })
+}
+
+/// A string value of a setter.
+pub unsafe fn string_value(p: *const c_char) -> Result<Value, String> {
+    text(p).map(|s| Value::String(s.to_owned())).ok_or_else(|| "a string value is NULL or not UTF-8".into())
+}
+
+pub unsafe fn get_fmu_state<M: Model>(c: Handle, f: Call, state: *mut FmuState) -> Status {
+    call::<M>(c, f, |inst| {
+        let out = state.as_mut().ok_or("FMUstate is NULL")?;
+        if out.is_null() {
+            *out = new_fmu_state(inst, inst.core.clone());
+        } else {
+            // FMI 2.0, 2.1.8 (FMI 3.0, 2.3.6.3): a non-NULL *FMUstate is a state of this
+            // instance, to overwrite.
+            let core = inst.core.clone();
+            *own_fmu_state(inst, *out)? = core;
+        }
+        Ok(Status::OK)
+    })
+}
+
+/// A new FMU state of `inst` holding `core`, registered so that freeing the instance frees it.
+fn new_fmu_state<M: Model>(inst: &mut Instance<M>, core: Core<M>) -> FmuState {
+    let s = Box::into_raw(Box::new(core));
+    inst.fmu_states.push(s);
+    s as FmuState
+}
+
+/// The FMU state behind a pointer if this instance allocated it and it was not freed: found in
+/// the instance's list, so no pointer the importer passes is dereferenced unless it is ours.
+fn own_fmu_state<'a, M: Model>(inst: &Instance<M>, s: FmuState) -> Result<&'a mut Core<M>, String> {
+    let p = s as *mut Core<M>;
+    if s.is_null() || !inst.fmu_states.contains(&p) {
+        let v = inst.version;
+        return Err(format!(
+            "FMUstate {s:p} is NULL, freed, or not a state of this instance of {} ({} or {} of this instance make one)",
+            M::INFO.identifier,
+            v.function("fmi2GetFMUstate"),
+            v.function("fmi2DeSerializeFMUstate")
+        ));
+    }
+    // SAFETY: the pointer is one this instance allocated and has not freed.
+    Ok(unsafe { &mut *p })
+}
+
+pub unsafe fn set_fmu_state<M: Model>(c: Handle, f: Call, state: FmuState) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.core = own_fmu_state(inst, state)?.clone();
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn free_fmu_state<M: Model>(c: Handle, f: Call, state: *mut FmuState) -> Status {
+    call::<M>(c, f, |inst| {
+        let p = state.as_mut().ok_or("FMUstate is NULL")?;
+        if p.is_null() {
+            return Ok(Status::OK);
+        }
+        let s = own_fmu_state(inst, *p)? as *mut Core<M>;
+        inst.fmu_states.retain(|&x| x != s);
+        drop(Box::from_raw(s));
+        *p = std::ptr::null_mut();
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn serialized_fmu_state_size<M: Model>(c: Handle, f: Call, state: FmuState, size: *mut usize) -> Status {
+    call::<M>(c, f, |inst| {
+        let out = size.as_mut().ok_or("size is NULL")?;
+        *out = fmu_state::serialize(own_fmu_state(inst, state)?, &inst.guid).len();
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn serialize_fmu_state<M: Model>(
+    c: Handle,
+    f: Call,
+    state: FmuState,
+    bytes: *mut u8,
+    size: usize,
+) -> Status {
+    call::<M>(c, f, |inst| {
+        let data = fmu_state::serialize(own_fmu_state(inst, state)?, &inst.guid);
+        if data.len() != size {
+            return Err(format!(
+                "size = {size} bytes, but the state needs {} ({})",
+                data.len(),
+                inst.version.function("fmi2SerializedFMUstateSize")
+            ));
+        }
+        slice_mut(bytes, size, "serializedState")?.copy_from_slice(&data);
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    c: Handle,
+    f: Call,
+    bytes: *const u8,
+    size: usize,
+    state: *mut FmuState,
+) -> Status {
+    call::<M>(c, f, |inst| {
+        let data = slice(bytes, size, "serializedState")?;
+        let out = state.as_mut().ok_or("FMUstate is NULL")?;
+        let core = fmu_state::deserialize::<M>(data, &inst.guid)?;
+        if let Some(other) = core.state.interface().filter(|&i| i != inst.interface) {
+            return Err(format!(
+                "the state was saved by a {other:?} instance (state {:?}); this instance is {:?}",
+                core.state, inst.interface
+            ));
+        }
+        *out = new_fmu_state(inst, core);
+        Ok(Status::OK)
+    })
+}
+
+/// Shared body of the functions boomsim does not provide.
+pub fn unsupported<M: Model>(c: Handle, f: Call, why: &str) -> Status {
+    call::<M>(c, f, |_| Err(format!("not supported: {why}")))
+}
+
+/// The directional derivative (FMI 2.0, 2.1.9; FMI 3.0, 2.3.11), for the models that provide it.
+pub unsafe fn get_directional_derivative<M: Model>(
+    c: Handle,
+    f: Call,
+    (unknown, n_unknown): (*const u32, usize),
+    (known, n_known): (*const u32, usize),
+    dv_known: *const f64,
+    dv_unknown: *mut f64,
+) -> Status {
+    if !M::DIRECTIONAL_DERIVATIVES {
+        return unsupported::<M>(c, f, "providesDirectionalDerivative=\"false\"");
+    }
+    call::<M>(c, f, |inst| {
+        let unknowns = slice(unknown, n_unknown, "vUnknown_ref")?;
+        let knowns = slice(known, n_known, "vKnown_ref")?;
+        let seeds = slice(dv_known, n_known, "dvKnown")?;
+        let out = slice_mut(dv_unknown, n_unknown, "dvUnknown")?;
+        inst.directional_derivative(unknowns, knowns, seeds, out)?;
+        Ok(Status::OK)
+    })
+}
+
+/// doStep: OK or Warning when done, Discard (logged) when stopped at the last good time.
+pub fn do_step<M: Model>(inst: &mut Instance<M>, function: &str, t: f64, h: f64) -> Result<Status, String> {
+    match inst.do_step(t, h)? {
+        Step::Done(warning) => Ok(warn(inst, function, warning)),
+        Step::Discarded(why) => {
+            inst.log.status(Status::Discard, &format!("{function}: {why}"));
+            Ok(Status::Discard)
+        }
+    }
+}
+
+/// completedIntegratorStep: no step events (`completedIntegratorStepNotNeeded`,
+/// `needsCompletedIntegratorStep="false"`), so neither flag is ever set.
+pub unsafe fn completed_integrator_step<M: Model, B: From<bool>>(
+    c: Handle,
+    f: Call,
+    enter_event_mode: *mut B,
+    terminate: *mut B,
+) -> Status {
+    call::<M>(c, f, |inst| {
+        let enter = enter_event_mode.as_mut().ok_or("enterEventMode is NULL")?;
+        let term = terminate.as_mut().ok_or("terminateSimulation is NULL")?;
+        (*enter, *term) = (B::from(false), B::from(false));
+        inst.core.last_successful_time = inst.core.time;
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn set_time<M: Model>(c: Handle, f: Call, time: f64) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.set_time(time)?;
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn set_continuous_states<M: Model>(c: Handle, f: Call, x: *const f64, nx: usize) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.set_continuous_states(slice(x, nx, "x")?)?;
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn get_continuous_states<M: Model>(c: Handle, f: Call, x: *mut f64, nx: usize) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.continuous_states(slice_mut(x, nx, "x")?)?;
+        Ok(Status::OK)
+    })
+}
+
+/// The state derivatives; Discard (FMI 2.0, 2.1.3: retry with a smaller step) where the states
+/// are outside the model's domain.
+pub unsafe fn get_derivatives<M: Model>(c: Handle, f: Call, dx: *mut f64, nx: usize) -> Status {
+    call::<M>(c, f, |inst| match inst.derivatives(slice_mut(dx, nx, "derivatives")?)? {
+        None => Ok(Status::OK),
+        Some(why) => {
+            inst.log.status(Status::Discard, &format!("{}: {why}", f.function));
+            Ok(Status::Discard)
+        }
+    })
+}
+
+pub unsafe fn get_event_indicators<M: Model>(c: Handle, f: Call, z: *mut f64, ni: usize) -> Status {
+    call::<M>(c, f, |inst| {
+        inst.event_indicators(slice_mut(z, ni, "eventIndicators")?)?;
+        Ok(Status::OK)
+    })
+}
+
+pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: Handle, f: Call, x: *mut f64, nx: usize) -> Status {
+    call::<M>(c, f, |_| {
+        let out = slice_mut(x, nx, "x_nominal")?;
+        Instance::<M>::check_states(nx)?;
+        out.iter_mut().zip(M::STATES).for_each(|(o, s)| *o = s.nominal);
+        Ok(Status::OK)
+    })
+}

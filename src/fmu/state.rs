@@ -1,0 +1,96 @@
+//! The states of an instance, shared by the FMI 2.0 and FMI 3.0 state machines (each adapter's
+//! `state.rs` holds its table of allowed states per function), and the building blocks of those
+//! tables.
+
+/// The instance's state. An instance of one interface never enters the states of the other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum State {
+    Instantiated,
+    InitializationMode,
+    /// Co-Simulation: after a step that succeeded (or initialisation).
+    StepComplete,
+    StepFailed,
+    StepCanceled,
+    /// Model Exchange: discrete-time equations active (after initialisation, fmi2EnterEventMode).
+    EventMode,
+    /// Model Exchange: the importer's integrator sets time and states and reads derivatives.
+    ContinuousTimeMode,
+    Terminated,
+    Error,
+}
+
+impl State {
+    /// The state's bit in a [`Mask`].
+    pub const fn bit(self) -> Mask {
+        1 << self as u16
+    }
+
+    /// The interface whose state this is; `None` for the states both share.
+    pub const fn interface(self) -> Option<Interface> {
+        match self {
+            State::StepComplete | State::StepFailed | State::StepCanceled => Some(Interface::CoSimulation),
+            State::EventMode | State::ContinuousTimeMode => Some(Interface::ModelExchange),
+            _ => None,
+        }
+    }
+
+    /// Every state, for messages and the FMU state bytes.
+    pub const ALL: [State; 9] = [
+        State::Instantiated,
+        State::InitializationMode,
+        State::StepComplete,
+        State::StepFailed,
+        State::StepCanceled,
+        State::EventMode,
+        State::ContinuousTimeMode,
+        State::Terminated,
+        State::Error,
+    ];
+}
+
+/// The interface an instance was instantiated as (fmi2Instantiate's fmuType).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interface {
+    ModelExchange,
+    CoSimulation,
+}
+
+/// A set of states.
+pub type Mask = u16;
+
+/// Where a function may be called: the interface (`None`: both) and the states.
+#[derive(Debug, Clone, Copy)]
+pub struct Rule {
+    pub interface: Option<Interface>,
+    pub states: Mask,
+}
+
+pub const INST: Mask = State::Instantiated.bit();
+pub const INIT: Mask = State::InitializationMode.bit();
+pub const DONE: Mask = State::StepComplete.bit();
+pub const FAIL: Mask = State::StepFailed.bit();
+pub const CANC: Mask = State::StepCanceled.bit();
+pub const EVENT: Mask = State::EventMode.bit();
+pub const CONT: Mask = State::ContinuousTimeMode.bit();
+pub const TERM: Mask = State::Terminated.bit();
+pub const ERR: Mask = State::Error.bit();
+
+pub const fn both(states: Mask) -> Rule {
+    Rule { interface: None, states }
+}
+pub const fn cs(states: Mask) -> Rule {
+    Rule { interface: Some(Interface::CoSimulation), states }
+}
+pub const fn me(states: Mask) -> Rule {
+    Rule { interface: Some(Interface::ModelExchange), states }
+}
+
+/// The names of the states in a mask, for error messages.
+pub fn describe(mask: Mask) -> String {
+    let names: Vec<String> = State::ALL.iter().filter(|s| mask & s.bit() != 0).map(|s| format!("{s:?}")).collect();
+    if names.is_empty() {
+        "no state".to_owned()
+    } else {
+        names.join(", ")
+    }
+}
