@@ -606,6 +606,10 @@ fn model_exchange_matches_fmi2_and_the_adjoint_is_the_transpose() {
         let mut short = [0.0; 1];
         assert_eq!(api::get_adjoint_derivative::<C>(i.c, u, k, (v.as_ptr(), nu), (short.as_mut_ptr(), 1)), ERR);
         assert!(i.last_error().contains("nSensitivity = 1"));
+        // A message names the FMI 3.0 argument (fmi3FunctionTypes.h), not FMI 2.0's dvKnown.
+        let nan = vec![f64::NAN; nk];
+        assert_eq!(api::get_directional_derivative::<C>(i.c, u, k, (nan.as_ptr(), nk), (jw.as_mut_ptr(), nu)), ERR);
+        assert!(i.last_error().contains("seed of \""), "{}", i.last_error());
     }
     let a: f64 = v.iter().zip(&jw).map(|(v, x)| v * x).sum();
     let b: f64 = jtv.iter().zip(&w).map(|(x, w)| x * w).sum();

@@ -419,10 +419,11 @@ pub unsafe fn get_directional_derivative<M: Model>(
         return unsupported::<M>(c, f, "providesDirectionalDerivative=\"false\"");
     }
     call::<M>(c, f, |inst| {
-        let unknowns = slice(unknown, n_unknown, "vUnknown_ref")?;
-        let knowns = slice(known, n_known, "vKnown_ref")?;
-        let seeds = slice(dv_known, n_known, "dvKnown")?;
-        let out = slice_mut(dv_unknown, n_unknown, "dvUnknown")?;
+        let name = |fmi2| inst.version.argument(fmi2);
+        let unknowns = slice(unknown, n_unknown, name("vUnknown_ref"))?;
+        let knowns = slice(known, n_known, name("vKnown_ref"))?;
+        let seeds = slice(dv_known, n_known, name("dvKnown"))?;
+        let out = slice_mut(dv_unknown, n_unknown, name("dvUnknown"))?;
         inst.directional_derivative(unknowns, knowns, seeds, out)?;
         Ok(Status::OK)
     })

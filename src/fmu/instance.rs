@@ -346,7 +346,7 @@ impl<M: Model> Instance<M> {
                 return Err(format!("known \"{}\" (vr {vr}) is not {what}", v.name));
             }
             if !dv.is_finite() {
-                return Err(format!("dvKnown of \"{}\" = {} is not a finite number", v.name, num(dv)));
+                return Err(format!("{} of \"{}\" = {} is not a finite number", self.version.argument("dvKnown"), v.name, num(dv)));
             }
         }
         if matches!(self.core.state, State::InitializationMode) {

@@ -27,6 +27,18 @@ impl Version {
         Cow::Borrowed(renamed)
     }
 
+    /// The name in this version of the FMI 2.0 argument `fmi2` of fmi2GetDirectionalDerivative
+    /// (FMI 3.0: unknowns, knowns, seed, sensitivity).
+    pub fn argument(self, fmi2: &'static str) -> &'static str {
+        match (self, fmi2) {
+            (Version::Fmi3, "vUnknown_ref") => "unknowns",
+            (Version::Fmi3, "vKnown_ref") => "knowns",
+            (Version::Fmi3, "dvKnown") => "seed",
+            (Version::Fmi3, "dvUnknown") => "sensitivity",
+            _ => fmi2,
+        }
+    }
+
     /// The name of a base type in this version (FMI 3.0: Float64, Int32).
     pub fn type_name(self, t: BaseType) -> &'static str {
         match (self, t) {
@@ -53,5 +65,7 @@ mod tests {
         assert_eq!(v.function("fmi2Reset"), "fmi3Reset");
         assert_eq!(Version::Fmi2.function("fmi2SetFMUstate"), "fmi2SetFMUstate");
         assert_eq!(v.type_name(BaseType::Real), "Float64");
+        assert_eq!(v.argument("dvKnown"), "seed");
+        assert_eq!(Version::Fmi2.argument("dvKnown"), "dvKnown");
     }
 }
