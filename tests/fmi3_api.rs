@@ -616,3 +616,65 @@ fn model_exchange_matches_fmi2_and_the_adjoint_is_the_transpose() {
     let scale: f64 = v.iter().zip(&jw).map(|(v, x)| (v * x).abs()).sum::<f64>().max(1e-300);
     assert!(a != 0.0 && (a - b).abs() <= 1e-12 * scale, "v.(Jw) = {a}, (J^T v).w = {b}");
 }
+
+/// FMI 3.0, 2.4.8: the event indicators are the variables ModelStructure lists as
+/// `<EventIndicator>`, and fmi3GetEventIndicators returns them in that order. Their values are
+/// the circuit's switching functions (thesis eq. 2.44-2.45: the spool demand jumps at u_ref = 0,
+/// the load-sensing pressure at x_v = +-x_db), computed here from valve.u_ref, valve.x_v and
+/// valve.x_db.
+#[test]
+fn event_indicators_are_the_declared_variables_in_their_order() {
+    fn declared(id: &str) -> Vec<u32> {
+        let xml =
+            std::fs::read_to_string(format!("{}/modelDescription/fmi3/{id}.xml", env!("CARGO_MANIFEST_DIR"))).unwrap();
+        xml.split("<EventIndicator valueReference=\"")
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap().parse().unwrap())
+            .collect()
+    }
+    fn vr_of<M: Model>(name: &str) -> u32 {
+        M::VARIABLES.iter().find(|v| v.name == name).unwrap().vr
+    }
+    fn check<M: Model>() {
+        let vrs = declared(M::INFO.identifier);
+        let i = Inst::<M>::initialized(true, &[(vr_of::<M>("valve.u_ref"), -0.3)]);
+        let n = M::STATES.len();
+        let mut x = vec![0.0; n];
+        let mut count = 0;
+        unsafe {
+            assert_eq!(api::get_number_of_event_indicators::<M>(i.c, &mut count), OK);
+            assert_eq!(api::enter_continuous_time_mode::<M>(i.c), OK);
+            assert_eq!(api::get_continuous_states::<M>(i.c, x.as_mut_ptr(), n), OK);
+        }
+        assert_eq!(count, vrs.len());
+        // Spool positions inside, at and beyond the dead band's edges.
+        let (k, x_db) = (
+            M::STATES.iter().position(|s| s.state == vr_of::<M>("valve.x_v")).unwrap(),
+            i.get(vr_of::<M>("valve.x_db")),
+        );
+        for x_v in [-2.0 * x_db, -x_db, 0.3 * x_db, 1.5 * x_db] {
+            x[k] = x_v;
+            let mut z = vec![f64::NAN; count];
+            unsafe {
+                assert_eq!(api::set_continuous_states::<M>(i.c, x.as_ptr(), n), OK);
+                assert_eq!(api::get_event_indicators::<M>(i.c, z.as_mut_ptr(), count), OK);
+            }
+            let by_vr: Vec<f64> = vrs.iter().map(|&r| i.get(r)).collect();
+            assert_eq!(z, by_vr, "{}: fmi3GetEventIndicators against fmi3GetFloat64", M::INFO.identifier);
+            assert_eq!(z, [-0.3, x_v - x_db, x_v + x_db], "{}", M::INFO.identifier);
+        }
+        unsafe {
+            let mut z = [0.0; 4];
+            assert_eq!(api::get_event_indicators::<M>(i.c, z.as_mut_ptr(), count + 1), ERR);
+        }
+        assert!(i.last_error().contains("event indicators"), "{}", i.last_error());
+    }
+    check::<HydraulicBoom>();
+    check::<HydraulicCircuit>();
+    // The controller has no switching function: none declared, none returned.
+    assert!(declared("PressureFeedbackController").is_empty());
+    let i = Inst::<Pfc>::initialized(true, &[]);
+    let mut count = 1;
+    unsafe { assert_eq!(api::get_number_of_event_indicators::<Pfc>(i.c, &mut count), OK) };
+    assert_eq!(count, 0);
+}

@@ -50,7 +50,7 @@ fn write<M: Model>() -> io::Result<String> {
     let root = root_attrs::<M>(
         "2.0",
         ("guid", guid::<M>()),
-        vec![("numberOfEventIndicators", M::EVENT_INDICATORS.to_string())],
+        vec![("numberOfEventIndicators", M::EVENT_INDICATORS.len().to_string())],
     );
     document(&root, |w| {
         // The capabilities both interfaces share, around each one's own (schema order).

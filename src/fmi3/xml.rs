@@ -161,8 +161,9 @@ fn write<M: Model>() -> io::Result<String> {
     })
 }
 
-/// FMI 3.0, 2.4.8: Output, ContinuousStateDerivative (in the order of the state vector) and
-/// InitialUnknown, each with its dependencies by value reference.
+/// FMI 3.0, 2.4.8: Output, ContinuousStateDerivative (in the order of the state vector),
+/// InitialUnknown and EventIndicator (in the order of fmi3GetEventIndicators), each with its
+/// dependencies by value reference.
 fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
     let structure = probe::<M>();
     let deps = dependencies::<M>(&structure);
@@ -178,6 +179,9 @@ fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
         }
         for (vr, deps) in &initial_unknowns::<M>(&structure) {
             unknown(w, "InitialUnknown", *vr, deps)?;
+        }
+        for &vr in M::EVENT_INDICATORS {
+            unknown(w, "EventIndicator", vr, &deps[&vr])?;
         }
         Ok(())
     })?;

@@ -95,6 +95,18 @@ impl<M: Model> Default for Core<M> {
     }
 }
 
+/// Writes the outputs and locals of `model`, the event indicators' variables included.
+fn write_outputs<M: Model>(model: &M, values: &mut Values) {
+    model.outputs(values);
+    if !M::EVENT_INDICATORS.is_empty() {
+        let mut z = vec![0.0; M::EVENT_INDICATORS.len()];
+        model.event_indicators(values, &mut z);
+        for (&r, z) in M::EVENT_INDICATORS.iter().zip(z) {
+            values.set_real(r, z);
+        }
+    }
+}
+
 /// A model-facing [`Log`] that writes through the instance logger.
 struct ModelLog<'a>(&'a Logger);
 
@@ -289,15 +301,10 @@ impl<M: Model> Instance<M> {
         self.with_model(|m, values| m.event_indicators(values, z))
     }
 
-    /// The number of event indicators this version's modelDescription.xml declares. FMI 3.0
-    /// declares event indicators as variables (ModelStructure `<EventIndicator>`), which the
-    /// tables do not have: the FMI 3.0 FMUs declare none (the importer's integrator steps over
-    /// the kinks of the right-hand side, as it does for any FMU without event indicators).
+    /// The number of event indicators (FMI 2.0 `numberOfEventIndicators`, FMI 3.0 the
+    /// `<EventIndicator>` elements): [`Model::EVENT_INDICATORS`].
     pub fn event_indicator_count(&self) -> usize {
-        match self.version {
-            Version::Fmi2 => M::EVENT_INDICATORS,
-            Version::Fmi3 => 0,
-        }
+        M::EVENT_INDICATORS.len()
     }
 
     /// fmi2GetDerivatives (FMI 3.0 also in Initialization Mode: those the values set so far give).
@@ -399,9 +406,9 @@ impl<M: Model> Instance<M> {
         }
         if c.state == State::InitializationMode {
             // Initial outputs follow from the values set so far.
-            M::initialize(&c.values)?.outputs(&mut c.values);
+            write_outputs(&M::initialize(&c.values)?, &mut c.values);
         } else if let Some(model) = &c.model {
-            model.outputs(&mut c.values);
+            write_outputs(model, &mut c.values);
         }
         c.outputs_current = true;
         c.derivatives_current = false;

@@ -76,9 +76,11 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// in modelDescription.xml, so it is the same for every parameter value.
     const STATES: &'static [ContinuousState];
 
-    /// Number of event indicators (`numberOfEventIndicators`): functions of states and inputs
-    /// whose sign changes where the right-hand side jumps. Default: none.
-    const EVENT_INDICATORS: usize = 0;
+    /// The event indicators' variables (Real locals), in the order of fmi2GetEventIndicators:
+    /// functions of states and inputs whose sign changes where the right-hand side jumps.
+    /// FMI 2.0 counts them (`numberOfEventIndicators`), FMI 3.0 lists them (`<EventIndicator>`).
+    /// Default: none.
+    const EVENT_INDICATORS: &'static [u32] = &[];
 
     /// Parameter settings that change the model's equations (rigid/flexible, port couplings):
     /// ModelStructure's dependencies hold in each. Default: the start values only.

@@ -15,8 +15,8 @@ use std::collections::{BTreeMap, BTreeSet};
 /// The probed dependencies, by value reference.
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct Structure {
-    /// Per output and per `der()` variable: the states and inputs it depends on after
-    /// initialisation.
+    /// Per output, `der()` variable and event indicator: the states and inputs it depends on
+    /// after initialisation.
     pub after: BTreeMap<u32, BTreeSet<u32>>,
     /// Per state and per `der()` variable: the inputs it depends on in Initialization Mode.
     pub initial: BTreeMap<u32, BTreeSet<u32>>,
@@ -62,14 +62,18 @@ fn input_step(x: f64, min: f64, max: f64) -> f64 {
     }
 }
 
-/// The unknowns after initialisation, by value reference: every output and the `der()` variables.
+/// The unknowns after initialisation, by value reference: every output, the `der()` variables
+/// and the event indicators.
 pub fn unknowns<M: Model>(model: &M, values: &Values) -> Vec<(u32, f64)> {
     let mut v = values.clone();
     model.outputs(&mut v);
     let mut dx = vec![0.0; M::STATES.len()];
     model.derivatives(values, &mut dx);
+    let mut z = vec![0.0; M::EVENT_INDICATORS.len()];
+    model.event_indicators(values, &mut z);
     let outputs = M::VARIABLES.iter().filter(|x| x.causality == Causality::Output).map(|x| (x.vr, v.real(x.vr)));
-    outputs.chain(M::STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d))).collect()
+    let derivatives = M::STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d));
+    outputs.chain(derivatives).chain(M::EVENT_INDICATORS.iter().copied().zip(z)).collect()
 }
 
 /// The initial unknowns a model built from `values` gives: its states and their derivatives.

@@ -179,8 +179,8 @@ pub fn initial_dependencies<M: Model>(v: &Variable) -> Vec<u32> {
 }
 
 /// The knowns of every unknown after initialisation, by value reference: for an output its
-/// declared inputs and the states it depends on; for a `der()` variable the states and inputs
-/// (both from [`super::structure::probe`]).
+/// declared inputs and the states it depends on; for a `der()` variable and an event indicator
+/// the states and inputs (both from [`super::structure::probe`]).
 pub fn dependencies<M: Model>(structure: &Structure) -> BTreeMap<u32, Vec<u32>> {
     let is_state = |r: &u32| M::STATES.iter().any(|s| s.state == *r);
     let probed = |vr: u32| structure.after.get(&vr).into_iter().flatten().copied();
@@ -188,7 +188,8 @@ pub fn dependencies<M: Model>(structure: &Structure) -> BTreeMap<u32, Vec<u32>> 
         .iter()
         .filter(|v| v.causality == Causality::Output)
         .map(|v| (v.vr, v.depends_on.iter().copied().chain(probed(v.vr).filter(is_state)).collect()));
-    outputs.chain(M::STATES.iter().map(|s| (s.derivative, probed(s.derivative).collect()))).collect()
+    let derived = M::STATES.iter().map(|s| s.derivative).chain(M::EVENT_INDICATORS.iter().copied());
+    outputs.chain(derived.map(|r| (r, probed(r).collect()))).collect()
 }
 
 /// FMI 2.0 section 2.2.8 (FMI 3.0, 2.4.8 alike): the initial unknowns in table order with their

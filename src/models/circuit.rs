@@ -57,8 +57,8 @@ pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values)
     }
 }
 
-/// Number of the circuit's event indicators, [`event_indicators`].
-pub(crate) const EVENT_INDICATORS: usize = 3;
+/// The circuit's event indicator variables, in the order of [`event_indicators`].
+pub(crate) const EVENT_INDICATORS: &[u32] = &[vr::EVENT_U_REF, vr::EVENT_DEAD_BAND_UPPER, vr::EVENT_DEAD_BAND_LOWER];
 
 /// The circuit's event indicators at spool position `x_v` and reference `u_ref`: the places
 /// where its right-hand side jumps. `u_ref`: the spool demand jumps between -x_db and +x_db

@@ -29,7 +29,7 @@ pub mod vr {
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 30] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 33] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
@@ -215,7 +215,7 @@ impl Model for HydraulicBoom {
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &PLANT_STATES;
-    const EVENT_INDICATORS: usize = super::circuit::EVENT_INDICATORS;
+    const EVENT_INDICATORS: &'static [u32] = super::circuit::EVENT_INDICATORS;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {
         super::boom::boom_configurations()

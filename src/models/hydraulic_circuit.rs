@@ -53,7 +53,7 @@ const START_FORCE: ParamSpec = ParamSpec {
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 37] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),
@@ -240,7 +240,7 @@ impl Model for HydraulicCircuit {
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
-    const EVENT_INDICATORS: usize = super::circuit::EVENT_INDICATORS;
+    const EVENT_INDICATORS: &'static [u32] = super::circuit::EVENT_INDICATORS;
     const DIRECTIONAL_DERIVATIVES: bool = true;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {

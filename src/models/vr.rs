@@ -27,6 +27,10 @@ pub const SOLVER_STEPS: u32 = 23;
 pub const SOLVER_REJECTED: u32 = 24;
 pub const SOLVER_RHS: u32 = 25;
 pub const SOLVER_JACOBIANS: u32 = 26;
+/// The circuit's event indicators ([`crate::models::circuit::event_indicators`]).
+pub const EVENT_U_REF: u32 = 27;
+pub const EVENT_DEAD_BAND_UPPER: u32 = 28;
+pub const EVENT_DEAD_BAND_LOWER: u32 = 29;
 pub const X0: u32 = 30;
 pub const FLEXIBLE: u32 = 31;
 pub const TIP_DEFLECTION: u32 = 40;
