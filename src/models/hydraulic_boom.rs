@@ -80,7 +80,8 @@ the table above lists them): the circuit's six, then the section angles <code>bo
 <code>boom.section[k].omega</code>. Slots beyond the last section repeat it, with its derivative; the rigid boom is
 its angle theta2 in every slot (Co-Simulation integrates it in the stroke). Three event indicators mark where the
 right-hand side jumps: the spool reference through zero (the dead band) and the spool at either edge of the dead
-band (the load-sensing switch); elsewhere the model is continuous (regularised orifices and friction, end stops as
+band (the load-sensing switch), readable as <code>event.spool_reference</code>, <code>event.dead_band_upper</code> and
+<code>event.dead_band_lower</code>; elsewhere the model is continuous (regularised orifices and friction, end stops as
 stiff springs). Directional derivatives are exact (forward-mode dual numbers through the same equations).</p>"#;
 
 /// Circuit + boom as one ODE, with the operator's reference held.
