@@ -102,3 +102,64 @@ fn the_split_models_pages_carry_the_coupling_recipe() {
         assert!(page.contains("<h2>Coupling recipe</h2>") && page.contains("start.F") && page.contains("port.Z_c"));
     }
 }
+
+/// The pages' figures. The schematic of the two circuit FMUs names every line's pressure and
+/// flow and every valve opening as the table does. The controller's plotted step response is
+/// eq. 6.2's: for G_f(s) = K_f s / (s / omega_f + 1), a step of p by dp gives
+/// u_comp(t) = K_f omega_f dp / Q_rated e^(-omega_f t), so the caption's numbers (sampled at
+/// 1 ms after the step and at the first communication point 1/omega_f later, rounded to 0.01 %)
+/// are the analytic ones to their rounding. HydraulicBoom's lowering run ends lower than it starts.
+#[test]
+fn the_pages_figures_follow_the_models() {
+    use boomsim::fmi2::pack::documentation;
+    use boomsim::fmi2::Model;
+    use boomsim::models::{HydraulicCircuit, PressureFeedbackController as Pfc};
+    let names = [
+        "p1",
+        "p2",
+        "p3",
+        "p4",
+        "Q1",
+        "Q2",
+        "Q3",
+        "Q4",
+        "valve.u",
+        "valve.x_v",
+        "cbv.u_cv",
+        "cbv.u_cbv",
+        "pcv.u",
+        "valve.p_x",
+        "cylinder.x",
+        "cylinder.F",
+    ];
+    let page = documentation::<HydraulicCircuit>(Version::Fmi2, &[]);
+    let svg = &page[page.find("<svg").unwrap()..page.find("</svg>").unwrap()];
+    for n in names {
+        assert!(HydraulicCircuit::VARIABLES.iter().any(|v| v.name == n), "{n} is a variable");
+        assert!(
+            svg.contains(&format!("{n},")) || svg.contains(&format!("{n}<")) || svg.contains(&format!("{n} ")),
+            "{n} in the schematic"
+        );
+    }
+    let number = |page: &str, after: &str| -> f64 {
+        let rest = &page[page.find(after).unwrap_or_else(|| panic!("\"{after}\" in the caption")) + after.len()..];
+        rest.split(' ').next().unwrap().parse().unwrap()
+    };
+    let param = |name: &str| match Pfc::VARIABLES.iter().find(|v| v.name == name).unwrap().kind {
+        Kind::Real { start, .. } => start,
+        _ => panic!("{name} is Real"),
+    };
+    let page = documentation::<Pfc>(Version::Fmi2, &[]);
+    let (k_f, omega, q) = (param("K_f"), param("omega_f"), param("Q_rated"));
+    let amplitude = 100.0 * k_f * omega * 1e5 / q;
+    let h = Pfc::INFO.step_size;
+    let later = ((1.0 / omega) / h).ceil() * h + h;
+    assert!((number(&page, "u_comp jumps to ") - amplitude * (-omega * h).exp()).abs() <= 0.005 + 1e-9);
+    assert!((number(&page, "later is ") - amplitude * (-omega * later).exp()).abs() <= 0.005 + 1e-9);
+    let page = documentation::<boomsim::models::HydraulicBoom>(Version::Fmi2, &[]);
+    let rest = &page[page.find("the stroke falls from ").expect("the lowering caption")..];
+    let stroke: Vec<f64> = rest.split(' ').filter_map(|w| w.parse().ok()).take(2).collect();
+    // It starts at start.x (480 mm, the experiments' start stroke, thesis chapter 7) and lowers.
+    assert_eq!(stroke[0], 480.0);
+    assert!(stroke[1] < stroke[0], "{stroke:?}");
+}

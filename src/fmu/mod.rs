@@ -5,6 +5,7 @@
 //! [`crate::fmi2`] and [`crate::fmi3`] add only what their version names or types differently.
 
 pub mod abi;
+pub mod chart;
 pub mod fmu_state;
 pub mod guid;
 pub mod instance;

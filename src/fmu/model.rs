@@ -94,6 +94,12 @@ pub trait Model: Clone + Send + Sized + 'static {
         Ok(())
     }
 
+    /// Figures for documentation/index.html (HTML with inline SVG), generated when the FMU is
+    /// packed. Default: none.
+    fn figures() -> String {
+        String::new()
+    }
+
     /// Builds the model from final parameter and input values at the end of initialisation
     /// (and, in initialisation mode, to compute initial outputs). Returns a message naming the
     /// offending variables when their combination is inconsistent.

@@ -3,6 +3,7 @@
 //! platform names, [`crate::platform`]), and `documentation/index.html`. The same library goes
 //! into both versions' archives: it exports the fmi2* and the fmi3* symbols.
 
+use super::chart::escape;
 use super::guid::{guid, token};
 use super::log::{num, GENERIC_CATEGORIES};
 use super::model::Model;
@@ -55,10 +56,6 @@ impl Fmu {
     }
 }
 
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
-
 fn row(v: &Variable) -> String {
     let (ty, start, unit, range) = match v.kind {
         Kind::Real { start, unit, display_unit, min, max } => {
@@ -77,12 +74,12 @@ fn row(v: &Variable) -> String {
     let start = if v.has_start() { start } else { String::new() };
     format!(
         "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{:?}</td><td>{ty}</td><td>{start}</td><td>{unit}</td><td>{}</td><td>{}</td></tr>\n",
-        html_escape(v.name),
+        escape(v.name),
         v.vr,
         v.causality,
         v.variability,
-        html_escape(&range),
-        html_escape(v.description)
+        escape(&range),
+        escape(v.description)
     )
 }
 
@@ -144,14 +141,15 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
         ("Variables", M::VARIABLES.len().to_string()),
     ];
     let rows: String =
-        rows.iter().map(|(k, v)| format!("<tr><th>{k}</th><td>{}</td></tr>\n", html_escape(v))).collect();
+        rows.iter().map(|(k, v)| format!("<tr><th>{k}</th><td>{}</td></tr>\n", escape(v))).collect();
     format!("<table class=\"facts\">\n{rows}</table>\n")
 }
 
 /// A small stylesheet: readable tables in any browser an importer opens the page in.
 const STYLE: &str = "body{font-family:sans-serif;max-width:70em;margin:2em auto;padding:0 1em;line-height:1.4}\
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #bbb;padding:0.2em 0.5em;text-align:left;\
-vertical-align:top}th{background:#eee}code{font-size:95%}table.facts th{width:18em}";
+vertical-align:top}th{background:#eee}code{font-size:95%}table.facts th{width:18em}\
+figure{margin:1.5em 0}figure svg{max-width:100%;height:auto;border:1px solid #ddd}figcaption{font-size:90%;color:#333;max-width:56em}";
 
 /// documentation/index.html of FMI `version`: the model's facts, equations and notes, and every
 /// variable.
@@ -159,11 +157,12 @@ pub fn documentation<M: Model>(version: Version, platforms: &[Platform]) -> Stri
     let i = &M::INFO;
     let rows: String = M::VARIABLES.iter().map(row).collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{id}</title><style>{STYLE}</style></head><body>\n<h1>{id} {version}</h1>\n<p>{desc}</p>\n<p>From the master's thesis <i>Stabilization of hydraulically actuated boom using pressure feedback</i> (University of Agder), exported by boomsim.</p>\n{facts}<h2>Model</h2>\n{doc}\n<h2>Variables</h2>\n<p>All values are SI; the display unit is given in brackets, and start values in it too.</p>\n<table>\n<tr><th>Name</th><th>VR</th><th>Causality</th><th>Variability</th><th>Type</th><th>Start</th><th>Unit</th><th>Range</th><th>Description</th></tr>\n{rows}</table>\n</body></html>\n",
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{id}</title><style>{STYLE}</style></head><body>\n<h1>{id} {version}</h1>\n<p>{desc}</p>\n<p>From the master's thesis <i>Stabilization of hydraulically actuated boom using pressure feedback</i> (University of Agder), exported by boomsim.</p>\n{facts}<h2>Model</h2>\n{doc}\n{figures}<h2>Variables</h2>\n<p>All values are SI; the display unit is given in brackets, and start values in it too.</p>\n<table>\n<tr><th>Name</th><th>VR</th><th>Causality</th><th>Variability</th><th>Type</th><th>Start</th><th>Unit</th><th>Range</th><th>Description</th></tr>\n{rows}</table>\n</body></html>\n",
         id = i.identifier,
         version = i.version,
-        desc = html_escape(i.description),
+        desc = escape(i.description),
         facts = facts::<M>(version, platforms),
         doc = i.documentation,
+        figures = M::figures(),
     )
 }

@@ -211,6 +211,10 @@ impl Model for BoomMechanics {
             .collect()
     }
 
+    fn figures() -> String {
+        super::figures::force_step::<Self>()
+    }
+
     fn model_exchange_check(values: &Values) -> Result<(), String> {
         port::model_exchange_check(values)
     }

@@ -222,6 +222,10 @@ impl Model for HydraulicBoom {
         super::boom::boom_configurations()
     }
 
+    fn figures() -> String {
+        super::figures::schematic::<Self>("the boom") + &super::figures::lowering::<Self>(super::figures::U_REFERENCE)
+    }
+
     fn initialize(values: &Values) -> Result<Self, String> {
         Self::with_state(values, None)
     }

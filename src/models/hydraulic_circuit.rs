@@ -247,6 +247,10 @@ impl Model for HydraulicCircuit {
         port::configurations()
     }
 
+    fn figures() -> String {
+        super::figures::schematic::<Self>("the mechanical port")
+    }
+
     fn model_exchange_check(values: &Values) -> Result<(), String> {
         port::model_exchange_check(values)
     }

@@ -3,6 +3,7 @@
 pub mod boom;
 pub mod boom_mechanics;
 pub mod circuit;
+pub(crate) mod figures;
 pub mod hydraulic_boom;
 pub mod hydraulic_circuit;
 pub mod port;

@@ -220,6 +220,33 @@ impl Model for PressureFeedbackController {
         interpolated_inputs: &[vr::U_REF, vr::P],
         documentation: DOCUMENTATION,
     };
+
+    /// The step response: p4 steps by 1 bar.
+    fn figures() -> String {
+        use super::figures::{figure, plot};
+        use crate::fmu::log::num;
+        const T_STEP: f64 = 0.05;
+        const DP: f64 = 1e5;
+        let record = [vr::P, vr::U_COMP];
+        let step = |t: f64, _: &[f64]| vec![(vr::P, if t >= T_STEP - 1e-12 { DP } else { 0.0 })];
+        let title = "PressureFeedbackController: p steps by 1 bar at t = 0.05 s";
+        let plotted = plot::<Self>(title, 0.25, &[], step, &record, &[&[0], &[1]]);
+        figure(plotted, |t, data| {
+            let at = |time: f64| t.iter().position(|&x| x >= time - 1e-12).map_or(f64::NAN, |k| data[1][k]);
+            let tau = 1.0 / FEEDBACK_SPECS[1].default;
+            format!(
+                "With the start values (K_f = {}, omega_f = {} rad/s, Q_rated = {} l/min), the compensation follows \
+                 the high-pass filter of eq. 6.2: u_comp jumps to {} % when p rises by 1 bar and {} ms (1/omega_f) \
+                 later is {} %, then decays to zero while p stays. Computed by this FMU's model when it was packed.",
+                num(FEEDBACK_SPECS[0].default),
+                num(FEEDBACK_SPECS[1].default),
+                num(FEEDBACK_SPECS[2].default * 60_000.0),
+                num((at(T_STEP + 1e-3) * 1e4).round() / 100.0),
+                num((tau * 1e4).round() / 10.0),
+                num((at(T_STEP + 1e-3 + tau) * 1e4).round() / 100.0),
+            )
+        })
+    }
     const VARIABLES: &'static [Variable] = VARIABLES;
     const STATES: &'static [ContinuousState] = STATES;
 
