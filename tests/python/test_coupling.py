@@ -218,6 +218,29 @@ def test_ssp_runs_in_importer(ssp_files, ssp_references, tool, system, sid):
 # --------------------------------------------------------------------------- SSP with FMI 3.0
 
 
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_inline_parameter_sets_validate_against_the_ssv_schema(ssp_files, tmp_path, fmi):
+    """Every inline ssv:ParameterSet against SSP 1.0's SystemStructureParameterValues.xsd (fmpy's
+    read_ssd does not check them): its types are Real, Integer, Boolean ..., so FMI 3.0's Float64
+    and Int32 parameters must be written as Real and Integer."""
+    import zipfile
+
+    import fmpy
+    from lxml import etree
+
+    xsd = pathlib.Path(fmpy.__file__).parent / "ssp" / "schema" / "SystemStructureParameterValues.xsd"
+    schema = etree.XMLSchema(etree.parse(str(xsd)))
+    sc, _ = ssp_files["B"]
+    for system in ("monolithic", "split"):
+        path = ssp.write(system, sc, "rigid", "tlm", tmp_path, fmi=fmi)
+        root = etree.fromstring(zipfile.ZipFile(path).read("SystemStructure.ssd"))
+        sets = root.findall(f".//{{{ssp.SSV}}}ParameterSet")
+        assert len(sets) == len(ssp.components(system, sc, "rigid", "tlm", fmi)[0])
+        for s in sets:
+            assert schema.validate(s), f"FMI {fmi} {system}: {schema.error_log.last_error}"
+
+
+
 @pytest.mark.parametrize("tool", list(ssp.IMPORTERS))
 def test_ssp_with_fmi3_fmus(ssp_files, tmp_path, tool):
     """Both SSPs of U and B with the FMI 3.0 .fmu files (`ssp.py --fmi 3`). An importer that reads
