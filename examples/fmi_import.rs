@@ -11,6 +11,9 @@
 //! (initialised with the start values, stepped to `stop`), `outputs` (every Real / Float64 output
 //! at `stop`), `fmi_version` and `error`.
 
+// The crate's FMI 2.0 and FMI 3.0 traits have the same names.
+use fmi::fmi2::instance::{CoSimulation as Cs2, Common as Common2};
+use fmi::fmi3::{CoSimulation as Cs3, Common as Common3, GetSet};
 use fmi::traits::FmiImport;
 use serde_json::{json, Map, Value};
 use std::collections::HashSet;
@@ -120,54 +123,53 @@ fn run3(path: &str, stop: f64, step: f64, starts: &[String], report: &mut Map<St
 }
 
 impl Slave for fmi::fmi2::instance::InstanceCS {
-    // (the crate's FMI 2.0 traits, by path: their names are those of the FMI 3.0 ones)
     fn enter_initialization_mode(&mut self, stop: f64) -> Result<(), String> {
-        fmi::fmi2::instance::Common::setup_experiment(self, None, 0.0, Some(stop)).map_err(|e| format!("setupExperiment: {e}"))?;
-        fmi::fmi2::instance::Common::enter_initialization_mode(self).map_err(|e| format!("enterInitializationMode: {e}"))?;
+        Common2::setup_experiment(self, None, 0.0, Some(stop)).map_err(|e| format!("setupExperiment: {e}"))?;
+        Common2::enter_initialization_mode(self).map_err(|e| format!("enterInitializationMode: {e}"))?;
         Ok(())
     }
     fn exit_initialization_mode(&mut self) -> Result<(), String> {
-        fmi::fmi2::instance::Common::exit_initialization_mode(self).map(drop).map_err(|e| format!("exitInitializationMode: {e}"))
+        Common2::exit_initialization_mode(self).map(drop).map_err(|e| format!("exitInitializationMode: {e}"))
     }
     fn set(&mut self, vr: u32, kind: Kind, value: &str) -> Result<(), String> {
         let r = [vr];
         match kind {
-            Kind::Real => fmi::fmi2::instance::Common::set_real(self, &r, &[number(value)?]),
-            Kind::Integer => fmi::fmi2::instance::Common::set_integer(self, &r, &[integer(value)?]),
-            Kind::Boolean => fmi::fmi2::instance::Common::set_boolean(self, &r, &[i32::from(boolean(value))]),
+            Kind::Real => Common2::set_real(self, &r, &[number(value)?]),
+            Kind::Integer => Common2::set_integer(self, &r, &[integer(value)?]),
+            Kind::Boolean => Common2::set_boolean(self, &r, &[i32::from(boolean(value))]),
             Kind::Other => return Err("unsupported type".into()),
         }
         .map(drop)
         .map_err(|e| e.to_string())
     }
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
-        fmi::fmi2::instance::CoSimulation::do_step(self, t, h, true).map(drop).map_err(|e| e.to_string())
+        Cs2::do_step(self, t, h, true).map(drop).map_err(|e| e.to_string())
     }
     fn get_real(&mut self, vr: u32) -> Result<f64, String> {
         let mut x = [0.0];
-        fmi::fmi2::instance::Common::get_real(self, &[vr], &mut x).map_err(|e| e.to_string())?;
+        Common2::get_real(self, &[vr], &mut x).map_err(|e| e.to_string())?;
         Ok(x[0])
     }
     fn terminate(&mut self) -> Result<(), String> {
-        fmi::fmi2::instance::Common::terminate(self).map(drop).map_err(|e| format!("terminate: {e}"))
+        Common2::terminate(self).map(drop).map_err(|e| format!("terminate: {e}"))
     }
 }
 
 impl Slave for fmi::fmi3::instance::InstanceCS {
     fn enter_initialization_mode(&mut self, stop: f64) -> Result<(), String> {
-        fmi::fmi3::Common::enter_initialization_mode(self, None, 0.0, Some(stop))
+        Common3::enter_initialization_mode(self, None, 0.0, Some(stop))
             .map(drop)
             .map_err(|e| format!("enterInitializationMode: {e}"))
     }
     fn exit_initialization_mode(&mut self) -> Result<(), String> {
-        fmi::fmi3::Common::exit_initialization_mode(self).map(drop).map_err(|e| format!("exitInitializationMode: {e}"))
+        Common3::exit_initialization_mode(self).map(drop).map_err(|e| format!("exitInitializationMode: {e}"))
     }
     fn set(&mut self, vr: u32, kind: Kind, value: &str) -> Result<(), String> {
         let r = [vr];
         match kind {
-            Kind::Real => fmi::fmi3::GetSet::set_float64(self, &r, &[number(value)?]),
-            Kind::Integer => fmi::fmi3::GetSet::set_int32(self, &r, &[integer(value)?]),
-            Kind::Boolean => fmi::fmi3::GetSet::set_boolean(self, &r, &[boolean(value)]),
+            Kind::Real => GetSet::set_float64(self, &r, &[number(value)?]),
+            Kind::Integer => GetSet::set_int32(self, &r, &[integer(value)?]),
+            Kind::Boolean => GetSet::set_boolean(self, &r, &[boolean(value)]),
             Kind::Other => return Err("unsupported type".into()),
         }
         .map(drop)
@@ -175,8 +177,7 @@ impl Slave for fmi::fmi3::instance::InstanceCS {
     }
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
         let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
-        fmi::fmi3::CoSimulation::do_step(self, t, h, true, &mut event, &mut terminate, &mut early, &mut last)
-            .map_err(|e| e.to_string())?;
+        Cs3::do_step(self, t, h, true, &mut event, &mut terminate, &mut early, &mut last).map_err(|e| e.to_string())?;
         // FMI 3.0, 4.2.1: without early return the step reaches t + h
         if event || terminate || early || last != t + h {
             return Err(format!(
@@ -188,11 +189,11 @@ impl Slave for fmi::fmi3::instance::InstanceCS {
     }
     fn get_real(&mut self, vr: u32) -> Result<f64, String> {
         let mut x = [0.0];
-        fmi::fmi3::GetSet::get_float64(self, &[vr], &mut x).map_err(|e| e.to_string())?;
+        GetSet::get_float64(self, &[vr], &mut x).map_err(|e| e.to_string())?;
         Ok(x[0])
     }
     fn terminate(&mut self) -> Result<(), String> {
-        fmi::fmi3::Common::terminate(self).map(drop).map_err(|e| format!("terminate: {e}"))
+        Common3::terminate(self).map(drop).map_err(|e| format!("terminate: {e}"))
     }
 }
 
