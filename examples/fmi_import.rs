@@ -55,7 +55,18 @@ struct Var {
 trait Slave {
     fn enter_initialization_mode(&mut self, stop: f64) -> Result<(), String>;
     fn exit_initialization_mode(&mut self) -> Result<(), String>;
-    fn set(&mut self, vr: u32, kind: Kind, value: &str) -> Result<(), String>;
+    fn set_real(&mut self, vr: u32, x: f64) -> Result<(), String>;
+    fn set_integer(&mut self, vr: u32, x: i32) -> Result<(), String>;
+    fn set_boolean(&mut self, vr: u32, x: bool) -> Result<(), String>;
+    /// Sets `value` (text) as a start value of the variable's type.
+    fn set(&mut self, vr: u32, kind: Kind, value: &str) -> Result<(), String> {
+        match kind {
+            Kind::Real => self.set_real(vr, value.parse().map_err(|_| format!("{value}: not a number"))?),
+            Kind::Integer => self.set_integer(vr, value.parse().map_err(|_| format!("{value}: not an integer"))?),
+            Kind::Boolean => self.set_boolean(vr, value == "true" || value == "1"),
+            Kind::Other => Err("unsupported type".into()),
+        }
+    }
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String>;
     fn get_real(&mut self, vr: u32) -> Result<f64, String>;
     fn terminate(&mut self) -> Result<(), String>;
@@ -131,16 +142,14 @@ impl Slave for fmi::fmi2::instance::InstanceCS {
     fn exit_initialization_mode(&mut self) -> Result<(), String> {
         Common2::exit_initialization_mode(self).map(drop).map_err(|e| format!("exitInitializationMode: {e}"))
     }
-    fn set(&mut self, vr: u32, kind: Kind, value: &str) -> Result<(), String> {
-        let r = [vr];
-        match kind {
-            Kind::Real => Common2::set_real(self, &r, &[number(value)?]),
-            Kind::Integer => Common2::set_integer(self, &r, &[integer(value)?]),
-            Kind::Boolean => Common2::set_boolean(self, &r, &[i32::from(boolean(value))]),
-            Kind::Other => return Err("unsupported type".into()),
-        }
-        .map(drop)
-        .map_err(|e| e.to_string())
+    fn set_real(&mut self, vr: u32, x: f64) -> Result<(), String> {
+        Common2::set_real(self, &[vr], &[x]).map(drop).map_err(|e| e.to_string())
+    }
+    fn set_integer(&mut self, vr: u32, x: i32) -> Result<(), String> {
+        Common2::set_integer(self, &[vr], &[x]).map(drop).map_err(|e| e.to_string())
+    }
+    fn set_boolean(&mut self, vr: u32, x: bool) -> Result<(), String> {
+        Common2::set_boolean(self, &[vr], &[i32::from(x)]).map(drop).map_err(|e| e.to_string())
     }
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
         Cs2::do_step(self, t, h, true).map(drop).map_err(|e| e.to_string())
@@ -164,16 +173,14 @@ impl Slave for fmi::fmi3::instance::InstanceCS {
     fn exit_initialization_mode(&mut self) -> Result<(), String> {
         Common3::exit_initialization_mode(self).map(drop).map_err(|e| format!("exitInitializationMode: {e}"))
     }
-    fn set(&mut self, vr: u32, kind: Kind, value: &str) -> Result<(), String> {
-        let r = [vr];
-        match kind {
-            Kind::Real => GetSet::set_float64(self, &r, &[number(value)?]),
-            Kind::Integer => GetSet::set_int32(self, &r, &[integer(value)?]),
-            Kind::Boolean => GetSet::set_boolean(self, &r, &[boolean(value)]),
-            Kind::Other => return Err("unsupported type".into()),
-        }
-        .map(drop)
-        .map_err(|e| e.to_string())
+    fn set_real(&mut self, vr: u32, x: f64) -> Result<(), String> {
+        GetSet::set_float64(self, &[vr], &[x]).map(drop).map_err(|e| e.to_string())
+    }
+    fn set_integer(&mut self, vr: u32, x: i32) -> Result<(), String> {
+        GetSet::set_int32(self, &[vr], &[x]).map(drop).map_err(|e| e.to_string())
+    }
+    fn set_boolean(&mut self, vr: u32, x: bool) -> Result<(), String> {
+        GetSet::set_boolean(self, &[vr], &[x]).map(drop).map_err(|e| e.to_string())
     }
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
         let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
@@ -232,16 +239,4 @@ fn simulate(
     report.insert("simulates".into(), json!(true));
     report.insert("outputs".into(), Value::Object(outputs));
     Ok(())
-}
-
-fn number(value: &str) -> Result<f64, String> {
-    value.parse().map_err(|_| format!("{value}: not a number"))
-}
-
-fn integer(value: &str) -> Result<i32, String> {
-    value.parse().map_err(|_| format!("{value}: not an integer"))
-}
-
-fn boolean(value: &str) -> bool {
-    value == "true" || value == "1"
 }
