@@ -20,9 +20,16 @@ use std::collections::HashSet;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    let usage = |why: &str| -> ! {
+        eprintln!("fmi_import: {why}; usage: fmi_import <file.fmu> <stop> <step> [name=value ...]");
+        std::process::exit(2)
+    };
     let (path, stop, step) = match &args[..] {
-        [p, s, h, ..] => (p.clone(), s.parse::<f64>().expect("stop time"), h.parse::<f64>().expect("step")),
-        _ => panic!("usage: fmi_import <file.fmu> <stop> <step> [name=value ...]"),
+        [p, s, h, ..] => match (s.parse::<f64>(), h.parse::<f64>()) {
+            (Ok(s), Ok(h)) if s > 0.0 && h > 0.0 => (p.clone(), s, h),
+            _ => usage(&format!("stop {s:?} and step {h:?} must be positive numbers")),
+        },
+        _ => usage("too few arguments"),
     };
     let mut report = Map::new();
     for key in ["loads", "validates", "simulates"] {
@@ -63,7 +70,11 @@ trait Slave {
         match kind {
             Kind::Real => self.set_real(vr, value.parse().map_err(|_| format!("{value}: not a number"))?),
             Kind::Integer => self.set_integer(vr, value.parse().map_err(|_| format!("{value}: not an integer"))?),
-            Kind::Boolean => self.set_boolean(vr, value == "true" || value == "1"),
+            Kind::Boolean => match value {
+                "true" | "1" => self.set_boolean(vr, true),
+                "false" | "0" => self.set_boolean(vr, false),
+                _ => Err(format!("{value}: not a Boolean (true, false, 1 or 0)")),
+            },
             Kind::Other => Err("unsupported type".into()),
         }
     }
@@ -73,7 +84,7 @@ trait Slave {
 }
 
 fn run(path: &str, stop: f64, step: f64, starts: &[String], report: &mut Map<String, Value>) -> Result<(), String> {
-    let version = fmi::import::peek_descr_path(path).map_err(|e| format!("import: {e}"))?.fmi_version;
+    let version = fmi::import::peek_descr_path(path).map_err(|e| format!("import {path}: {e}"))?.fmi_version;
     report.insert("fmi_version".into(), json!(version));
     match version.as_str() {
         "2.0" => run2(path, stop, step, starts, report),
