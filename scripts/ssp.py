@@ -54,8 +54,8 @@ for _r in RECORD.values():
 #: Name of every component's inline parameter set (ecos applies a set by name at init).
 PARAMETER_SET = "scenario"
 NAMES = {"monolithic": "BoomSystem", "split": "BoomSystemSplit"}
-#: SSP 1.0 type of an FMI variable type (SystemStructureCommon.xsd has Real, Integer, Boolean,
-#: String, Enumeration, Binary: FMI 3.0's Float64 and Int32 are Real and Integer there).
+#: SSP 1.0 type of an FMI variable type (SystemStructureParameterValues.xsd has Real, Integer,
+#: Boolean, String, Enumeration, Binary: FMI 3.0's Float64 and Int32 are Real and Integer there).
 SSP_TYPE = {"Float64": "Real", "Int32": "Integer"}
 
 
@@ -211,10 +211,9 @@ def run_libcosim(path, system: str, stop: float, step: float) -> dict:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.WARNING)
     from libcosimpy._internal import get_last_error_message
 
+    log_output_level(CosimLogLevel.WARNING)
     try:
         ex = CosimExecution.from_ssp_file(str(path), step_size=int(round(step * 1e9)))
     except AssertionError:  # its message says only "check if path is correct"; libcosim's says why
