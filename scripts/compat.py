@@ -14,8 +14,10 @@ importer that cannot be imported or run says why in the matrix; it is never skip
 Importers: fmpy (simulate_fmu, fmpy.validation.validate_fmu), libcosimpy (a CosimLocalSlave in
 a fixed-step execution), ecospy (EcosSimulationStructure.add_model), fmu-manipulation-toolbox
 (`fmutool -check`: checker only, no simulation), the Rust `fmi` crate (examples/fmi_import.rs);
-and fmpy again with the FMI 3.0 .fmu of the same binary (target/fmu/fmi3), matched against fmpy's
-FMI 2.0 run (the `fmi` crate's FMI 3.0 import is tested in tests/fmi3_crate.rs).
+and fmpy and the `fmi` crate (0.8, feature `fmi3`) again with the FMI 3.0 .fmu of the same binary
+(target/fmu/fmi3), matched against fmpy's FMI 2.0 run like every other row; their note also says
+whether the outputs equal the same importer's FMI 2.0 run bit for bit (the same library, the same
+calls: they should).
 """
 
 from __future__ import annotations
@@ -43,7 +45,8 @@ CASES = {
     "HydraulicCircuit": {"valve.u_ref": 0.2, "cylinder.x": 0.3, "cylinder.v": 0.01},
     "BoomMechanics": {"cylinder.F": 2.0e4, "boom.flexible": False},
 }
-IMPORTERS = ["fmpy", "libcosimpy", "ecospy", "fmu-manipulation-toolbox", "fmi (Rust crate)", "fmpy (FMI 3.0)"]
+IMPORTERS = ["fmpy", "libcosimpy", "ecospy", "fmu-manipulation-toolbox", "fmi (Rust crate)", "fmpy (FMI 3.0)",
+             "fmi (Rust crate, FMI 3.0)"]
 
 
 class Cell(dict):
@@ -135,13 +138,35 @@ def run_rust(path, case) -> tuple[Cell, dict]:
     args = [f"{k}={str(v).lower() if isinstance(v, bool) else v}" for k, v in case.items()]
     p = subprocess.run([str(exe), str(path), str(STOP), str(STEP), *args], capture_output=True, text=True, timeout=300)
     r = json.loads(p.stdout)
+    expected = "3.0" if path.parent.name == "fmi3" else "2.0"
+    if r.get("fmi_version") != expected:  # a stale example without the FMI 3.0 import
+        raise RuntimeError(f"{exe.name} ran fmiVersion {r.get('fmi_version')!r}, not {expected}: "
+                           "rebuild it with `cargo build --release --example fmi_import`")
     return Cell(loads=r["loads"], validates=r["validates"], simulates=r["simulates"], note=r.get("error", "")), \
         r.get("outputs", {})
 
 
+def fmi3(run):
+    """`run` with the FMI 3.0 .fmu beside the FMI 2.0 one (target/fmu/fmi3/<Id>.fmu)."""
+    return lambda path, case: run(path.parent / "fmi3" / path.name, case)
+
+
 RUNNERS = {"fmpy": run_fmpy, "libcosimpy": run_libcosim, "ecospy": run_ecos,
            "fmu-manipulation-toolbox": run_fmutool, "fmi (Rust crate)": run_rust,
-           "fmpy (FMI 3.0)": lambda path, case: run_fmpy(path.parent / "fmi3" / path.name, case)}
+           "fmpy (FMI 3.0)": fmi3(run_fmpy), "fmi (Rust crate, FMI 3.0)": fmi3(run_rust)}
+
+
+#: The FMI 3.0 rows and the FMI 2.0 row of the same importer.
+FMI2_ROW = {"fmpy (FMI 3.0)": "fmpy", "fmi (Rust crate, FMI 3.0)": "fmi (Rust crate)"}
+
+
+def same_as_fmi2(values: dict, fmi2: dict) -> str:
+    """Note on an FMI 3.0 row: its outputs against the same importer's FMI 2.0 run."""
+    if not values or set(values) != set(fmi2):
+        return "outputs differ from its FMI 2.0 run"
+    d = {n: abs(values[n] - fmi2[n]) for n in fmi2 if values[n] != fmi2[n]}
+    return "bit-identical to its FMI 2.0 run" if not d else \
+        f"differs from its FMI 2.0 run by up to {max(d.values()):.3g} (in {max(d, key=d.get)})"
 
 
 def matches(values: dict, reference: dict) -> tuple[bool, str]:
@@ -159,7 +184,7 @@ def matrix() -> dict:
     out = {}
     for fmu, case in CASES.items():
         path = FMU_DIR / f"{fmu}.fmu"
-        row, reference = {}, None
+        row, reference, outputs = {}, None, {}
         for name in IMPORTERS:
             try:
                 cell, values = RUNNERS[name](path, case)
@@ -173,7 +198,9 @@ def matrix() -> dict:
                 ok, why = matches(values, reference) if cell["simulates"] and reference else (False, "")
                 cell["matches"] = ok
                 cell["note"] = "; ".join(x for x in (cell["note"], why) if x)
-            row[name] = cell
+            if name in FMI2_ROW and cell["simulates"]:
+                cell["note"] = "; ".join(x for x in (cell["note"], same_as_fmi2(values, outputs[FMI2_ROW[name]])) if x)
+            row[name], outputs[name] = cell, values
         out[fmu] = row
     return out
 

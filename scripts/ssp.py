@@ -1,6 +1,6 @@
 """SSP 1.0 packages of the boom systems and their runs in three SSP importers.
 
-    .venv/bin/python scripts/ssp.py [--scenario B] [--boom rigid] [--coupling tlm] [--out target/ssp]
+    .venv/bin/python scripts/ssp.py [--scenario B] [--boom rigid] [--coupling tlm] [--fmi 2|3] [--out target/ssp]
 
 writes
     target/ssp/BoomSystem.ssp       HydraulicBoom + PressureFeedbackController (two FMUs)
@@ -13,6 +13,11 @@ split system, as these masters step all FMUs from the same values). The controll
 p.extrapolation = true: these masters pass no input derivatives and read its command before they
 pass the new p4, so it extrapolates p4 from its last two samples (scripts/README.md, "Coupling").
 
+`--fmi 3` embeds the FMI 3.0 .fmu files of target/fmu/fmi3 instead (written to target/ssp/fmi3)
+and tries them in the same three importers; where one runs them (ecospy), the run is compared with
+the FMI 2.0 SSP in the same importer as well (expected: the same record, bit for bit); NOT_FMI3
+has the errors of the others (fmpy's SSP simulator, libcosimpy) and why.
+
 The operator reference of the scenario must be constant (U, B, ...): it is bound as the start value
 of the controller's u_ref input. Masters that start the connections at 0 (fmpy's simulate_ssp) get
 the documented first-step deviation; see scripts/README.md, "SSP".
@@ -21,6 +26,7 @@ the documented first-step deviation; see scripts/README.md, "SSP".
 from __future__ import annotations
 
 import argparse
+import math
 import pathlib
 import sys
 import tempfile
@@ -48,9 +54,12 @@ for _r in RECORD.values():
 #: Name of every component's inline parameter set (ecos applies a set by name at init).
 PARAMETER_SET = "scenario"
 NAMES = {"monolithic": "BoomSystem", "split": "BoomSystemSplit"}
+#: SSP 1.0 type of an FMI variable type (SystemStructureParameterValues.xsd has Real, Integer,
+#: Boolean, String, Enumeration, Binary: FMI 3.0's Float64 and Int32 are Real and Integer there).
+SSP_TYPE = {"Float64": "Real", "Int32": "Integer"}
 
 
-def components(system: str, sc: dict, boom: str, coupling: str) -> tuple[dict, list]:
+def components(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> tuple[dict, list]:
     """({component: (FMU id, {parameter: value})}, [(from comp, output, to comp, input)])."""
     ctrl = {k: sc["controller"][k] for k in ("K_f", "omega_f") if k in sc["controller"]}
     ctrl["enable"] = bool(sc["controller"]["enable"])
@@ -69,7 +78,7 @@ def components(system: str, sc: dict, boom: str, coupling: str) -> tuple[dict, l
         return comps, conns
     mode = 1 if coupling.startswith("tlm") else 0
     mech = {"start.x": sc["start_stroke"], "boom.flexible": flexible, "port.coupling": mode}
-    f_start = start_force(mech)
+    f_start = start_force(mech, fmi)
     circ = {"start.x": sc["start_stroke"], "start.F": f_start, "port.coupling": mode, "port.c_m": f_start,
             "cylinder.x": sc["start_stroke"]}
     mech["port.c_h"] = mech["cylinder.F"] = f_start
@@ -84,9 +93,10 @@ def components(system: str, sc: dict, boom: str, coupling: str) -> tuple[dict, l
     return comps, conns
 
 
-def start_force(mech: dict) -> float:
-    """BoomMechanics' start.F for these parameters (the circuit's start.F binding)."""
-    f = cosim.FmuFile.get("BoomMechanics")
+def start_force(mech: dict, fmi: int = 2) -> float:
+    """BoomMechanics' start.F for these parameters (the circuit's start.F binding), through the
+    FMI `fmi` .fmu."""
+    f = cosim.FmuFile.get("BoomMechanics", fmi)
     s = f.slave("start_force")
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
@@ -99,9 +109,9 @@ def start_force(mech: dict) -> float:
     return value
 
 
-def ssd(system: str, sc: dict, boom: str, coupling: str) -> str:
-    """SystemStructure.ssd of `system` for scenario `sc`."""
-    comps, conns = components(system, sc, boom, coupling)
+def ssd(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> str:
+    """SystemStructure.ssd of `system` for scenario `sc` with the FMI `fmi` .fmu files."""
+    comps, conns = components(system, sc, boom, coupling, fmi)
     kinds = {}
     for a, out, b, inp in conns:
         kinds.setdefault(a, {})[out] = "output"
@@ -113,7 +123,7 @@ def ssd(system: str, sc: dict, boom: str, coupling: str) -> str:
              f'version="1.0" name="{NAMES[system]}">',
              f'  <ssd:System name="{NAMES[system]}">', "    <ssd:Elements>"]
     for name, (fmu, params) in comps.items():
-        md = cosim.FmuFile.get(fmu)
+        md = cosim.FmuFile.get(fmu, fmi)
         lines.append(f'      <ssd:Component name="{name}" type="application/x-fmu-sharedlibrary" '
                      f'source="resources/{fmu}.fmu">')
         lines.append("        <ssd:Connectors>")
@@ -123,7 +133,7 @@ def ssd(system: str, sc: dict, boom: str, coupling: str) -> str:
         lines += ["        <ssd:ParameterBindings>", "          <ssd:ParameterBinding>", "            <ssd:ParameterValues>",
                   f'              <ssv:ParameterSet version="1.0" name="{PARAMETER_SET}">', "                <ssv:Parameters>"]
         for k, v in params.items():
-            ty = md.vars[k].type
+            ty = SSP_TYPE.get(md.vars[k].type, md.vars[k].type)
             text = str(v).lower() if ty == "Boolean" else repr(int(v) if ty == "Integer" else float(v))
             lines.append(f"                  <ssv:Parameter name={quoteattr(k)}><ssv:{ty} value=\"{text}\"/></ssv:Parameter>")
         lines += ["                </ssv:Parameters>", "              </ssv:ParameterSet>", "            </ssd:ParameterValues>",
@@ -138,17 +148,22 @@ def ssd(system: str, sc: dict, boom: str, coupling: str) -> str:
     return "\n".join(lines)
 
 
-def write(system: str, sc: dict, boom: str = "rigid", coupling: str = "tlm", out=cosim.ROOT / "target" / "ssp"):
-    """Writes <out>/<BoomSystem|BoomSystemSplit>.ssp; returns its path."""
-    out = pathlib.Path(out)
+def write(system: str, sc: dict, boom: str = "rigid", coupling: str = "tlm", out=None, fmi: int = 2):
+    """Writes <out>/<BoomSystem|BoomSystemSplit>.ssp with the FMI `fmi` .fmu files (default out:
+    target/ssp, target/ssp/fmi3 for FMI 3.0); returns its path."""
+    out = pathlib.Path(out or default_out(fmi))
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"{NAMES[system]}.ssp"
-    comps, _ = components(system, sc, boom, coupling)
+    comps, _ = components(system, sc, boom, coupling, fmi)
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", ssd(system, sc, boom, coupling))
+        z.writestr("SystemStructure.ssd", ssd(system, sc, boom, coupling, fmi))
         for fmu, _ in comps.values():
-            z.write(cosim.FmuFile.get(fmu).path, f"resources/{fmu}.fmu")
+            z.write(cosim.FmuFile.get(fmu, fmi).path, f"resources/{fmu}.fmu")
     return path
+
+
+def default_out(fmi: int) -> pathlib.Path:
+    return cosim.ROOT / "target" / "ssp" / ("fmi3" if fmi == 3 else "")
 
 
 # --------------------------------------------------------------------------- importers
@@ -196,9 +211,13 @@ def run_libcosim(path, system: str, stop: float, step: float) -> dict:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy._internal import get_last_error_message
 
     log_output_level(CosimLogLevel.WARNING)
-    ex = CosimExecution.from_ssp_file(str(path), step_size=int(round(step * 1e9)))
+    try:
+        ex = CosimExecution.from_ssp_file(str(path), step_size=int(round(step * 1e9)))
+    except AssertionError:  # its message says only "check if path is correct"; libcosim's says why
+        raise RuntimeError(f"Unable to create execution from path: {get_last_error_message()}") from None
     obs = CosimObserver.create_time_series(buffer_size=int(round(stop / step)) + 10)
     ex.add_observer(obs)
     index = {s.name.decode(): s.index for s in ex.slave_infos()}
@@ -235,6 +254,15 @@ def run_ecos(path, system: str, stop: float, step: float) -> dict:
 
 
 IMPORTERS = {"fmpy": run_fmpy, "libcosimpy": run_libcosim, "ecospy": run_ecos}
+#: The importers that do not read an SSP of FMI 3.0 FMUs (tried with `--fmi 3`): the start of the
+#: error each gives, and why. ecospy 0.7.2 reads them (its fmi4c loads FMI 3.0).
+NOT_FMI3 = {
+    # simulate_ssp instantiates every FMU that is not FMI 1.0 as an FMU2Slave, whose FMI 2.0
+    # loader looks for binaries/linux64 (an FMI 3.0 archive has binaries/x86_64-linux)
+    "fmpy": "Cannot find shared library",
+    # libcosim's FMU loader (FMI Library) takes FMI 1.0 and 2.0 only
+    "libcosimpy": "Unable to create execution from path: Unsupported feature: Unsupported FMI version",
+}
 
 
 def as_result(data: dict, sc: dict, boom: str, step: float) -> cosim.Result:
@@ -251,31 +279,54 @@ def reference(system: str, sc: dict, boom: str, coupling: str, step: float) -> d
     return mx.compute(split.run(sc, boom, {"tlm": "tlm-jacobi", "plain": "jacobi"}[coupling], step))
 
 
+def run(tool: str, path, system: str, sc: dict, boom: str, step: float) -> tuple[dict, dict]:
+    """(record, metrics) of the SSP `path` in importer `tool`."""
+    data = IMPORTERS[tool](path, system, sc["stop_time"], step)
+    return data, mx.compute(as_result(data, sc, boom, step))
+
+
+def record_difference(a: dict, b: dict) -> float:
+    """Largest |a - b| over the recorded columns of two runs (inf if their lengths differ)."""
+    if any(len(a[k]) != len(b[k]) for k in a):
+        return math.inf
+    return max(float(np.max(np.abs(np.asarray(a[k]) - np.asarray(b[k])), initial=0.0)) for k in a)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", default="B")
     ap.add_argument("--boom", default="rigid")
     ap.add_argument("--coupling", default="tlm", choices=("plain", "tlm"))
     ap.add_argument("--step", type=float, default=1e-3)
-    ap.add_argument("--out", default=str(cosim.ROOT / "target" / "ssp"))
+    ap.add_argument("--fmi", type=int, choices=(2, 3), default=2,
+                    help="FMI version of the embedded FMUs: 2 (target/fmu) or 3 (target/fmu/fmi3)")
+    ap.add_argument("--out", default=None, help="output folder (default target/ssp, target/ssp/fmi3 with --fmi 3)")
     ap.add_argument("--no-run", action="store_true", help="only write the .ssp files")
     args = ap.parse_args(argv)
     sc = cosim.load_scenario(args.scenario)
     for system in ("monolithic", "split"):
-        path = write(system, sc, args.boom, args.coupling, args.out)
+        path = write(system, sc, args.boom, args.coupling, args.out, args.fmi)
         print(path)
         if args.no_run:
             continue
         ref = reference(system, sc, args.boom, args.coupling, args.step)
-        for tool, fn in IMPORTERS.items():
+        fmi2_path = write(system, sc, args.boom, args.coupling, tempfile.mkdtemp(), 2) if args.fmi == 3 else None
+        for tool in IMPORTERS:
             try:
-                m = mx.compute(as_result(fn(path, system, sc["stop_time"], args.step), sc, args.boom, args.step))
+                data, m = run(tool, path, system, sc, args.boom, args.step)
             except Exception as e:  # noqa: BLE001 - report any importer failure
-                print(f"  {tool}: FAILED: {type(e).__name__}: {e}")
+                known = args.fmi == 3 and str(e).startswith(NOT_FMI3.get(tool, "\0"))
+                print(f"  {tool}: " + ("does not read FMI 3.0: " if known else "FAILED: ") + f"{type(e).__name__}: {e}")
                 continue
             cmp = split.compare(ref, m)
             bad = {k: (a, b) for k, (a, b, ok) in cmp.items() if not ok}
             print(f"  {tool}: " + ("matches the fmpy runner" if not bad else f"differs: {bad}"))
+            if fmi2_path:
+                data2, m2 = run(tool, fmi2_path, system, sc, args.boom, args.step)
+                same = {k for k in m if m[k] == m2.get(k)}
+                print(f"  {tool}: FMI 3.0 vs FMI 2.0 SSP: largest record difference {record_difference(data, data2):.3g}, "
+                      + ("every metric identical" if same == set(m) else f"metrics differ: "
+                         f"{ {k: (m2.get(k), m[k]) for k in set(m) - same} }"))
 
 
 if __name__ == "__main__":

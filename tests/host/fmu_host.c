@@ -1,19 +1,26 @@
-/* A minimal FMI 2.0 Co-Simulation host in portable C, to run boomsim's libraries on every platform
- * (Linux x86-64 natively, Windows x64 under wine, Linux aarch64 under qemu-user) and compare the
- * numbers. It loads one or two libraries with dlopen/LoadLibrary, instantiates each with its GUID,
- * sets start values, steps them in order (Gauss-Seidel: each FMU's inputs are read from the others
- * just before its step) and prints the requested outputs with 17 significant digits.
+/* A minimal FMI 2.0 / FMI 3.0 Co-Simulation host in portable C, to run boomsim's libraries on every
+ * platform (Linux x86-64 natively, Windows x64 under wine, Linux aarch64 under qemu-user) and
+ * compare the numbers. It loads one or two libraries with dlopen/LoadLibrary, instantiates each with
+ * its GUID (FMI 2.0) or instantiationToken (FMI 3.0), sets start values, steps them in order
+ * (Gauss-Seidel: each FMU's inputs are read from the others just before its step) and prints the
+ * requested outputs with 17 significant digits (a double round-trips exactly).
  *
- *   fmu_host STEPS H LIB GUID [LIB GUID] -- OP...
+ *   fmu_host [--fmi3] STEPS H LIB GUID [LIB GUID] -- OP...
+ *     --fmi3          use the FMI 3.0 entry points (fmi3InstantiateCoSimulation ... fmi3DoStep);
+ *                     the scenario logic below is the same for both versions: only the small
+ *                     wrappers fmu_* call one version's functions or the other's
  *     real:I:VR=X     Real start value of FMU I (0 or 1), set in initialisation mode
  *     bool:I:VR=B     Boolean start value (0/1), set before initialisation mode
  *     link:I:VR=J:VR  before each step of FMU I: its input VR gets FMU J's output VR
  *     ramp:I:VR=X,D   before each step of FMU I: its input VR is X + D t
  *     print:I:VR      printed after every 100th step and the last
- *     tol:X           relative tolerance for fmi2SetupExperiment (default: none defined)
+ *     tol:X           relative tolerance (fmi2SetupExperiment / fmi3EnterInitializationMode;
+ *                     default: none defined)
  *
- * Exit status: 0 when every call returned fmi2OK, 1 otherwise (the failing call is printed). */
+ * Exit status: 0 when every call returned OK (fmi2OK = fmi3OK = 0), 1 otherwise (the failing call
+ * is printed), 2 for bad arguments. */
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,7 +37,7 @@
 
 typedef void *Component;
 typedef unsigned int VR;
-typedef int Status; /* fmi2OK = 0 */
+typedef int Status; /* fmi2OK = fmi3OK = 0 */
 
 typedef struct {
     void (*logger)(void *, const char *, int, const char *, const char *, ...);
@@ -40,15 +47,30 @@ typedef struct {
     void *environment;
 } Callbacks;
 
+/* FMI 3.0's logger: not variadic, no instance name (fmi3LogMessageCallback). */
+typedef void (*Logger3)(void *, Status, const char *, const char *);
+
 typedef struct {
+    int fmi3; /* 0: the fmi2 functions below, 1: the fmi3 ones */
+    const char *path;
+    /* FMI 2.0 */
     Component (*instantiate)(const char *, int, const char *, const char *, const Callbacks *, int, int);
     Status (*setup)(Component, int, double, double, int, double);
     Status (*enter_init)(Component);
-    Status (*exit_init)(Component);
     Status (*set_real)(Component, const VR *, size_t, const double *);
     Status (*get_real)(Component, const VR *, size_t, double *);
     Status (*set_boolean)(Component, const VR *, size_t, const int *);
     Status (*do_step)(Component, double, double, int);
+    /* FMI 3.0 */
+    Component (*instantiate3)(const char *, const char *, const char *, bool, bool, bool, bool, const VR *, size_t,
+                              void *, Logger3, void *);
+    Status (*enter_init3)(Component, bool, double, double, bool, double);
+    Status (*set_float64)(Component, const VR *, size_t, const double *, size_t);
+    Status (*get_float64)(Component, const VR *, size_t, double *, size_t);
+    Status (*set_boolean3)(Component, const VR *, size_t, const bool *, size_t);
+    Status (*do_step3)(Component, double, double, bool, bool *, bool *, bool *, double *);
+    /* both (the same signatures) */
+    Status (*exit_init)(Component);
     Status (*terminate)(Component);
     void (*free_instance)(Component);
     Component c;
@@ -73,6 +95,11 @@ static void logger(void *env, const char *name, int status, const char *category
     fputc('\n', stderr);
 }
 
+static void logger3(void *env, Status status, const char *category, const char *message) {
+    if (status == 0) return;
+    fprintf(stderr, "[%s %d %s] %s\n", (const char *)env, status, category, message);
+}
+
 static void check(Status s, const char *what) {
     if (s != 0) {
         fprintf(stderr, "fmu_host: %s returned status %d\n", what, s);
@@ -89,27 +116,94 @@ static void *need(void *lib, const char *name) {
     return f;
 }
 
-static void load(Fmu *f, const char *path, const char *guid, const Callbacks *cb) {
+static void load(Fmu *f, int fmi3, const char *path, const char *guid, const Callbacks *cb) {
     void *lib = LOAD(path);
     if (!lib) {
         fprintf(stderr, "fmu_host: cannot load %s\n", path);
         exit(1);
     }
-    *(void **)&f->instantiate = need(lib, "fmi2Instantiate");
-    *(void **)&f->setup = need(lib, "fmi2SetupExperiment");
-    *(void **)&f->enter_init = need(lib, "fmi2EnterInitializationMode");
-    *(void **)&f->exit_init = need(lib, "fmi2ExitInitializationMode");
-    *(void **)&f->set_real = need(lib, "fmi2SetReal");
-    *(void **)&f->get_real = need(lib, "fmi2GetReal");
-    *(void **)&f->set_boolean = need(lib, "fmi2SetBoolean");
-    *(void **)&f->do_step = need(lib, "fmi2DoStep");
-    *(void **)&f->terminate = need(lib, "fmi2Terminate");
-    *(void **)&f->free_instance = need(lib, "fmi2FreeInstance");
-    f->c = f->instantiate("host", 1 /* fmi2CoSimulation */, guid, "", cb, 0, 0);
+    f->fmi3 = fmi3;
+    f->path = path;
+    const char *v = fmi3 ? "fmi3" : "fmi2";
+    char name[64];
+#define NEED(field, suffix) (snprintf(name, sizeof name, "%s%s", v, suffix), *(void **)&f->field = need(lib, name))
+    NEED(exit_init, "ExitInitializationMode");
+    NEED(terminate, "Terminate");
+    NEED(free_instance, "FreeInstance");
+    if (fmi3) {
+        NEED(instantiate3, "InstantiateCoSimulation");
+        NEED(enter_init3, "EnterInitializationMode");
+        NEED(set_float64, "SetFloat64");
+        NEED(get_float64, "GetFloat64");
+        NEED(set_boolean3, "SetBoolean");
+        NEED(do_step3, "DoStep");
+        /* no event mode, no early return, no intermediate variables; the environment is the path */
+        f->c = f->instantiate3("host", guid, NULL, false, false, false, false, NULL, 0, (void *)path, logger3, NULL);
+    } else {
+        NEED(instantiate, "Instantiate");
+        NEED(setup, "SetupExperiment");
+        NEED(enter_init, "EnterInitializationMode");
+        NEED(set_real, "SetReal");
+        NEED(get_real, "GetReal");
+        NEED(set_boolean, "SetBoolean");
+        NEED(do_step, "DoStep");
+        f->c = f->instantiate("host", 1 /* fmi2CoSimulation */, guid, "", cb, 0, 0);
+    }
+#undef NEED
     if (!f->c) {
-        fprintf(stderr, "fmu_host: fmi2Instantiate of %s refused\n", path);
+        fprintf(stderr, "fmu_host: %sInstantiate%s of %s refused\n", v, fmi3 ? "CoSimulation" : "", path);
         exit(1);
     }
+}
+
+/* The version-neutral calls main() makes; each checks the status and names the function. */
+static void fmu_enter_init(Fmu *f, double tolerance) {
+    if (f->fmi3) {
+        check(f->enter_init3(f->c, tolerance > 0, tolerance, 0.0, false, 0.0), "fmi3EnterInitializationMode");
+        return;
+    }
+    check(f->setup(f->c, tolerance > 0, tolerance, 0.0, 0, 0.0), "fmi2SetupExperiment");
+    check(f->enter_init(f->c), "fmi2EnterInitializationMode");
+}
+
+static void fmu_exit_init(Fmu *f) { check(f->exit_init(f->c), f->fmi3 ? "fmi3ExitInitializationMode" : "fmi2ExitInitializationMode"); }
+
+static void fmu_set_real(Fmu *f, VR vr, double x) {
+    if (f->fmi3) check(f->set_float64(f->c, &vr, 1, &x, 1), "fmi3SetFloat64");
+    else check(f->set_real(f->c, &vr, 1, &x), "fmi2SetReal");
+}
+
+static double fmu_get_real(Fmu *f, VR vr) {
+    double x;
+    if (f->fmi3) check(f->get_float64(f->c, &vr, 1, &x, 1), "fmi3GetFloat64");
+    else check(f->get_real(f->c, &vr, 1, &x), "fmi2GetReal");
+    return x;
+}
+
+static void fmu_set_boolean(Fmu *f, VR vr, int b) {
+    bool b3 = b != 0;
+    if (f->fmi3) check(f->set_boolean3(f->c, &vr, 1, &b3, 1), "fmi3SetBoolean");
+    else check(f->set_boolean(f->c, &vr, 1, &b), "fmi2SetBoolean");
+}
+
+static void fmu_do_step(Fmu *f, double t, double h) {
+    if (f->fmi3) {
+        bool event = false, terminate = false, early = false;
+        double last = 0.0;
+        check(f->do_step3(f->c, t, h, true, &event, &terminate, &early, &last), "fmi3DoStep");
+        if (event || terminate || early || last != t + h) {
+            fprintf(stderr, "fmu_host: fmi3DoStep at %g: event %d, terminate %d, early return %d, reached %g\n", t, event,
+                    terminate, early, last);
+            exit(1);
+        }
+        return;
+    }
+    check(f->do_step(f->c, t, h, 1), "fmi2DoStep");
+}
+
+static void fmu_free(Fmu *f) {
+    check(f->terminate(f->c), f->fmi3 ? "fmi3Terminate" : "fmi2Terminate");
+    f->free_instance(f->c);
 }
 
 static Op parse(const char *s) {
@@ -134,9 +228,7 @@ static void print_outputs(Fmu *fmus, const Op *ops, int n_ops, double t) {
     printf("%.17g", t);
     for (int k = 0; k < n_ops; k++) {
         if (ops[k].kind != 'p') continue;
-        double x;
-        check(fmus[ops[k].fmu].get_real(fmus[ops[k].fmu].c, &ops[k].vr, 1, &x), "fmi2GetReal");
-        printf(" %.17g", x);
+        printf(" %.17g", fmu_get_real(&fmus[ops[k].fmu], ops[k].vr));
     }
     printf("\n");
 }
@@ -145,14 +237,15 @@ int main(int argc, char **argv) {
     Callbacks cb = {logger, calloc, free, NULL, NULL};
     Fmu fmus[2];
     Op ops[MAX_OPS];
-    int n_fmus = 0, n_ops = 0, k = 3;
-    if (argc < 6) {
-        fprintf(stderr, "usage: fmu_host STEPS H LIB GUID [LIB GUID] -- OP...\n");
+    int fmi3 = argc > 1 && strcmp(argv[1], "--fmi3") == 0;
+    int n_fmus = 0, n_ops = 0, k = 3 + fmi3;
+    if (argc < 6 + fmi3) {
+        fprintf(stderr, "usage: fmu_host [--fmi3] STEPS H LIB GUID [LIB GUID] -- OP...\n");
         return 2;
     }
-    long steps = atol(argv[1]);
-    double h = atof(argv[2]);
-    for (; k + 1 < argc && strcmp(argv[k], "--") != 0 && n_fmus < 2; k += 2) load(&fmus[n_fmus++], argv[k], argv[k + 1], &cb);
+    long steps = atol(argv[1 + fmi3]);
+    double h = atof(argv[2 + fmi3]);
+    for (; k + 1 < argc && strcmp(argv[k], "--") != 0 && n_fmus < 2; k += 2) load(&fmus[n_fmus++], fmi3, argv[k], argv[k + 1], &cb);
     for (k++; k < argc && n_ops < MAX_OPS; k++) ops[n_ops++] = parse(argv[k]);
 
     double tolerance = 0.0;
@@ -161,37 +254,27 @@ int main(int argc, char **argv) {
     }
     for (int i = 0; i < n_fmus; i++) {
         for (int j = 0; j < n_ops; j++) {
-            if (ops[j].kind == 'b' && ops[j].fmu == i) {
-                int b = ops[j].value != 0;
-                check(fmus[i].set_boolean(fmus[i].c, &ops[j].vr, 1, &b), "fmi2SetBoolean");
-            }
+            if (ops[j].kind == 'b' && ops[j].fmu == i) fmu_set_boolean(&fmus[i], ops[j].vr, ops[j].value != 0);
         }
-        check(fmus[i].setup(fmus[i].c, tolerance > 0, tolerance, 0.0, 0, 0.0), "fmi2SetupExperiment");
-        check(fmus[i].enter_init(fmus[i].c), "fmi2EnterInitializationMode");
+        fmu_enter_init(&fmus[i], tolerance);
         for (int j = 0; j < n_ops; j++) {
-            if (ops[j].kind == 'r' && ops[j].fmu == i) check(fmus[i].set_real(fmus[i].c, &ops[j].vr, 1, &ops[j].value), "fmi2SetReal");
+            if (ops[j].kind == 'r' && ops[j].fmu == i) fmu_set_real(&fmus[i], ops[j].vr, ops[j].value);
         }
-        check(fmus[i].exit_init(fmus[i].c), "fmi2ExitInitializationMode");
+        fmu_exit_init(&fmus[i]);
     }
     for (long n = 0; n < steps; n++) {
         double t = n * h;
         for (int i = 0; i < n_fmus; i++) {
             for (int j = 0; j < n_ops; j++) {
                 if (ops[j].fmu != i || (ops[j].kind != 'l' && ops[j].kind != 'm')) continue;
-                double x = ops[j].value + ops[j].slope * t;
-                if (ops[j].kind == 'l') {
-                    Fmu *src = &fmus[ops[j].src_fmu];
-                    check(src->get_real(src->c, &ops[j].src_vr, 1, &x), "fmi2GetReal");
-                }
-                check(fmus[i].set_real(fmus[i].c, &ops[j].vr, 1, &x), "fmi2SetReal");
+                double x = ops[j].kind == 'l' ? fmu_get_real(&fmus[ops[j].src_fmu], ops[j].src_vr)
+                                              : ops[j].value + ops[j].slope * t;
+                fmu_set_real(&fmus[i], ops[j].vr, x);
             }
-            check(fmus[i].do_step(fmus[i].c, t, h, 1), "fmi2DoStep");
+            fmu_do_step(&fmus[i], t, h);
         }
         if ((n + 1) % 100 == 0 || n + 1 == steps) print_outputs(fmus, ops, n_ops, (n + 1) * h);
     }
-    for (int i = 0; i < n_fmus; i++) {
-        check(fmus[i].terminate(fmus[i].c), "fmi2Terminate");
-        fmus[i].free_instance(fmus[i].c);
-    }
+    for (int i = 0; i < n_fmus; i++) fmu_free(&fmus[i]);
     return 0;
 }

@@ -8,7 +8,9 @@
   scripts/baselines/tolerances.toml where 2 % of a near-zero value is below its resolution);
 - stability of each coupling against the communication step (LIFT scenario of scripts/split.py);
 - SSP: BoomSystem.ssp / BoomSystemSplit.ssp validate against the SSP 1.0 schema and run in
-  fmpy's SSP simulator, libcosimpy and ecospy with the fmpy runner's metrics.
+  fmpy's SSP simulator, libcosimpy and ecospy with the fmpy runner's metrics; with the FMI 3.0
+  FMUs they run in ecospy with the FMI 2.0 SSP's record bit for bit (fmpy's SSP simulator and
+  libcosimpy read no FMI 3.0).
 """
 
 import math
@@ -211,3 +213,49 @@ def test_ssp_runs_in_importer(ssp_files, ssp_references, tool, system, sid):
         got[k] = float(data[k.removesuffix("_max")][data["time"] > START_UP].max())
     bad = {k: (m, s) for k, (m, s, ok) in split.compare(ssp_references[sid, system], got).items() if not ok}
     assert not bad, f"{tool} / {system} / {sid}: fmpy runner vs SSP {bad}"
+
+
+# --------------------------------------------------------------------------- SSP with FMI 3.0
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_inline_parameter_sets_validate_against_the_ssv_schema(ssp_files, tmp_path, fmi):
+    """Every inline ssv:ParameterSet against SSP 1.0's SystemStructureParameterValues.xsd (fmpy's
+    read_ssd does not check them): its types are Real, Integer, Boolean ..., so FMI 3.0's Float64
+    and Int32 parameters must be written as Real and Integer."""
+    import zipfile
+
+    import fmpy
+    from lxml import etree
+
+    xsd = pathlib.Path(fmpy.__file__).parent / "ssp" / "schema" / "SystemStructureParameterValues.xsd"
+    schema = etree.XMLSchema(etree.parse(str(xsd)))
+    sc, _ = ssp_files["B"]
+    for system in ("monolithic", "split"):
+        path = ssp.write(system, sc, "rigid", "tlm", tmp_path, fmi=fmi)
+        root = etree.fromstring(zipfile.ZipFile(path).read("SystemStructure.ssd"))
+        sets = root.findall(f".//{{{ssp.SSV}}}ParameterSet")
+        assert len(sets) == len(ssp.components(system, sc, "rigid", "tlm", fmi)[0])
+        for s in sets:
+            assert schema.validate(s), f"FMI {fmi} {system}: {schema.error_log.last_error}"
+
+
+
+@pytest.mark.parametrize("tool", list(ssp.IMPORTERS))
+def test_ssp_with_fmi3_fmus(ssp_files, tmp_path, tool):
+    """Both SSPs of U and B with the FMI 3.0 .fmu files (`ssp.py --fmi 3`). An importer that reads
+    them gives the FMI 2.0 SSP's record in the same importer bit for bit, hence the same metrics
+    (tolerance 0: the master makes the same calls with the same values, no input derivatives in
+    either version, and the library's fmi3 and fmi2 functions run the same code); the others fail
+    with the error of ssp.NOT_FMI3 (if one starts to read FMI 3.0, this says so)."""
+    for sid, (sc, files) in ssp_files.items():
+        for system, fmi2 in files.items():
+            fmi3 = ssp.write(system, sc, "rigid", "tlm", tmp_path / sid, fmi=3)
+            if tool in ssp.NOT_FMI3:
+                with pytest.raises(Exception, match="^" + ssp.NOT_FMI3[tool]):
+                    ssp.run(tool, fmi3, system, sc, "rigid", 1e-3)
+                continue
+            data3, m3 = ssp.run(tool, fmi3, system, sc, "rigid", 1e-3)
+            data2, m2 = ssp.run(tool, fmi2, system, sc, "rigid", 1e-3)
+            assert ssp.record_difference(data3, data2) == 0.0, f"{tool} / {system} / {sid}"
+            assert m3 == m2, f"{tool} / {system} / {sid}"

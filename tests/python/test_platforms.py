@@ -1,6 +1,9 @@
 """Every FMU carries linux64, win64 and aarch64-linux binaries, and each runs: the C host of
 tests/host/fmu_host.c, compiled with gcc, MinGW-w64 and aarch64 gcc, loads the library natively,
-under wine64 and under qemu-aarch64, and the numbers must agree with linux64.
+under wine64 and under qemu-aarch64, and the numbers must agree with linux64. The same for the
+FMI 3.0 .fmu (binaries/x86_64-linux, x86_64-windows, aarch64-linux: the same library), through the
+host's FMI 3.0 entry points (`fmu_host --fmi3`), and there FMI 3.0 must equal FMI 2.0 on the same
+platform bit for bit: the same binary runs the same code (src/fmu/abi.rs) for both versions' calls.
 
 Needs `boomsim pack --platforms all` (scripts/test does it) and scripts/setup-cross.
 
@@ -35,19 +38,31 @@ IDS = ("PressureFeedbackController", "HydraulicBoom", "HydraulicCircuit", "BoomM
 WINE = "/usr/lib/wine/wine64"
 QEMU = ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
 SUFFIX = {"linux64": ".so", "win64": ".dll", "aarch64-linux": ".so"}
+#: The binaries/ folder of each platform in an FMI 3.0 .fmu (FMI 3.0, 2.5.1.1: platform tuples).
+TUPLE = {"linux64": "x86_64-linux", "win64": "x86_64-windows", "aarch64-linux": "aarch64-linux"}
+FMI_VERSIONS = (2, 3)
 #: The libraries a binary may import: what every Windows 10 and every glibc Linux has.
 ALLOWED_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "userenv.dll", "ws2_32.dll", "bcryptprimitives.dll"}
 ALLOWED_SO = {"libc.so.6", "libm.so.6", "libgcc_s.so.1", "ld-linux-aarch64.so.1", "ld-linux-x86-64.so.2"}
 
+def fmu3_path(ident):
+    path = ROOT / "target" / "fmu" / "fmi3" / f"{ident}.fmu"
+    assert path.exists(), f"{path} is missing: run target/release/boomsim pack"
+    return path
+
+
 @pytest.fixture(scope="module")
 def unpacked(tmp_path_factory):
-    """Every FMU unzipped, with its GUID."""
+    """{(fmi, identifier): (folder, GUID or instantiationToken, {platform: library})}: every FMU
+    of both versions unzipped."""
     out = {}
     for ident in IDS:
-        d = tmp_path_factory.mktemp(ident)
-        with zipfile.ZipFile(fmu_path(ident)) as z:
-            z.extractall(d)
-        out[ident] = (d, ET.parse(d / "modelDescription.xml").getroot().get("guid"))
+        for fmi, path, attr in ((2, fmu_path(ident), "guid"), (3, fmu3_path(ident), "instantiationToken")):
+            d = tmp_path_factory.mktemp(f"{ident}-fmi{fmi}")
+            with zipfile.ZipFile(path) as z:
+                z.extractall(d)
+            libs = {p: d / "binaries" / (TUPLE[p] if fmi == 3 else p) / (ident + SUFFIX[p]) for p in PLATFORMS}
+            out[fmi, ident] = (d, ET.parse(d / "modelDescription.xml").getroot().get(attr), libs)
     return out
 
 
@@ -68,16 +83,31 @@ def hosts(tmp_path_factory):
     return out
 
 
-def run(hosts, unpacked, platform, steps, fmus, ops):
-    """fmu_host's printed rows (lists of floats) for the FMUs `fmus` on `platform`."""
-    args = [str(steps), "0.001"]
+def run(hosts, unpacked, platform, steps, fmus, ops, fmi=2):
+    """fmu_host's printed rows (lists of floats, exact: printed with 17 digits) for the FMI `fmi`
+    FMUs `fmus` on `platform`."""
+    args = (["--fmi3"] if fmi == 3 else []) + [str(steps), "0.001"]
     for ident in fmus:
-        d, guid = unpacked[ident]
-        args += [str(d / "binaries" / platform / (ident + SUFFIX[platform])), guid]
+        _, token, libs = unpacked[fmi, ident]
+        args += [str(libs[platform]), token]
     env = dict(os.environ, WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
     r = subprocess.run(hosts[platform] + args + ["--"] + ops, capture_output=True, text=True, env=env, timeout=600)
-    assert r.returncode == 0, f"{platform}: {r.stderr}"
+    assert r.returncode == 0, f"{platform}, FMI {fmi}: {r.stderr}"
     return [[float(x) for x in line.split()] for line in r.stdout.splitlines()]
+
+
+@pytest.fixture(scope="module")
+def runs(hosts, unpacked):
+    """run(), each (scenario, platform, FMI version) once for the tests of this module."""
+    done = {}
+
+    def get(name, platform, fmi):
+        if (name, platform, fmi) not in done:
+            _, fmus, steps, ops, _ = next(s for s in SCENARIOS if s[0] == name)
+            done[name, platform, fmi] = run(hosts, unpacked, platform, steps, fmus, ops, fmi)
+        return done[name, platform, fmi]
+
+    return get
 
 
 #: Scenarios: (name, FMUs, steps, ops, relative tolerance). Value references are the stable ones
@@ -133,7 +163,7 @@ def test_exports_and_dependencies(unpacked, ident, platform):
     """fmpy loads all 34 functions: each binary exports exactly the FMI 2.0 and FMI 3.0 functions
     (one library for both versions' .fmu), and imports nothing a plain
     Windows 10 or glibc Linux lacks (no libgcc_s_seh, libwinpthread, libstdc++)."""
-    lib = unpacked[ident][0] / "binaries" / platform / (ident + SUFFIX[platform])
+    lib = unpacked[2, ident][2][platform]
     exports, imports = exports_and_imports(platform, lib)
     assert exports == EXPORTED
     allowed = ALLOWED_DLLS if platform == "win64" else ALLOWED_SO
@@ -141,20 +171,34 @@ def test_exports_and_dependencies(unpacked, ident, platform):
     assert not extra, f"{ident} on {platform} imports {sorted(extra)}"
 
 
+@pytest.mark.parametrize("fmi", FMI_VERSIONS)
 @pytest.mark.parametrize("name,fmus,steps,ops,rtol", SCENARIOS, ids=[s[0] for s in SCENARIOS])
-def test_every_platform_computes_the_same(hosts, unpacked, name, fmus, steps, ops, rtol):
-    """The same scenario on linux64 (native), win64 (wine64) and aarch64-linux (qemu-aarch64)."""
-    reference = run(hosts, unpacked, "linux64", steps, fmus, ops)
+def test_every_platform_computes_the_same(runs, name, fmus, steps, ops, rtol, fmi):
+    """The same scenario on linux64 (native), win64 (wine64) and aarch64-linux (qemu-aarch64),
+    through FMI 2.0 and FMI 3.0."""
+    reference = runs(name, "linux64", fmi)
     assert len(reference) == steps // 100 and all(len(r) == len(reference[0]) for r in reference)
     for platform in PLATFORMS[1:]:
-        rows = run(hosts, unpacked, platform, steps, fmus, ops)
+        rows = runs(name, platform, fmi)
         assert len(rows) == len(reference)
         # Relative to each output's largest magnitude over the run (a flow crossing zero has no
         # relative error of its own).
         scale = [max(abs(r[j]) for r in reference) or 1.0 for j in range(len(reference[0]))]
         worst = max(abs(a - b) / s for a_row, b_row in zip(reference, rows) for a, b, s in zip(a_row, b_row, scale))
-        print(f"{name} on {platform}: largest relative difference to linux64 {worst:.3g}")
-        assert worst <= rtol, f"{name} on {platform}: {worst:.3g} > {rtol:g}"
+        print(f"{name} on {platform}, FMI {fmi}: largest relative difference to linux64 {worst:.3g}")
+        assert worst <= rtol, f"{name} on {platform}, FMI {fmi}: {worst:.3g} > {rtol:g}"
+
+
+@pytest.mark.parametrize("platform", PLATFORMS)
+@pytest.mark.parametrize("name", [s[0] for s in SCENARIOS])
+def test_fmi3_equals_fmi2_on_the_same_platform(runs, name, platform):
+    """FMI 3.0 and FMI 2.0 on one platform: bit for bit (the same library; fmi3DoStep,
+    fmi3SetFloat64 ... and their FMI 2.0 counterparts call the same code, and the host passes
+    the same values in the same order)."""
+    rows2, rows3 = runs(name, platform, 2), runs(name, platform, 3)
+    assert len(rows3) == len(rows2) > 0
+    differ = [(r2[0], j) for r2, r3 in zip(rows2, rows3) for j, (a, b) in enumerate(zip(r2, r3)) if a != b]
+    assert not differ, f"{name} on {platform}: FMI 3.0 differs from FMI 2.0 at (time, column) {differ[:5]}"
 
 
 def test_tools_are_installed():

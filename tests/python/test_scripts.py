@@ -58,3 +58,8 @@ def test_plots_use_the_signs_of_the_csv_and_the_title():
 def test_the_other_runners_refuse_an_unknown_scenario_in_one_line(args):
     code, last = run(*args)
     assert code == 2 and 'unknown scenario "Q"' in last, last
+
+
+def test_ssp_refuses_an_unknown_fmi_version_in_one_line():
+    code, last = run("ssp.py", "--fmi", "4", "--no-run")
+    assert code == 2 and "--fmi: invalid choice: 4 (choose from 2, 3)" in last, last
