@@ -4,9 +4,10 @@
 use crate::callbacks::Callbacks;
 use crate::model_description::Description;
 use fmi::fmi2::binding;
+use crate::fmu_states::{FmuState, StateFunctions};
 pub use fmi::fmi2::binding::{
     fmi2CallbackFunctions as CallbackFunctions, fmi2CallbackLogger as Logger, fmi2Component as Component,
-    fmi2FMUstate as FmuState, fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2OK as OK,
+    fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2OK as OK,
     fmi2Status_fmi2Warning as WARNING, Fmi2Binding as Fmi2,
 };
 use std::ffi::CString;
@@ -85,5 +86,26 @@ impl Library {
             fmi.fmi2FreeInstance(c);
         }
         Ok(Library { path: path.to_owned(), fmi, model })
+    }
+}
+
+impl StateFunctions for Fmi2 {
+    unsafe fn get(&self, c: Component, state: *mut FmuState) -> Status {
+        self.fmi2GetFMUstate(c, state)
+    }
+    unsafe fn set(&self, c: Component, state: FmuState) -> Status {
+        self.fmi2SetFMUstate(c, state)
+    }
+    unsafe fn free(&self, c: Component, state: *mut FmuState) -> Status {
+        self.fmi2FreeFMUstate(c, state)
+    }
+    unsafe fn size(&self, c: Component, state: FmuState, size: *mut usize) -> Status {
+        self.fmi2SerializedFMUstateSize(c, state, size)
+    }
+    unsafe fn serialize(&self, c: Component, state: FmuState, bytes: *mut u8, size: usize) -> Status {
+        self.fmi2SerializeFMUstate(c, state, bytes.cast(), size)
+    }
+    unsafe fn deserialize(&self, c: Component, bytes: *const u8, size: usize, state: *mut FmuState) -> Status {
+        self.fmi2DeSerializeFMUstate(c, bytes.cast(), size, state)
     }
 }
