@@ -616,3 +616,25 @@ fn model_exchange_matches_fmi2_and_the_adjoint_is_the_transpose() {
     let scale: f64 = v.iter().zip(&jw).map(|(v, x)| (v * x).abs()).sum::<f64>().max(1e-300);
     assert!(a != 0.0 && (a - b).abs() <= 1e-12 * scale, "v.(Jw) = {a}, (J^T v).w = {b}");
 }
+
+/// fmi3GetEventIndicators with the number fmi3GetNumberOfEventIndicators and the model
+/// description declare returns fmi3OK and leaves the instance usable. Found by the API fuzzer
+/// (examples/fuzz): the boom FMUs declare none in FMI 3.0, but the model wrote its three FMI 2.0
+/// indicators into the empty array, and the caught panic put the instance in the Error state.
+#[test]
+fn event_indicators_of_the_declared_number() {
+    fn declared<M: Model>() {
+        let i = Inst::<M>::initialized(true, &[]);
+        let mut n = usize::MAX;
+        unsafe {
+            assert_eq!(api::get_number_of_event_indicators::<M>(i.c, &mut n), OK);
+            let mut z = vec![f64::NAN; n];
+            assert_eq!(api::get_event_indicators::<M>(i.c, z.as_mut_ptr(), n), OK, "{}", i.last_error());
+            assert!(z.iter().all(|x| x.is_finite()), "{z:?}");
+            assert_eq!(api::enter_continuous_time_mode::<M>(i.c), OK, "{}", i.last_error());
+        }
+    }
+    declared::<HydraulicBoom>();
+    declared::<HydraulicCircuit>();
+    declared::<Pfc>();
+}

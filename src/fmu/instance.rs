@@ -286,6 +286,10 @@ impl<M: Model> Instance<M> {
     /// fmi2GetEventIndicators (in Initialization Mode: those the values set so far give).
     pub fn event_indicators(&mut self, z: &mut [f64]) -> Result<(), String> {
         Self::check_count("ni", z.len(), self.event_indicator_count(), "event indicators")?;
+        if z.is_empty() {
+            // This version declares none (FMI 3.0): the model's own would not fit.
+            return Ok(());
+        }
         self.with_model(|m, values| m.event_indicators(values, z))
     }
 
