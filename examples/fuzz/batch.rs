@@ -9,6 +9,20 @@ use std::os::raw::c_int;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
 
+thread_local! {
+    /// The child's end of the heartbeat pipe (-1: none, as on replay).
+    static HEARTBEAT: std::cell::Cell<c_int> = const { std::cell::Cell::new(-1) };
+}
+
+/// Tells the parent that the child is alive and starts (or repeats) a sequence.
+pub fn beat() {
+    let fd = HEARTBEAT.with(|h| h.get());
+    if fd >= 0 {
+        // SAFETY: one byte from a live buffer to the pipe; a parent that is gone does not matter.
+        unsafe { libc::write(fd, [1u8].as_ptr().cast(), 1) };
+    }
+}
+
 /// Sequences per forked child.
 const BATCH: u64 = 20;
 /// A sequence still running after this long is a hang.
@@ -94,8 +108,8 @@ fn run_child(library: &dyn Subject, seeds: &[u64], report: &mut Report, heartbea
             break;
         }
         report.running = i as u64;
-        // SAFETY: one byte from a live buffer to the pipe; a parent that is gone does not matter.
-        unsafe { libc::write(heartbeat, [1u8].as_ptr().cast(), 1) };
+        HEARTBEAT.with(|h| h.set(heartbeat));
+        beat();
         if let Err(violation) = library.run_sequence(seed, report) {
             report.violation.set(format_args!("{violation}"));
             return EXIT_VIOLATION;

@@ -22,13 +22,6 @@ pub use fmi::fmi2::binding::fmi2EventInfo as EventInfo;
 pub const LAST_SUCCESSFUL_TIME: c_int = binding::fmi2StatusKind_fmi2LastSuccessfulTime as c_int;
 pub const TERMINATED: c_int = binding::fmi2StatusKind_fmi2Terminated as c_int;
 
-/// The first of the functions named that `fmi` does not export.
-macro_rules! first_missing {
-    ($fmi:ident: $($function:ident)*) => {
-        [$((stringify!($function), $fmi.$function.is_ok())),*].into_iter().find(|(_, ok)| !ok).map(|(f, _)| f)
-    };
-}
-
 /// One FMU under test: its functions and its model description.
 pub struct Library {
     pub path: PathBuf,
@@ -42,9 +35,7 @@ impl Library {
     /// once with its GUID: a stale build would refuse every instantiation, and the fuzzer would
     /// test nothing but error paths.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let stem =
-            path.file_stem().and_then(|s| s.to_str()).ok_or_else(|| format!("{}: no file name", path.display()))?;
-        let identifier = stem.strip_prefix("lib").unwrap_or(stem);
+        let identifier = crate::identifier(path)?;
         let model = Description::read(&crate::repository().join(format!("modelDescription/{identifier}.xml")))?;
         // SAFETY: an FMU library has no initialisers that could break this process; it stays loaded.
         let fmi = unsafe { Fmi2::new(path) }.map_err(|e| format!("dlopen {e}"))?;

@@ -9,13 +9,6 @@ pub use fmi::fmi3::binding::{
 use std::path::{Path, PathBuf};
 use std::ptr::{null, null_mut};
 
-/// The first of the functions named that `fmi` does not export.
-macro_rules! first_missing {
-    ($fmi:ident: $($function:ident)*) => {
-        [$((stringify!($function), $fmi.$function.is_ok())),*].into_iter().find(|(_, ok)| !ok).map(|(f, _)| f)
-    };
-}
-
 /// One FMU under test through FMI 3.0: its functions and its model description.
 pub struct Library {
     pub path: PathBuf,
@@ -28,9 +21,7 @@ impl Library {
     /// fmi3FunctionTypes.h, reads `modelDescription/fmi3/<Id>.xml` and instantiates once for
     /// Co-Simulation with its instantiation token (a stale build refuses it).
     pub fn load(path: &Path) -> Result<Self, String> {
-        let stem =
-            path.file_stem().and_then(|s| s.to_str()).ok_or_else(|| format!("{}: no file name", path.display()))?;
-        let identifier = stem.strip_prefix("lib").unwrap_or(stem);
+        let identifier = crate::identifier(path)?;
         let xml = crate::repository().join(format!("modelDescription/fmi3/{identifier}.xml"));
         let model = Description::read(&xml)?;
         if !model.fmi3 {

@@ -26,6 +26,7 @@ pub fn run_logged(fmi3: bool, seed: u64, report: &mut Report, drive: impl Fn(&mu
     report.fmi3 = fmi3;
     let mut leaked = 0;
     for _ in 0..2 {
+        crate::batch::beat();
         LOG.with(|sink| *sink.borrow_mut() = LogSink { echo: report.echo, fmi3, ..LogSink::default() });
         report.traced = 0;
         let before = heap_in_use();

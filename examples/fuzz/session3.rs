@@ -150,7 +150,9 @@ impl<'a> Session3<'a> {
     fn check_status(&self, op: &Op3, status: Option<Status>, (errors, discards): (u64, u64)) -> Result<(), String> {
         if let (Some(why), Some(s)) = (forbidden(op, self.view.phase, self.me, self.model), status) {
             if s != ERROR {
-                return Err(format!("returned {}, but the call must fail: {why}", name(s)));
+                let call = op.describe();
+                let function = call.split([' ', '(']).next().unwrap_or_default();
+                return Err(format!("{function} returned {}, but the call must fail: {why}", name(s)));
             }
         }
         match status {
