@@ -229,11 +229,11 @@ impl<'a> Session<'a> {
             }
             Op::SetTime { t } => status(f.fmi2SetTime(c, *t)),
             Op::SetContinuousStates { x } => status(f.fmi2SetContinuousStates(c, x.ptr(), x.len())),
-            Op::GetDerivatives { n, null } => reals(*n, *null, |p| f.fmi2GetDerivatives(c, p, *n)),
-            Op::GetEventIndicators { n, null } => reals(*n, *null, |p| f.fmi2GetEventIndicators(c, p, *n)),
-            Op::GetContinuousStates { n, null } => reals(*n, *null, |p| f.fmi2GetContinuousStates(c, p, *n)),
+            Op::GetDerivatives { n, null } => real_output(*n, *null, |p| f.fmi2GetDerivatives(c, p, *n)),
+            Op::GetEventIndicators { n, null } => real_output(*n, *null, |p| f.fmi2GetEventIndicators(c, p, *n)),
+            Op::GetContinuousStates { n, null } => real_output(*n, *null, |p| f.fmi2GetContinuousStates(c, p, *n)),
             Op::GetNominalsOfContinuousStates { n, null } => {
-                reals(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
+                real_output(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
             }
         }
     }
@@ -358,10 +358,16 @@ impl<'a> Session<'a> {
 
 /// Calls `f` with a buffer of `n` NaNs (NULL for `null`): the status and what it holds after (a
 /// value the FMU does not write fails the finiteness check).
-unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
+pub unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Vec<f64>) {
     let mut v = vec![f64::NAN; n];
     let s = f(out(&mut v, null));
-    (Some(s), Output::Reals(if null { Vec::new() } else { v }))
+    (Some(s), if null { Vec::new() } else { v })
+}
+
+/// `reals` with its numbers as the call's output.
+unsafe fn real_output(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
+    let (s, v) = reals(n, null, f);
+    (s, Output::Reals(v))
 }
 
 /// An fmi2OK answer of a Model Exchange getter holds finite numbers only.
@@ -373,7 +379,7 @@ fn finite(values: &[f64], function: &str) -> Result<(), String> {
 }
 
 /// An output pointer to `buffer`, or NULL.
-fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
+pub fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
     if null {
         null_mut()
     } else {

@@ -28,7 +28,7 @@ use crate::model_description::Description;
 use crate::ops::{Arr, Slot, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
 use crate::report::Report;
-use crate::session::Target;
+use crate::session::{out, Target};
 use crate::view::{Phase, View};
 use std::ffi::CStr;
 use std::os::raw::c_char;
@@ -431,12 +431,10 @@ fn name(s: Status) -> String {
     crate::report::outcome(i64::from(s), true)
 }
 
-/// Calls `f` with a buffer of `n` NaNs (NULL for `null`): the status and what it holds after (a
-/// value the FMU does not write fails the finiteness check).
+/// `session::reals` with its numbers as the call's output.
 unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
-    let mut v = vec![f64::NAN; n];
-    let s = f(out(&mut v, null));
-    (Some(s), Output::Reals(if null { Vec::new() } else { v }))
+    let (s, v) = crate::session::reals(n, null, f);
+    (s, Output::Reals(v))
 }
 
 /// Calls `f` with a size_t*, NULL for `null`.
@@ -444,15 +442,6 @@ unsafe fn count(null: bool, f: impl FnOnce(*mut usize) -> Status) -> (Option<Sta
     let mut n = usize::MAX;
     let s = f(if null { null_mut() } else { &mut n });
     (Some(s), Output::Count(n))
-}
-
-/// An output pointer to `buffer`, or NULL.
-fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
-    if null {
-        null_mut()
-    } else {
-        buffer.as_mut_ptr()
-    }
 }
 
 /// An fmi3OK answer holds finite numbers only.
