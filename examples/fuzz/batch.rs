@@ -2,14 +2,26 @@
 //! and the rest go on. The child writes a byte to a pipe as each sequence starts, and the parent
 //! kills it when one runs longer than `SEQUENCE_TIMEOUT`. The child's account is in a `SharedReport`.
 
-use crate::fmi2::Library;
-use crate::report::{Report, SharedReport, Tally};
+use crate::report::{Report, SharedReport, Subject, Tally};
 use crate::rng::sequence_seed;
-use crate::sequence::run_sequence;
 use std::ffi::CStr;
 use std::os::raw::c_int;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::{Duration, Instant};
+
+thread_local! {
+    /// The child's end of the heartbeat pipe (-1: none, as on replay).
+    static HEARTBEAT: std::cell::Cell<c_int> = const { std::cell::Cell::new(-1) };
+}
+
+/// Tells the parent that the child is alive and starts (or repeats) a sequence.
+pub fn beat() {
+    let fd = HEARTBEAT.with(|h| h.get());
+    if fd >= 0 {
+        // SAFETY: one byte from a live buffer to the pipe; a parent that is gone does not matter.
+        unsafe { libc::write(fd, [1u8].as_ptr().cast(), 1) };
+    }
+}
 
 /// Sequences per forked child.
 const BATCH: u64 = 20;
@@ -20,8 +32,9 @@ const EXIT_VIOLATION: c_int = 1;
 /// Exit status of a child in which the fuzzer itself panicked.
 const EXIT_FUZZER_PANIC: c_int = 3;
 
-/// Fuzzes one library for `budget`, batch after batch, printing the first failure of each kind.
-pub fn fuzz_library(library: &Library, master: u64, budget: Duration) -> Result<Tally, String> {
+/// Fuzzes one library through one FMI version for `budget`, batch after batch, printing the first
+/// failure of each kind.
+pub fn fuzz_library(library: &dyn Subject, master: u64, budget: Duration) -> Result<Tally, String> {
     let mut report = SharedReport::new()?;
     let started = Instant::now();
     let deadline = started + budget;
@@ -29,7 +42,7 @@ pub fn fuzz_library(library: &Library, master: u64, budget: Duration) -> Result<
     let mut next = 0;
     while Instant::now() < deadline {
         let seeds: Vec<u64> =
-            (next..next + BATCH).map(|k| sequence_seed(master, &library.model.identifier, k)).collect();
+            (next..next + BATCH).map(|k| sequence_seed(master, library.identifier(), library.fmi(), k)).collect();
         report.clear();
         let ending = run_batch(library, &seeds, &mut report, deadline)?;
         let r = report.get();
@@ -39,7 +52,8 @@ pub fn fuzz_library(library: &Library, master: u64, budget: Duration) -> Result<
         }
         next += r.counts.sequences;
         if let Some(ending) = ending {
-            if tally.kinds.insert(r.signature(&library.model.identifier, &ending)) {
+            let name = format!("{} (FMI {})", library.identifier(), library.fmi());
+            if tally.kinds.insert(r.signature(&name, &ending)) {
                 r.print_failure(library, seeds[r.running as usize], &ending);
             }
             tally.failures += 1;
@@ -54,7 +68,7 @@ pub fn fuzz_library(library: &Library, master: u64, budget: Duration) -> Result<
 /// Runs `seeds` in a forked child and waits for it; `None` when every sequence passed, else how
 /// the child ended. The child's account is in `report`.
 fn run_batch(
-    library: &Library,
+    library: &dyn Subject,
     seeds: &[u64],
     report: &mut SharedReport,
     deadline: Instant,
@@ -88,15 +102,15 @@ fn run_batch(
 }
 
 /// The child: runs the sequences, a heartbeat byte before each; the exit status.
-fn run_child(library: &Library, seeds: &[u64], report: &mut Report, heartbeat: c_int, deadline: Instant) -> c_int {
+fn run_child(library: &dyn Subject, seeds: &[u64], report: &mut Report, heartbeat: c_int, deadline: Instant) -> c_int {
     for (i, &seed) in seeds.iter().enumerate() {
         if i > 0 && Instant::now() >= deadline {
             break;
         }
         report.running = i as u64;
-        // SAFETY: one byte from a live buffer to the pipe; a parent that is gone does not matter.
-        unsafe { libc::write(heartbeat, [1u8].as_ptr().cast(), 1) };
-        if let Err(violation) = run_sequence(library, seed, report) {
+        HEARTBEAT.with(|h| h.set(heartbeat));
+        beat();
+        if let Err(violation) = library.run_sequence(seed, report) {
             report.violation.set(format_args!("{violation}"));
             return EXIT_VIOLATION;
         }

@@ -1,6 +1,8 @@
-//! The callbacks fmi2Instantiate gets; the logger checks every call it receives.
+//! The callbacks fmi2Instantiate gets, and FMI 3.0's logMessage; the loggers check every call they
+//! receive.
 
 use crate::fmi2::{CallbackFunctions, Logger, Status};
+use crate::fmi3;
 use crate::report::outcome;
 use std::cell::RefCell;
 use std::ffi::CStr;
@@ -11,7 +13,13 @@ use std::os::raw::{c_char, c_int, c_void};
 pub struct LogSink {
     /// Print every message to stderr (replay).
     pub echo: bool,
+    /// The sequence is an FMI 3.0 one (status names).
+    pub fmi3: bool,
     pub messages: u64,
+    /// Messages with status Discard and with Error or Fatal (the oracle's check that an error
+    /// or discard comes with a message compares them before and after a call).
+    pub discards: u64,
+    pub errors: u64,
     pub internal_errors: u64,
     pub first_internal_error: Option<String>,
     /// The first oracle violation in a logger call.
@@ -22,10 +30,11 @@ thread_local! {
     pub static LOG: RefCell<LogSink> = RefCell::new(LogSink::default());
 }
 
-/// The componentEnvironment given to fmi2Instantiate: the logger checks that it comes back.
+/// The componentEnvironment given to fmi2Instantiate (FMI 3.0: instanceEnvironment): the logger
+/// checks that it comes back.
 static ENVIRONMENT: u8 = 0;
 
-fn environment() -> *mut c_void {
+pub fn environment() -> *mut c_void {
     &ENVIRONMENT as *const u8 as *mut c_void
 }
 
@@ -57,12 +66,25 @@ unsafe extern "C" fn logger(
     } else {
         None
     };
+    record(violation, status as c_int, category, message);
+}
+
+/// Counts a message, or keeps the violation found in the logger's arguments; on replay, prints it.
+///
+/// # Safety
+/// Without a violation, `category` and `message` are NUL-terminated strings.
+unsafe fn record(violation: Option<String>, status: c_int, category: *const c_char, message: *const c_char) {
     LOG.with(|sink| {
         let sink = &mut *sink.borrow_mut();
         sink.messages += 1;
         if let Some(violation) = violation {
             sink.violation.get_or_insert(violation);
             return;
+        }
+        match status {
+            2 => sink.discards += 1,
+            3..=4 => sink.errors += 1,
+            _ => {}
         }
         let message = CStr::from_ptr(message);
         if message.to_bytes().windows(15).any(|w| w == b"internal error:") {
@@ -71,9 +93,24 @@ unsafe extern "C" fn logger(
         }
         if sink.echo {
             let category = CStr::from_ptr(category).to_string_lossy();
-            eprintln!("     log {} {category}: {}", outcome(i64::from(status as c_int)), message.to_string_lossy());
+            eprintln!("     log {} {category}: {}", outcome(i64::from(status), sink.fmi3), message.to_string_lossy());
         }
     });
+}
+
+/// FMI 3.0's fmi3LogMessageCallback (not variadic, no instance name): checks the call, counts the
+/// message and, on replay, prints it.
+pub unsafe extern "C" fn log_message(env: *mut c_void, status: fmi3::Status, category: *const c_char, message: *const c_char) {
+    let violation = if env != environment() {
+        Some(format!("logMessage got instanceEnvironment {env:p}, not the one given at instantiation"))
+    } else if category.is_null() || message.is_null() {
+        Some("logMessage got a NULL category or message".into())
+    } else if status > 4 {
+        Some(format!("logMessage got status {status}, which is not an fmi3Status"))
+    } else {
+        None
+    };
+    record(violation, status as c_int, category, message);
 }
 
 unsafe extern "C" fn allocate(n: usize, size: usize) -> *mut c_void {

@@ -4,9 +4,10 @@
 use crate::callbacks::Callbacks;
 use crate::model_description::Description;
 use fmi::fmi2::binding;
+use crate::fmu_states::{FmuState, StateFunctions};
 pub use fmi::fmi2::binding::{
     fmi2CallbackFunctions as CallbackFunctions, fmi2CallbackLogger as Logger, fmi2Component as Component,
-    fmi2FMUstate as FmuState, fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2OK as OK,
+    fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2OK as OK,
     fmi2Status_fmi2Warning as WARNING, Fmi2Binding as Fmi2,
 };
 use std::ffi::CString;
@@ -21,13 +22,6 @@ pub use fmi::fmi2::binding::fmi2EventInfo as EventInfo;
 pub const LAST_SUCCESSFUL_TIME: c_int = binding::fmi2StatusKind_fmi2LastSuccessfulTime as c_int;
 pub const TERMINATED: c_int = binding::fmi2StatusKind_fmi2Terminated as c_int;
 
-/// The first of the functions named that `fmi` does not export.
-macro_rules! first_missing {
-    ($fmi:ident: $($function:ident)*) => {
-        [$((stringify!($function), $fmi.$function.is_ok())),*].into_iter().find(|(_, ok)| !ok).map(|(f, _)| f)
-    };
-}
-
 /// One FMU under test: its functions and its model description.
 pub struct Library {
     pub path: PathBuf,
@@ -41,9 +35,7 @@ impl Library {
     /// once with its GUID: a stale build would refuse every instantiation, and the fuzzer would
     /// test nothing but error paths.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let stem =
-            path.file_stem().and_then(|s| s.to_str()).ok_or_else(|| format!("{}: no file name", path.display()))?;
-        let identifier = stem.strip_prefix("lib").unwrap_or(stem);
+        let identifier = crate::identifier(path)?;
         let model = Description::read(&crate::repository().join(format!("modelDescription/{identifier}.xml")))?;
         // SAFETY: an FMU library has no initialisers that could break this process; it stays loaded.
         let fmi = unsafe { Fmi2::new(path) }.map_err(|e| format!("dlopen {e}"))?;
@@ -85,5 +77,26 @@ impl Library {
             fmi.fmi2FreeInstance(c);
         }
         Ok(Library { path: path.to_owned(), fmi, model })
+    }
+}
+
+impl StateFunctions for Fmi2 {
+    unsafe fn get(&self, c: Component, state: *mut FmuState) -> Status {
+        self.fmi2GetFMUstate(c, state)
+    }
+    unsafe fn set(&self, c: Component, state: FmuState) -> Status {
+        self.fmi2SetFMUstate(c, state)
+    }
+    unsafe fn free(&self, c: Component, state: *mut FmuState) -> Status {
+        self.fmi2FreeFMUstate(c, state)
+    }
+    unsafe fn size(&self, c: Component, state: FmuState, size: *mut usize) -> Status {
+        self.fmi2SerializedFMUstateSize(c, state, size)
+    }
+    unsafe fn serialize(&self, c: Component, state: FmuState, bytes: *mut u8, size: usize) -> Status {
+        self.fmi2SerializeFMUstate(c, state, bytes.cast(), size)
+    }
+    unsafe fn deserialize(&self, c: Component, bytes: *const u8, size: usize, state: *mut FmuState) -> Status {
+        self.fmi2DeSerializeFMUstate(c, bytes.cast(), size, state)
     }
 }

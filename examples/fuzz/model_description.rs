@@ -1,5 +1,7 @@
-//! What the fuzzer reads from `modelDescription/<Id>.xml`: the GUID, the log categories and every
-//! variable, with the lists the call generators draw from.
+//! What the fuzzer reads from `modelDescription/<Id>.xml` (FMI 2.0) or
+//! `modelDescription/fmi3/<Id>.xml` (FMI 3.0): the GUID or instantiation token, the log
+//! categories, every variable, the continuous states and event indicators, with the lists the call
+//! generators draw from.
 
 use crate::rng::Rng;
 use quick_xml::events::{BytesStart, Event};
@@ -8,7 +10,7 @@ use std::collections::HashMap;
 use std::os::raw::c_int;
 use std::path::Path;
 
-/// A variable's base type.
+/// A variable's base type (FMI 3.0: Float64, Int32, Boolean, String).
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Type {
     Real,
@@ -25,9 +27,9 @@ pub struct Variable {
     pub name: String,
     pub vr: u32,
     pub ty: Type,
-    causality: String,
-    variability: String,
-    initial: Option<String>,
+    pub causality: String,
+    pub variability: String,
+    pub initial: Option<String>,
     pub min: f64,
     pub max: f64,
     start: Option<f64>,
@@ -36,7 +38,8 @@ pub struct Variable {
 type Attributes = HashMap<String, String>;
 
 impl Variable {
-    /// From the attributes of a ScalarVariable and of its type element (`Real`, `Integer`, ...).
+    /// From the attributes of a ScalarVariable and of its type element (`Real`, `Integer`, ...);
+    /// in FMI 3.0 both are those of the variable's element (`Float64`, `Int32`, ...).
     fn new(scalar: &Attributes, tag: &str, typed: &Attributes) -> Result<Self, String> {
         let name = scalar.get("name").cloned().ok_or("a ScalarVariable without name")?;
         let vr = scalar
@@ -44,8 +47,8 @@ impl Variable {
             .and_then(|s| s.parse().ok())
             .ok_or_else(|| format!("{name}: no valid valueReference"))?;
         let (ty, lo, hi) = match tag {
-            "Real" => (Type::Real, f64::NEG_INFINITY, f64::INFINITY),
-            "Integer" | "Enumeration" => (Type::Integer, c_int::MIN as f64, c_int::MAX as f64),
+            "Real" | "Float64" => (Type::Real, f64::NEG_INFINITY, f64::INFINITY),
+            "Integer" | "Enumeration" | "Int32" => (Type::Integer, c_int::MIN as f64, c_int::MAX as f64),
             "Boolean" => (Type::Boolean, 0.0, 1.0),
             _ => (Type::String, 0.0, 1.0),
         };
@@ -119,7 +122,12 @@ impl Variable {
 /// The model description, with the lists the generators draw from.
 pub struct Description {
     pub identifier: String,
+    /// The GUID (FMI 2.0) or instantiationToken (FMI 3.0).
     pub guid: String,
+    /// `fmiVersion` is 3.0.
+    pub fmi3: bool,
+    /// `providesAdjointDerivatives` of the CoSimulation element (FMI 3.0).
+    pub adjoint: bool,
     pub categories: Vec<String>,
     pub variables: Vec<Variable>,
     /// Value references per type, in the order of `TYPES`.
@@ -135,8 +143,8 @@ pub struct Description {
     pub real_inputs: Vec<usize>,
     /// `boom.flexible`, when the model has it.
     pub flexible: Option<u32>,
-    /// Continuous states (Real variables with `derivative`) and event indicators, for Model
-    /// Exchange.
+    /// Continuous states (Real variables with `derivative`) and event indicators
+    /// (`numberOfEventIndicators`; FMI 3.0: the `EventIndicator` elements), for Model Exchange.
     pub states: usize,
     pub event_indicators: usize,
     pub max_vr: u32,
@@ -152,7 +160,7 @@ impl Description {
     fn parse(xml: &str) -> Result<Self, String> {
         let mut reader = quick_xml::Reader::from_str(xml);
         let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
-        let (mut states, mut event_indicators) = (0, 0);
+        let (mut states, mut event_indicators, mut fmi3, mut adjoint) = (0, 0, false, false);
         let mut scalar: Option<Attributes> = None;
         loop {
             match reader.read_event().map_err(|e| e.to_string())? {
@@ -160,15 +168,30 @@ impl Description {
                     let a = attributes(&e)?;
                     match e.name().0 {
                         "fmiModelDescription" => {
-                            guid = a.get("guid").cloned();
+                            fmi3 = a.get("fmiVersion").is_some_and(|v| v.starts_with("3."));
+                            guid = a.get(if fmi3 { "instantiationToken" } else { "guid" }).cloned();
                             event_indicators = a
                                 .get("numberOfEventIndicators")
                                 .map_or(Ok(0), |n| n.parse())
                                 .map_err(|e| format!("numberOfEventIndicators: {e}"))?;
                         }
-                        "CoSimulation" => identifier = a.get("modelIdentifier").cloned(),
+                        "CoSimulation" => {
+                            identifier = a.get("modelIdentifier").cloned();
+                            adjoint = a.get("providesAdjointDerivatives").is_some_and(|v| v == "true");
+                        }
                         "Category" => categories.extend(a.get("name").cloned()),
                         "ScalarVariable" => scalar = Some(a),
+                        "EventIndicator" if fmi3 => event_indicators += 1,
+                        tag @ ("Float64" | "Int32" | "Boolean" | "String") if fmi3 => {
+                            states += usize::from(tag == "Float64" && a.contains_key("derivative"));
+                            variables.push(Variable::new(&a, tag, &a)?);
+                        }
+                        tag @ ("Float32" | "Int8" | "UInt8" | "Int16" | "UInt16" | "UInt32" | "Int64" | "UInt64"
+                        | "Enumeration" | "Binary" | "Clock")
+                            if fmi3 =>
+                        {
+                            return Err(format!("a {tag} variable: the fuzzer knows Float64, Int32, Boolean and String"));
+                        }
                         tag @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration") => {
                             states += usize::from(tag == "Real" && a.contains_key("derivative"));
                             if let Some(s) = scalar.take() {
@@ -204,7 +227,9 @@ impl Description {
             max_vr: variables.iter().map(|v| v.vr).max().unwrap_or(0),
             index: variables.iter().enumerate().map(|(i, v)| (v.vr, i)).collect(),
             identifier: identifier.ok_or("no CoSimulation modelIdentifier")?,
-            guid: guid.ok_or("no guid")?,
+            guid: guid.ok_or("no guid or instantiationToken")?,
+            fmi3,
+            adjoint,
             flexible,
             states,
             event_indicators,

@@ -1,7 +1,8 @@
 //! The call catalogue: one `Op` per FMI function, with the arguments it is called with.
 
 use crate::callbacks::Callbacks;
-use crate::fmi2::{Component, FmuState};
+use crate::fmi2::Component;
+use crate::fmu_states::{FmuState, StateCall};
 use crate::view::View;
 use std::ffi::CString;
 use std::fmt::{self, Debug};
@@ -81,7 +82,7 @@ impl Debug for Text {
     }
 }
 
-/// The fmi2FMUstate* argument of fmi2GetFMUstate and fmi2FreeFMUstate: NULL, or a variable
+/// The FMUstate* argument of fmi2GetFMUstate and fmi2FreeFMUstate (FMI 3.0 alike): NULL, or a variable
 /// holding the given state pointer.
 #[derive(Debug, Clone, Copy)]
 pub enum Slot {
@@ -89,7 +90,7 @@ pub enum Slot {
     Holding(FmuState),
 }
 
-/// Bytes for fmi2DeSerializeFMUstate and how they were made.
+/// Bytes for fmi2DeSerializeFMUstate (fmi3DeserializeFMUState) and how they were made.
 pub struct Blob {
     pub bytes: Arr<u8>,
     pub how: String,
@@ -179,28 +180,8 @@ pub enum Op {
         vr: Arr<u32>,
         values: Arr<Text>,
     },
-    GetFMUstate {
-        state: Slot,
-    },
-    SetFMUstate {
-        state: FmuState,
-    },
-    FreeFMUstate {
-        state: Slot,
-    },
-    SerializedFMUstateSize {
-        state: FmuState,
-        null_size: bool,
-    },
-    SerializeFMUstate {
-        state: FmuState,
-        size: usize,
-        null_buffer: bool,
-    },
-    DeSerializeFMUstate {
-        bytes: Blob,
-        null_state: bool,
-    },
+    /// The FMU state functions.
+    State(StateCall),
     GetDirectionalDerivative {
         unknowns: Arr<u32>,
         knowns: Arr<u32>,

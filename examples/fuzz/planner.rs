@@ -3,6 +3,7 @@
 //! reset; mostly with the rigid boom (`boom.flexible` = false).
 
 use crate::fmi2::{LAST_SUCCESSFUL_TIME, TERMINATED};
+use crate::fmu_states::{FmuStates, StateCall};
 use crate::model_description::{Description, Type, Variable};
 use crate::ops::{Arr, Op, Slot, Text};
 use crate::rng::Rng;
@@ -55,7 +56,7 @@ impl Planner {
                 0..=2 => last_successful_time,
                 3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
                 4..=5 => get_reals(rng, m),
-                6 if !s.states.live.is_empty() => Op::SetFMUstate { state: rng.pick(&s.states.live).ptr },
+                6 if !s.states.live.is_empty() => Op::State(StateCall::Set { state: rng.pick(&s.states.live).ptr }),
                 6..=8 => Op::Reset,
                 _ => Op::Terminate,
             },
@@ -170,31 +171,32 @@ impl Planner {
 
 /// An FMU state call of an importer: get a new one, overwrite, restore, serialize (size first),
 /// deserialize intact bytes (or, now and then, damaged ones), free.
-fn state_op(rng: &mut Rng, s: &Session) -> Op {
-    let live = rng.choose(&s.states.live);
+pub fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
+    let live = rng.choose(&states.live);
     match (rng.below(8), live) {
-        (1, Some(l)) => Op::GetFMUstate { state: Slot::Holding(l.ptr) },
-        (2, Some(l)) => Op::SetFMUstate { state: l.ptr },
+        (1, Some(l)) => StateCall::Get { state: Slot::Holding(l.ptr) },
+        (2, Some(l)) => StateCall::Set { state: l.ptr },
         (3..=4, Some(l)) => match l.size {
-            Some(size) => Op::SerializeFMUstate { state: l.ptr, size, null_buffer: false },
-            None => Op::SerializedFMUstateSize { state: l.ptr, null_size: false },
+            Some(size) => StateCall::Serialize { state: l.ptr, size, null_buffer: false },
+            None => StateCall::Size { state: l.ptr, null_size: false },
         },
-        (5, _) if !s.states.saved.is_empty() => {
-            Op::DeSerializeFMUstate { bytes: rng.pick(&s.states.saved).intact(), null_state: false }
+        (5, _) if !states.saved.is_empty() => {
+            StateCall::Deserialize { bytes: rng.pick(&states.saved).intact(), null_state: false }
         }
-        (6, _) if !s.states.saved.is_empty() => Op::DeSerializeFMUstate { bytes: blob(rng, s), null_state: false },
-        (7, Some(l)) => Op::FreeFMUstate { state: Slot::Holding(l.ptr) },
-        _ => Op::GetFMUstate { state: Slot::Holding(null_mut()) },
+        (6, _) if !states.saved.is_empty() => StateCall::Deserialize { bytes: blob(rng, states), null_state: false },
+        (7, Some(l)) => StateCall::Free { state: Slot::Holding(l.ptr) },
+        _ => StateCall::Get { state: Slot::Holding(null_mut()) },
     }
+}
+
+fn state_op(rng: &mut Rng, s: &Session) -> Op {
+    Op::State(state_call(rng, &s.states))
 }
 
 /// fmi2GetDirectionalDerivative of one to three outputs with respect to one or two Real inputs,
 /// with seeds of order one.
 fn plausible_directional_derivative(rng: &mut Rng, m: &Description) -> Op {
-    let unknowns: Vec<u32> = (0..rng.range(1, 3)).filter_map(|_| rng.choose(&m.outputs).copied()).collect();
-    let knowns: Vec<u32> =
-        (0..rng.range(1, 2)).filter_map(|_| rng.choose(&m.real_inputs)).map(|&i| m.variables[i].vr).collect();
-    let dv_known = knowns.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
+    let (unknowns, knowns, dv_known) = plausible_derivative(rng, m);
     Op::GetDirectionalDerivative {
         unknowns: Arr::Items(unknowns),
         knowns: Arr::Items(knowns),
@@ -203,8 +205,32 @@ fn plausible_directional_derivative(rng: &mut Rng, m: &Description) -> Op {
     }
 }
 
+/// The unknowns, knowns and seeds of a directional derivative: one to three outputs, one or
+/// two Real inputs, seeds of order one.
+pub fn plausible_derivative(rng: &mut Rng, m: &Description) -> (Vec<u32>, Vec<u32>, Vec<f64>) {
+    let unknowns: Vec<u32> = (0..rng.range(1, 3)).filter_map(|_| rng.choose(&m.outputs).copied()).collect();
+    let knowns: Vec<u32> =
+        (0..rng.range(1, 2)).filter_map(|_| rng.choose(&m.real_inputs)).map(|&i| m.variables[i].vr).collect();
+    let seeds = knowns.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
+    (unknowns, knowns, seeds)
+}
+
 /// fmi2Set of one to three variables of one type from `candidates` (indices), with values in range.
 fn plausible_set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Op> {
+    let (ty, vr, values) = plausible_values(rng, m, candidates)?;
+    let vr = Arr::Items(vr);
+    let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
+    Some(match ty {
+        Type::Real => Op::SetReal { vr, values: Arr::Items(values.clone()) },
+        Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
+        Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
+        Type::String => Op::SetString { vr, values: Arr::Items(values.iter().map(|_| Text::new("fuzz")).collect()) },
+    })
+}
+
+/// One to three variables of one type from `candidates` (indices) with values in range (as
+/// f64: Integer rounded, Boolean 0 or 1; none for String): the type, references and values.
+pub fn plausible_values(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<(Type, Vec<u32>, Vec<f64>)> {
     let first = &m.variables[*rng.choose(candidates)?];
     let mut vars = vec![first];
     for _ in 0..rng.below(3) {
@@ -213,26 +239,23 @@ fn plausible_set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option
             vars.push(v);
         }
     }
-    let values: Vec<f64> = vars.iter().map(|v| v.plausible(rng)).collect();
-    let vr = Arr::Items(vars.iter().map(|v| v.vr).collect());
-    let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
-    Some(match first.ty {
-        Type::Real => Op::SetReal { vr, values: Arr::Items(values) },
-        Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
-        Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
-        Type::String => Op::SetString { vr, values: Arr::Items(vars.iter().map(|_| Text::new("fuzz")).collect()) },
-    })
+    let values = vars.iter().map(|v| v.plausible(rng)).collect();
+    Some((first.ty, vars.iter().map(|v| v.vr).collect(), values))
 }
 
 /// fmi2GetReal of the outputs, of a few Reals, or of every Real.
 fn get_reals(rng: &mut Rng, m: &Description) -> Op {
+    Op::GetReal { vr: Arr::Items(some_reals(rng, m)), null_values: false }
+}
+
+/// The outputs, a few Reals, or every Real.
+pub fn some_reals(rng: &mut Rng, m: &Description) -> Vec<u32> {
     let reals = m.of_type(Type::Real);
-    let vr = match rng.below(10) {
+    match rng.below(10) {
         0..=2 if !m.outputs.is_empty() => m.outputs.clone(),
         0..=6 => (0..rng.range(1, 8)).filter_map(|_| rng.choose(reals).copied()).collect(),
         _ => reals.to_vec(),
-    };
-    Op::GetReal { vr: Arr::Items(vr), null_values: false }
+    }
 }
 
 /// First-order derivatives of one or two Real inputs, of a size that keeps them in range for a while.
@@ -256,20 +279,42 @@ fn plausible_slopes(rng: &mut Rng, m: &Description) -> Option<Op> {
     })
 }
 
-/// fmi2SetupExperiment as an importer calls it: start mostly 0 (sometimes far from it, where
-/// the time's resolution is coarse), a tolerance, sometimes a stop time.
+/// fmi2SetupExperiment as an importer calls it (see `plausible_experiment`).
 fn plausible_setup(rng: &mut Rng) -> Op {
+    let e = plausible_experiment(rng);
+    Op::SetupExperiment {
+        tolerance_defined: c_int::from(e.tolerance_defined),
+        tolerance: e.tolerance,
+        start: e.start,
+        stop_defined: c_int::from(e.stop_defined),
+        stop: e.stop,
+    }
+}
+
+/// The experiment of fmi2SetupExperiment and fmi3EnterInitializationMode.
+#[derive(Debug, Clone, Copy)]
+pub struct Experiment {
+    pub tolerance_defined: bool,
+    pub tolerance: f64,
+    pub start: f64,
+    pub stop_defined: bool,
+    pub stop: f64,
+}
+
+/// An experiment as an importer sets it up: start mostly 0 (sometimes far from it, where the
+/// time's resolution is coarse), a tolerance, sometimes a stop time.
+pub fn plausible_experiment(rng: &mut Rng) -> Experiment {
     let start = match rng.below(20) {
         0..=15 => 0.0,
         16..=17 => rng.uniform(0.0, 100.0),
         18 => 1e6,
         _ => 1e9,
     };
-    Op::SetupExperiment {
-        tolerance_defined: c_int::from(rng.chance(0.5)),
+    Experiment {
+        tolerance_defined: rng.chance(0.5),
         tolerance: rng.log_uniform(1e-8, 1e-4),
         start,
-        stop_defined: c_int::from(rng.chance(0.3)),
+        stop_defined: rng.chance(0.3),
         stop: start + rng.uniform(0.05, 1.0),
     }
 }

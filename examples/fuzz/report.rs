@@ -2,11 +2,10 @@
 //! with the parent so that it survives a crash; the parent's tallies of them.
 
 use crate::callbacks::LogSink;
-use crate::fmi2::{Library, Status};
+use crate::fmu_states::Status;
 use std::borrow::Cow;
 use std::collections::HashSet;
 use std::fmt;
-use std::os::raw::c_int;
 use std::ptr::null_mut;
 use std::time::Duration;
 
@@ -61,6 +60,8 @@ pub struct TraceEntry {
 pub struct Report {
     /// Print every call to stderr as it happens (replay).
     pub echo: bool,
+    /// The sequence running is an FMI 3.0 one (status names).
+    pub fmi3: bool,
     /// Index in the batch of the sequence running (or failed).
     pub running: u64,
     /// The child finished its batch (or ran out of time) normally.
@@ -109,11 +110,11 @@ impl Report {
 
     /// Records the status of the call that returned.
     pub fn end(&mut self, status: Option<Status>) {
-        let echo = self.echo;
+        let (echo, fmi3) = (self.echo, self.fmi3);
         let entry = self.entry(self.traced);
-        entry.outcome = status.map_or(NO_STATUS, |s| i64::from(s as c_int));
+        entry.outcome = status.map_or(NO_STATUS, i64::from);
         if echo {
-            eprintln!("     -> {}", outcome(entry.outcome));
+            eprintln!("     -> {}", outcome(entry.outcome, fmi3));
         }
     }
 
@@ -146,31 +147,42 @@ impl Report {
 
     /// Prints a failure: the seed, how the child ended, the violation, the last calls, the
     /// replay command.
-    pub fn print_failure(&self, library: &Library, seed: u64, ending: &str) {
-        eprintln!("fuzz: FAILURE in {}, sequence seed {seed}: {ending}", library.model.identifier);
+    pub fn print_failure(&self, subject: &dyn Subject, seed: u64, ending: &str) {
+        eprintln!("fuzz: FAILURE in {} (FMI {}), sequence seed {seed}: {ending}", subject.identifier(), subject.fmi());
         if !self.violation.text().is_empty() {
             eprintln!("fuzz:   {}", self.violation.text());
         }
         eprintln!("fuzz:   last calls of the sequence:");
         for (n, entry) in self.tail() {
-            eprintln!("fuzz:     #{n} {} -> {}", entry.line.text(), outcome(entry.outcome));
+            eprintln!("fuzz:     #{n} {} -> {}", entry.line.text(), outcome(entry.outcome, self.fmi3));
         }
-        eprintln!("fuzz:   replay: bash scripts/fuzz --lib {} --seed {seed} --replay", library.path.display());
+        eprintln!("fuzz:   replay: bash scripts/fuzz --lib {} --seed {seed} --replay", subject.path().display());
     }
 }
 
-/// A call's outcome for people.
-pub fn outcome(outcome: i64) -> String {
+/// A call's outcome for people, with FMI 2.0's or (`fmi3`) FMI 3.0's status names.
+pub fn outcome(outcome: i64, fmi3: bool) -> String {
+    let v = if fmi3 { 3 } else { 2 };
     match outcome {
         NO_RETURN => "no return: the crash or hang is in this call".into(),
         NO_STATUS => "returned".into(),
-        0 => "fmi2OK".into(),
-        1 => "fmi2Warning".into(),
-        2 => "fmi2Discard".into(),
-        3 => "fmi2Error".into(),
-        4 => "fmi2Fatal".into(),
-        s => format!("{s}, not an fmi2Status"),
+        0 => format!("fmi{v}OK"),
+        1 => format!("fmi{v}Warning"),
+        2 => format!("fmi{v}Discard"),
+        3 => format!("fmi{v}Error"),
+        4 => format!("fmi{v}Fatal"),
+        s => format!("{s}, not an fmi{v}Status"),
     }
+}
+
+/// What is fuzzed: one library through one FMI version.
+pub trait Subject {
+    fn identifier(&self) -> &str;
+    fn path(&self) -> &std::path::Path;
+    /// 2 or 3.
+    fn fmi(&self) -> u8;
+    /// Runs the sequence of `seed`, adding to `report`; `Err` is the oracle violation.
+    fn run_sequence(&self, seed: u64, report: &mut Report) -> Result<(), String>;
 }
 
 /// A `Report` in an anonymous shared mapping, inherited by the forked children.
@@ -251,6 +263,14 @@ pub struct Tally {
 }
 
 impl Tally {
+    /// Adds another library's tally with its elapsed time.
+    pub fn add_timed(&mut self, other: &Tally) {
+        self.counts.add(other.counts);
+        self.failures += other.failures;
+        self.kinds.extend(other.kinds.iter().cloned());
+        self.elapsed += other.elapsed;
+    }
+
     /// Adds another library's tally but its elapsed time.
     pub fn add(&mut self, other: Tally) {
         self.counts.add(other.counts);

@@ -64,10 +64,29 @@ impl Rng {
     }
 }
 
-/// The seed of sequence `k` of a model in a run with the given master seed.
-pub fn sequence_seed(master: u64, identifier: &str, k: u64) -> u64 {
+/// The seed of sequence `k` of a model through FMI version `fmi` (2 or 3) in a run with the given
+/// master seed. Its top bit is the version (set: FMI 3.0), so that a seed alone replays.
+pub fn sequence_seed(master: u64, identifier: &str, fmi: u8, k: u64) -> u64 {
     let name =
         identifier.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
-    let mut state = master ^ name.rotate_left(17) ^ k.wrapping_mul(0xd6e8_feb8_6659_fd93);
-    splitmix64(&mut state)
+    let version = if fmi == 3 { 0x9e37_79b9_7f4a_7c15 } else { 0 };
+    let mut state = master ^ name.rotate_left(17) ^ k.wrapping_mul(0xd6e8_feb8_6659_fd93) ^ version;
+    let seed = splitmix64(&mut state) & !FMI3_BIT;
+    if fmi == 3 {
+        seed | FMI3_BIT
+    } else {
+        seed
+    }
+}
+
+/// The bit of a sequence seed that marks an FMI 3.0 sequence.
+const FMI3_BIT: u64 = 1 << 63;
+
+/// The FMI version (2 or 3) of a sequence seed.
+pub fn seed_version(seed: u64) -> u8 {
+    if seed & FMI3_BIT != 0 {
+        3
+    } else {
+        2
+    }
 }

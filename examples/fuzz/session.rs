@@ -18,10 +18,9 @@
 
 use crate::callbacks::LOG;
 use crate::fmi2::{
-    CallbackFunctions, Component, EventInfo, Fmi2, FmuState, Library, Status, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK,
-    WARNING,
+    CallbackFunctions, Component, EventInfo, Fmi2, Library, Status, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK, WARNING,
 };
-use crate::fmu_states::FmuStates;
+use crate::fmu_states::{FmuStates, StateCall, StateOutput};
 use crate::model_description::Description;
 use crate::ops::{Arr, Instantiation, Op, Slot, Text};
 use crate::report::Report;
@@ -49,9 +48,7 @@ enum Output {
     Instance(Component),
     Reals(Vec<f64>),
     Strings(Vec<*const c_char>),
-    State(FmuState),
-    Size(usize),
-    Bytes(Vec<u8>),
+    Stateful(StateOutput),
     Real(f64),
 }
 
@@ -104,7 +101,10 @@ impl<'a> Session<'a> {
             Target::Null => (null_mut(), " on a NULL instance"),
             Target::Second => (self.second, " on the second instance"),
         };
-        self.report.begin(format_args!("fmi2{op:?}{on}"));
+        match &op {
+            Op::State(call) => self.report.begin(format_args!("{}{on}", call.describe(false))),
+            op => self.report.begin(format_args!("fmi2{op:?}{on}")),
+        }
         // SAFETY: every pointer passed is NULL or points to as many elements as announced,
         // alive for the call (see `invoke`); the instance is one of the session's or NULL.
         let (status, output) = unsafe { self.invoke(c, &op) };
@@ -119,7 +119,7 @@ impl<'a> Session<'a> {
         match (target, output) {
             (Target::Main, output) => self.observe(op, status, ok, output),
             (Target::Null, _) if ok => Err("returned fmi2OK or fmi2Warning for a NULL instance".into()),
-            (Target::Second, Output::State(p)) if ok && !p.is_null() => {
+            (Target::Second, Output::Stateful(StateOutput::State(p))) if ok && !p.is_null() => {
                 self.states.foreign.push(p);
                 Ok(())
             }
@@ -172,22 +172,9 @@ impl<'a> Session<'a> {
                 let strings = values.map(Text::ptr);
                 status(f.fmi2SetString(c, vr.ptr(), same_len(vr, values), strings.ptr()))
             }
-            Op::GetFMUstate { state } => with_slot(*state, |p| f.fmi2GetFMUstate(c, p)),
-            Op::SetFMUstate { state } => status(f.fmi2SetFMUstate(c, *state)),
-            Op::FreeFMUstate { state } => with_slot(*state, |p| f.fmi2FreeFMUstate(c, p)),
-            Op::SerializedFMUstateSize { state, null_size } => {
-                let mut size = [0];
-                (Some(f.fmi2SerializedFMUstateSize(c, *state, out(&mut size, *null_size))), Output::Size(size[0]))
-            }
-            Op::SerializeFMUstate { state, size, null_buffer } => {
-                let mut bytes = vec![0u8; if *null_buffer { 0 } else { *size }];
-                let p = out(&mut bytes, *null_buffer);
-                (Some(f.fmi2SerializeFMUstate(c, *state, p.cast(), *size)), Output::Bytes(bytes))
-            }
-            Op::DeSerializeFMUstate { bytes, null_state } => {
-                let (data, mut state) = (&bytes.bytes, [null_mut()]);
-                let s = f.fmi2DeSerializeFMUstate(c, data.ptr().cast(), data.len(), out(&mut state, *null_state));
-                (Some(s), Output::State(state[0]))
+            Op::State(call) => {
+                let (s, output) = call.invoke(f, c);
+                (Some(s), Output::Stateful(output))
             }
             Op::GetDirectionalDerivative { unknowns: u, knowns: k, dv_known, null_dv_unknown } => {
                 let (n, mut dv) = (same_len(k, dv_known), vec![f64::NAN; u.len()]);
@@ -242,11 +229,11 @@ impl<'a> Session<'a> {
             }
             Op::SetTime { t } => status(f.fmi2SetTime(c, *t)),
             Op::SetContinuousStates { x } => status(f.fmi2SetContinuousStates(c, x.ptr(), x.len())),
-            Op::GetDerivatives { n, null } => reals(*n, *null, |p| f.fmi2GetDerivatives(c, p, *n)),
-            Op::GetEventIndicators { n, null } => reals(*n, *null, |p| f.fmi2GetEventIndicators(c, p, *n)),
-            Op::GetContinuousStates { n, null } => reals(*n, *null, |p| f.fmi2GetContinuousStates(c, p, *n)),
+            Op::GetDerivatives { n, null } => real_output(*n, *null, |p| f.fmi2GetDerivatives(c, p, *n)),
+            Op::GetEventIndicators { n, null } => real_output(*n, *null, |p| f.fmi2GetEventIndicators(c, p, *n)),
+            Op::GetContinuousStates { n, null } => real_output(*n, *null, |p| f.fmi2GetContinuousStates(c, p, *n)),
             Op::GetNominalsOfContinuousStates { n, null } => {
-                reals(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
+                real_output(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
             }
         }
     }
@@ -322,18 +309,7 @@ impl<'a> Session<'a> {
             (Op::GetString { .. }, Output::Strings(p)) if ok && p.iter().any(|s| s.is_null()) => {
                 return Err("fmi2GetString returned fmi2OK with a NULL string".into());
             }
-            (Op::GetFMUstate { state }, Output::State(p)) if ok => self.states.got(state, p, self.view)?,
-            (Op::SetFMUstate { state }, _) if ok => self.view = self.states.live_mut(state, "fmi2SetFMUstate")?.view,
-            (Op::FreeFMUstate { state: Slot::Holding(p) }, Output::State(after)) if ok => {
-                self.states.freed(p, after)?
-            }
-            (Op::SerializedFMUstateSize { state, .. }, Output::Size(n)) if ok => {
-                self.states.live_mut(state, "fmi2SerializedFMUstateSize")?.size = Some(n);
-            }
-            (Op::SerializeFMUstate { state, .. }, Output::Bytes(bytes)) if ok => {
-                self.states.serialized(state, bytes)?
-            }
-            (Op::DeSerializeFMUstate { bytes, .. }, Output::State(p)) if ok => self.states.deserialized(&bytes, p)?,
+            (Op::State(call), Output::Stateful(output)) if ok => self.states.observe(call, output, &mut self.view)?,
             (Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, .. }, Output::Real(t)) if ok => {
                 self.view.synchronised(t)?
             }
@@ -356,7 +332,7 @@ impl<'a> Session<'a> {
             Ok(())
         } else if self.second.is_null() {
             self.second = c;
-            self.call(Op::GetFMUstate { state: Slot::Holding(null_mut()) }, Target::Second)
+            self.call(Op::State(StateCall::Get { state: Slot::Holding(null_mut()) }), Target::Second)
         } else {
             self.call(Op::FreeInstance { instance: c }, Target::Main)
         }
@@ -382,10 +358,16 @@ impl<'a> Session<'a> {
 
 /// Calls `f` with a buffer of `n` NaNs (NULL for `null`): the status and what it holds after (a
 /// value the FMU does not write fails the finiteness check).
-unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
+pub unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Vec<f64>) {
     let mut v = vec![f64::NAN; n];
     let s = f(out(&mut v, null));
-    (Some(s), Output::Reals(if null { Vec::new() } else { v }))
+    (Some(s), if null { Vec::new() } else { v })
+}
+
+/// `reals` with its numbers as the call's output.
+unsafe fn real_output(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
+    let (s, v) = reals(n, null, f);
+    (s, Output::Reals(v))
 }
 
 /// An fmi2OK answer of a Model Exchange getter holds finite numbers only.
@@ -397,7 +379,7 @@ fn finite(values: &[f64], function: &str) -> Result<(), String> {
 }
 
 /// An output pointer to `buffer`, or NULL.
-fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
+pub fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
     if null {
         null_mut()
     } else {
@@ -409,15 +391,6 @@ fn out<T>(buffer: &mut [T], null: bool) -> *mut T {
 fn same_len<A, B>(a: &Arr<A>, b: &Arr<B>) -> usize {
     assert_eq!(a.len(), b.len(), "fuzzer bug: paired arrays of different lengths");
     a.len()
-}
-
-/// Calls `f` with the FMUstate* of a slot; the status and what the variable holds after.
-unsafe fn with_slot(slot: Slot, f: impl FnOnce(*mut FmuState) -> Status) -> (Option<Status>, Output) {
-    let (s, held) = match slot {
-        Slot::Null => (f(null_mut()), null_mut()),
-        Slot::Holding(mut p) => (f(&mut p), p),
-    };
-    (Some(s), Output::State(held))
 }
 
 /// Checks a string a function returned.

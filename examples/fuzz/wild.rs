@@ -7,15 +7,18 @@
 //! Exchange calls with NULL or wrongly sized arrays, special states and times.
 
 use crate::callbacks::Callbacks;
-use crate::fmi2::{FmuState, CO_SIMULATION, MODEL_EXCHANGE};
+use crate::fmi2::{CO_SIMULATION, MODEL_EXCHANGE};
+use crate::fmu_states::{FmuState, FmuStates, StateCall};
+use crate::view::View;
 use crate::model_description::{Description, Type, Variable, TYPES};
 use crate::ops::{Arr, Blob, Instantiation, Op, Slot, Text};
+use crate::planner::Experiment;
 use crate::rng::Rng;
 use crate::session::Session;
 use std::os::raw::c_int;
 use std::ptr::null_mut;
 
-const SPECIAL_REALS: [f64; 14] = [
+pub const SPECIAL_REALS: [f64; 14] = [
     f64::NAN,
     f64::INFINITY,
     f64::NEG_INFINITY,
@@ -31,11 +34,11 @@ const SPECIAL_REALS: [f64; 14] = [
     -1.0,
     1e300,
 ];
-const SPECIAL_INTEGERS: [c_int; 8] = [0, 1, -1, 2, c_int::MIN, c_int::MAX, 1000, -1000];
+pub const SPECIAL_INTEGERS: [c_int; 8] = [0, 1, -1, 2, c_int::MIN, c_int::MAX, 1000, -1000];
 const SPECIAL_BOOLEANS: [c_int; 6] = [0, 1, 2, -1, 255, c_int::MIN];
 const STATUS_KINDS: [c_int; 7] = [0, 1, 2, 3, 4, -1, 99];
 /// Valid instance names, some unusual.
-const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m", "%s%n%s", "a.b[1]"];
+pub const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m", "%s%n%s", "a.b[1]"];
 
 /// Any of the functions with any arguments (fmi2FreeInstance through a second instance).
 pub fn wild(rng: &mut Rng, s: &Session) -> Op {
@@ -59,12 +62,7 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
             let ty = *rng.pick(&TYPES);
             wild_set(rng, m, ty)
         }
-        17 => Op::GetFMUstate { state: any_slot(rng, s) },
-        18 => Op::SetFMUstate { state: any_state(rng, s) },
-        19 => Op::FreeFMUstate { state: any_slot(rng, s) },
-        20 => Op::SerializedFMUstateSize { state: any_state(rng, s), null_size: rng.chance(0.1) },
-        21 => wild_serialize(rng, s),
-        22 => Op::DeSerializeFMUstate { bytes: blob(rng, s), null_state: rng.chance(0.05) },
+        17..=22 => Op::State(wild_state_call(rng, &s.states)),
         23 => {
             let (unknowns, knowns) = (vrs(rng, m, real), vrs(rng, m, real));
             let dv_known = array(rng, knowns.len(), |r| wild_real(r, None));
@@ -81,7 +79,10 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
             let orders = array(rng, vr.len(), |r| *r.pick(&[1, 0, 2, -1]));
             Op::GetRealOutputDerivatives { vr, orders, null_values: rng.chance(0.1) }
         }
-        26 => wild_step(rng, s),
+        26 => {
+            let (t, h) = wild_step(rng, &s.view, s.budget());
+            Op::DoStep { t, h, no_set_prior: *rng.pick(&[0, 1, 2]) }
+        }
         27 => Op::CancelStep,
         28 => Op::GetStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
         29 => Op::GetRealStatus { kind: *rng.pick(&STATUS_KINDS), null_value: rng.chance(0.1) },
@@ -112,7 +113,7 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
 }
 
 /// A count announced for an array of `n`: mostly `n`, else 0, one off, or far off.
-fn wild_count(rng: &mut Rng, n: usize) -> usize {
+pub fn wild_count(rng: &mut Rng, n: usize) -> usize {
     match rng.below(10) {
         0..=5 => n,
         6 => 0,
@@ -148,7 +149,7 @@ pub fn instantiation(rng: &mut Rng, m: &Description) -> Instantiation {
 }
 
 /// A GUID that is not this model's.
-fn bad_guid(rng: &mut Rng, guid: &str) -> Text {
+pub fn bad_guid(rng: &mut Rng, guid: &str) -> Text {
     match rng.below(5) {
         0 => Text::Null,
         1 => Text::new(""),
@@ -176,7 +177,7 @@ pub fn wild_real(rng: &mut Rng, var: Option<&Variable>) -> f64 {
     }
 }
 
-fn wild_integer(rng: &mut Rng, var: Option<&Variable>) -> c_int {
+pub fn wild_integer(rng: &mut Rng, var: Option<&Variable>) -> c_int {
     match (rng.below(4), var) {
         (0..=1, _) => *rng.pick(&SPECIAL_INTEGERS),
         (2, Some(v)) => v.edge(rng) as c_int,
@@ -194,7 +195,7 @@ pub fn wild_boolean(rng: &mut Rng) -> c_int {
 }
 
 /// Any string: NULL, empty, a log category, not UTF-8, printf directives, very long.
-fn wild_text(rng: &mut Rng, m: &Description) -> Text {
+pub fn wild_text(rng: &mut Rng, m: &Description) -> Text {
     match rng.below(8) {
         0 => Text::Null,
         1 => Text::new(""),
@@ -208,7 +209,7 @@ fn wild_text(rng: &mut Rng, m: &Description) -> Text {
 }
 
 /// Items, or NULL announcing as many now and then.
-fn maybe_null<T>(rng: &mut Rng, items: Vec<T>) -> Arr<T> {
+pub fn maybe_null<T>(rng: &mut Rng, items: Vec<T>) -> Arr<T> {
     if rng.chance(0.05) {
         Arr::Null(items.len())
     } else {
@@ -217,14 +218,14 @@ fn maybe_null<T>(rng: &mut Rng, items: Vec<T>) -> Arr<T> {
 }
 
 /// `n` generated elements, or NULL for them now and then.
-fn array<T>(rng: &mut Rng, n: usize, mut item: impl FnMut(&mut Rng) -> T) -> Arr<T> {
+pub fn array<T>(rng: &mut Rng, n: usize, mut item: impl FnMut(&mut Rng) -> T) -> Arr<T> {
     let items = (0..n).map(|_| item(rng)).collect();
     maybe_null(rng, items)
 }
 
 /// A value reference for a function on type `ty`: mostly of that type, else of another type,
 /// one past the largest, or any number.
-fn any_vr(rng: &mut Rng, m: &Description, ty: Type) -> u32 {
+pub fn any_vr(rng: &mut Rng, m: &Description, ty: Type) -> u32 {
     let any = rng.next() as u32;
     match rng.below(10) {
         0..=5 if !m.of_type(ty).is_empty() => *rng.pick(m.of_type(ty)),
@@ -235,7 +236,7 @@ fn any_vr(rng: &mut Rng, m: &Description, ty: Type) -> u32 {
 }
 
 /// Value references for a function on type `ty`: none, a few, many, or all of the type.
-fn vrs(rng: &mut Rng, m: &Description, ty: Type) -> Arr<u32> {
+pub fn vrs(rng: &mut Rng, m: &Description, ty: Type) -> Arr<u32> {
     let list = match rng.below(20) {
         0 => Vec::new(),
         1..=2 if !m.of_type(ty).is_empty() => m.of_type(ty).to_vec(),
@@ -246,7 +247,7 @@ fn vrs(rng: &mut Rng, m: &Description, ty: Type) -> Arr<u32> {
 }
 
 /// The variables behind value references (`None` for unknown ones and NULL arrays).
-fn variables_of<'m>(m: &'m Description, vr: &Arr<u32>) -> Vec<Option<&'m Variable>> {
+pub fn variables_of<'m>(m: &'m Description, vr: &Arr<u32>) -> Vec<Option<&'m Variable>> {
     match vr {
         Arr::Items(v) => v.iter().map(|&r| m.variable(r)).collect(),
         Arr::Null(n) => vec![None; *n],
@@ -273,19 +274,26 @@ fn wild_set(rng: &mut Rng, m: &Description, ty: Type) -> Op {
 
 /// fmi2SetupExperiment with any tolerance, start and stop.
 fn wild_setup(rng: &mut Rng) -> Op {
+    let e = wild_experiment(rng);
+    let (tolerance_defined, stop_defined) = (wild_boolean(rng), wild_boolean(rng));
+    Op::SetupExperiment { tolerance_defined, tolerance: e.tolerance, start: e.start, stop_defined, stop: e.stop }
+}
+
+/// An experiment with any tolerance, start and stop.
+pub fn wild_experiment(rng: &mut Rng) -> Experiment {
     let start = *rng.pick(&[0.0, 0.0, 1.0, -1.0, 1e9, f64::NAN, f64::INFINITY, -1e300, f64::MAX, 5e-324]);
-    Op::SetupExperiment {
-        tolerance_defined: wild_boolean(rng),
+    Experiment {
+        tolerance_defined: rng.chance(0.5),
         tolerance: *rng.pick(&[1e-6, 1e-20, 0.0, -1e-6, f64::NAN, f64::INFINITY, 1e-300, 0.5, 1e-12, 1e-2]),
         start,
-        stop_defined: wild_boolean(rng),
+        stop_defined: rng.chance(0.5),
         stop: start + *rng.pick(&[0.1, 0.0, -1.0, f64::NAN, f64::INFINITY, f64::MAX, 1e-12, 1e3]),
     }
 }
 
-/// fmi2DoStep with any communication point and step size, bounded by the time budget.
-fn wild_step(rng: &mut Rng, s: &Session) -> Op {
-    let time = s.view.time;
+/// A communication point and step size for a doStep: any, bounded by the time budget.
+pub fn wild_step(rng: &mut Rng, view: &View, budget: f64) -> (f64, f64) {
+    let time = view.time;
     let tolerance = 1e-9 * time.abs().max(1.0);
     let t = match rng.below(10) {
         0..=5 => time,
@@ -303,12 +311,11 @@ fn wild_step(rng: &mut Rng, s: &Session) -> Op {
         8 => *rng.pick(&[1e3, 1e300, f64::MAX]),
         _ => wild_real(rng, None),
     };
-    let (t, h) = s.view.bounded_step(t, h, s.budget());
-    Op::DoStep { t, h, no_set_prior: *rng.pick(&[0, 1, 2]) }
+    view.bounded_step(t, h, budget)
 }
 
 /// fmi2SetDebugLogging categories: mostly the model's own, sometimes anything.
-fn categories(rng: &mut Rng, m: &Description) -> Arr<Text> {
+pub fn categories(rng: &mut Rng, m: &Description) -> Arr<Text> {
     let n = rng.below(4);
     array(rng, n, |r| match r.choose(&m.categories) {
         Some(c) if r.chance(0.7) => Text::new(c),
@@ -316,43 +323,55 @@ fn categories(rng: &mut Rng, m: &Description) -> Arr<Text> {
     })
 }
 
-/// An fmi2FMUstate argument: mostly a live state, sometimes a freed one, one of the second
+/// Any FMU state call: any state, slot, size and bytes.
+pub fn wild_state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
+    match rng.below(6) {
+        0 => StateCall::Get { state: any_slot(rng, states) },
+        1 => StateCall::Set { state: any_state(rng, states) },
+        2 => StateCall::Free { state: any_slot(rng, states) },
+        3 => StateCall::Size { state: any_state(rng, states), null_size: rng.chance(0.1) },
+        4 => wild_serialize(rng, states),
+        _ => StateCall::Deserialize { bytes: blob(rng, states), null_state: rng.chance(0.05) },
+    }
+}
+
+/// An FMUstate argument: mostly a live state, sometimes a freed one, one of the second
 /// instance, or NULL.
-fn any_state(rng: &mut Rng, s: &Session) -> FmuState {
+fn any_state(rng: &mut Rng, states: &FmuStates) -> FmuState {
     match rng.below(10) {
-        0..=5 if !s.states.live.is_empty() => rng.pick(&s.states.live).ptr,
-        0..=7 if !s.states.stale.is_empty() => *rng.pick(&s.states.stale),
-        0..=8 if !s.states.foreign.is_empty() => *rng.pick(&s.states.foreign),
+        0..=5 if !states.live.is_empty() => rng.pick(&states.live).ptr,
+        0..=7 if !states.stale.is_empty() => *rng.pick(&states.stale),
+        0..=8 if !states.foreign.is_empty() => *rng.pick(&states.foreign),
         _ => null_mut(),
     }
 }
 
-/// An fmi2FMUstate* argument: NULL, a variable holding NULL (a new state), or any state.
-fn any_slot(rng: &mut Rng, s: &Session) -> Slot {
+/// An FMUstate* argument: NULL, a variable holding NULL (a new state), or any state.
+fn any_slot(rng: &mut Rng, states: &FmuStates) -> Slot {
     match rng.below(10) {
         0 => Slot::Null,
         1..=4 => Slot::Holding(null_mut()),
-        _ => Slot::Holding(any_state(rng, s)),
+        _ => Slot::Holding(any_state(rng, states)),
     }
 }
 
-/// fmi2SerializeFMUstate with the right size, one off, or any.
-fn wild_serialize(rng: &mut Rng, s: &Session) -> Op {
-    let state = any_state(rng, s);
-    let known = s.states.live.iter().find(|l| l.ptr == state).and_then(|l| l.size);
+/// A serialize call with the right size, one off, or any.
+fn wild_serialize(rng: &mut Rng, states: &FmuStates) -> StateCall {
+    let state = any_state(rng, states);
+    let known = states.live.iter().find(|l| l.ptr == state).and_then(|l| l.size);
     let size = match (rng.below(6), known) {
         (0..=2, Some(n)) => n,
         (3, Some(n)) => n + 1,
         (4, Some(n)) => n.saturating_sub(1),
         _ => *rng.pick(&[0, 1, 64, 100_000]),
     };
-    Op::SerializeFMUstate { state, size, null_buffer: rng.chance(0.1) }
+    StateCall::Serialize { state, size, null_buffer: rng.chance(0.1) }
 }
 
-/// Bytes for fmi2DeSerializeFMUstate: a state this instance serialized, intact, damaged, or
-/// edited with the CRC recomputed; or garbage.
-pub fn blob(rng: &mut Rng, s: &Session) -> Blob {
-    let Some(saved) = rng.choose(&s.states.saved) else { return garbage(rng) };
+/// Bytes for deserialization: a state this instance serialized, intact, damaged, or edited with
+/// the CRC recomputed; or garbage.
+pub fn blob(rng: &mut Rng, states: &FmuStates) -> Blob {
+    let Some(saved) = rng.choose(&states.saved) else { return garbage(rng) };
     let mut bytes = saved.bytes.clone();
     let len = bytes.len();
     let (how, damaged) = match rng.below(20) {

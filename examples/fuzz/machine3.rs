@@ -1,0 +1,109 @@
+//! What the FMI 3.0 standard forbids, written from its text (not from the FMU's table): the
+//! state machines of Co-Simulation (section 4.2.4) and Model Exchange (3.2.4), the variables
+//! fmi3Set* may set in each state (2.3.3 and the `initial`/`causality`/`variability` rules of
+//! 2.4.7), and the calls whose arguments cannot be right (unknown value references, a variable
+//! of another type, nValues other than the number of scalars, NULL with elements announced).
+//! A call forbidden here must return fmi3Error. Where the text leaves room, nothing is claimed.
+
+use crate::model_description::{Description, Type};
+use crate::ops::Arr;
+use crate::ops3::Op3;
+use crate::view::Phase;
+
+/// Why the call must fail, if it must: `phase` is the instance's (certain), `me` its interface.
+pub fn forbidden(op: &Op3, phase: Phase, me: bool, m: &Description) -> Option<String> {
+    use Phase::*;
+    let phase_name = match phase {
+        StepComplete | StepFailed => "Step Mode",
+        Instantiated => "Instantiated",
+        Initialization => "Initialization Mode",
+        EventMode => "Event Mode",
+        ContinuousTime => "Continuous-Time Mode",
+        Terminated => "Terminated",
+        Unknown | Broken => return None,
+    };
+    let step = matches!(phase, StepComplete | StepFailed);
+    let state = |allowed: bool| (!allowed).then(|| format!("not allowed in {phase_name}"));
+    let me_only = |allowed: bool| if me { state(allowed) } else { Some("a Model Exchange function on a Co-Simulation instance".into()) };
+    let cs_only = |allowed: bool| if me { Some("a Co-Simulation function on a Model Exchange instance".into()) } else { state(allowed) };
+    let values = || argument_error(op, m).or_else(|| setter_error(op, phase, m));
+    match op {
+        Op3::EnterInitializationMode(_) => state(phase == Instantiated),
+        Op3::ExitInitializationMode => state(phase == Initialization),
+        // Co-Simulation enters Event Mode only with eventModeUsed, which no valid instance has.
+        Op3::EnterEventMode if !me => Some("fmi3EnterEventMode without eventModeUsed".into()),
+        Op3::EnterEventMode => state(!matches!(phase, Instantiated | Initialization | Terminated)),
+        Op3::Terminate => state(matches!(phase, EventMode | ContinuousTime) || step),
+        Op3::GetFloat64 { .. } | Op3::GetInt32 { .. } | Op3::GetBoolean { .. } | Op3::GetString { .. } => {
+            state(phase != Instantiated).or_else(values)
+        }
+        Op3::SetFloat64 { .. } | Op3::SetInt32 { .. } | Op3::SetBoolean { .. } | Op3::SetString { .. } => {
+            state(phase != Terminated).or_else(values)
+        }
+        Op3::OtherType { ty, vr, .. } => {
+            let known = vr.len() > 0 && *ty < 8;
+            known.then(|| format!("no variable is a {}", crate::ops3::OTHER_TYPES[*ty]))
+        }
+        Op3::Refused { .. } => Some("not provided by this FMU (modelDescription.xml)".into()),
+        Op3::Derivative { adjoint: true, .. } if !m.adjoint => Some("providesAdjointDerivatives=\"false\"".into()),
+        Op3::Derivative { .. } => state(phase != Instantiated),
+        Op3::EnterStepMode => cs_only(false),
+        Op3::DoStep { .. } => cs_only(step),
+        Op3::UpdateDiscreteStates { .. } | Op3::EnterContinuousTimeMode => me_only(phase == EventMode),
+        Op3::CompletedIntegratorStep { .. } => me_only(phase == ContinuousTime),
+        Op3::SetTime { .. } | Op3::SetContinuousStates { .. } => {
+            me_only(!matches!(phase, Instantiated | Initialization | Terminated))
+        }
+        Op3::GetContinuousStateDerivatives { .. }
+        | Op3::GetEventIndicators { .. }
+        | Op3::GetContinuousStates { .. }
+        | Op3::GetNominalsOfContinuousStates { .. } => me_only(phase != Instantiated),
+        _ => None,
+    }
+}
+
+/// Get and set arguments that cannot be right in any state.
+fn argument_error(op: &Op3, m: &Description) -> Option<String> {
+    let (vr, n_values, ty) = match op {
+        Op3::GetFloat64 { vr, n_values, .. } => (vr, *n_values, Type::Real),
+        Op3::GetInt32 { vr, n_values, .. } => (vr, *n_values, Type::Integer),
+        Op3::GetBoolean { vr, n_values, .. } => (vr, *n_values, Type::Boolean),
+        Op3::GetString { vr, n_values, .. } => (vr, *n_values, Type::String),
+        Op3::SetFloat64 { vr, values } => (vr, values.len(), Type::Real),
+        Op3::SetInt32 { vr, values } => (vr, values.len(), Type::Integer),
+        Op3::SetBoolean { vr, values } => (vr, values.len(), Type::Boolean),
+        Op3::SetString { vr, values } => (vr, values.len(), Type::String),
+        _ => return None,
+    };
+    if n_values != vr.len() {
+        return Some(format!("nValues = {n_values} for {} scalar variables", vr.len()));
+    }
+    let Arr::Items(refs) = vr else {
+        return (vr.len() > 0).then(|| "valueReferences is NULL".into());
+    };
+    refs.iter().find_map(|&r| match m.variable(r) {
+        None => Some(format!("vr {r} is no variable")),
+        Some(v) if v.ty != ty => Some(format!("{} is of another type", v.name)),
+        _ => None,
+    })
+}
+
+/// Variables fmi3Set* may not set in `phase`: the independent variable, calculated values and
+/// constants always; after initialisation fixed parameters; in Continuous-Time Mode all but
+/// continuous inputs.
+fn setter_error(op: &Op3, phase: Phase, m: &Description) -> Option<String> {
+    let vr = match op {
+        Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. } => vr,
+        _ => return None,
+    };
+    let Arr::Items(refs) = vr else { return None };
+    let initialised = !matches!(phase, Phase::Instantiated | Phase::Initialization);
+    refs.iter().filter_map(|&r| m.variable(r)).find_map(|v| {
+        let calculated = v.initial.as_deref().map_or(matches!(v.causality.as_str(), "output" | "local" | "calculatedParameter"), |i| i == "calculated");
+        let never = v.causality == "independent" || v.variability == "constant" || calculated;
+        let fixed = initialised && v.causality == "parameter" && v.variability != "tunable";
+        let continuous_input = v.causality == "input" && v.variability == "continuous";
+        let not_now = phase == Phase::ContinuousTime && !continuous_input;
+        (never || fixed || not_now).then(|| format!("{} cannot be set in this state", v.name))
+    })
+}

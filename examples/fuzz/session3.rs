@@ -1,0 +1,482 @@
+//! One FMI 3.0 sequence's instance: makes each call through the C ABI, checks the oracle on what
+//! it returned and keeps track of the instance's state. The oracle (a violation fails the sequence):
+//! - every function returns a valid fmi3Status (0..=4), and never fmi3OK or fmi3Warning for a
+//!   NULL instance;
+//! - a call that `machine3` says the standard forbids in the instance's state (or whose
+//!   arguments cannot be right) returns fmi3Error;
+//! - every fmi3Error and fmi3Discard of an instance with a logger comes with a logMessage call of
+//!   that status during the call (discards only while logStatusDiscard or logAll is on), and so
+//!   does an instantiation that returns NULL;
+//! - an instantiation with the model description's token and valid arguments returns an
+//!   instance, one with a wrong token NULL; fmi3InstantiateScheduledExecution returns NULL;
+//! - after fmi3OK or fmi3Warning: Float64 outputs of every function finite (nominals positive,
+//!   too), fmi3Boolean outputs 0 or 1, strings non-NULL, the numbers of continuous states and
+//!   event indicators those of the XML; fmi3DoStep without early return or event handling and
+//!   with lastSuccessfulTime = currentCommunicationPoint + communicationStepSize (Discard: in
+//!   [currentCommunicationPoint, + communicationStepSize]);
+//! - fmi3GetVersion is "3.0"; the logger gets the instanceEnvironment given at instantiation, a
+//!   valid status and non-NULL strings (checked in `callbacks`);
+//! - the FMU state checks of `fmu_states`.
+//!
+//! Crashes and hangs are caught by `batch`, leaks by `sequence`.
+
+use crate::callbacks::{environment, log_message, LOG};
+use crate::fmi3::{Fmi3, Instance, Library, Status};
+use crate::fmu_states::{FmuStates, StateCall, StateOutput};
+use crate::machine3::forbidden;
+use crate::model_description::Description;
+use crate::ops::{Arr, Slot, Text};
+use crate::ops3::{Instantiation3, Interface3, Op3};
+use crate::report::Report;
+use crate::session::{out, Target};
+use crate::view::{Phase, View};
+use std::ffi::CStr;
+use std::os::raw::c_char;
+use std::ptr::{null, null_mut};
+
+const OK: Status = 0;
+const WARNING: Status = 1;
+const DISCARD: Status = 2;
+const ERROR: Status = 3;
+
+/// Simulated seconds per sequence at most (as for FMI 2.0).
+const SIMULATION_BUDGET: f64 = 0.5;
+
+/// What a call wrote.
+enum Output {
+    Nothing,
+    Text(*const c_char),
+    Instance(Instance),
+    Reals(Vec<f64>),
+    /// fmi3Boolean outputs, as bytes.
+    Flags(Vec<u8>),
+    Strings(Vec<*const c_char>),
+    Stateful(StateOutput),
+    Count(usize),
+    /// fmi3DoStep: eventHandlingNeeded, terminateSimulation, earlyReturn; lastSuccessfulTime.
+    Step([u8; 3], f64),
+    /// fmi3UpdateDiscreteStates: its five flags and nextEventTime.
+    Event([u8; 5], f64),
+}
+
+/// One FMI 3.0 sequence's instance with the fuzzer's bookkeeping.
+pub struct Session3<'a> {
+    fmi: &'a Fmi3,
+    pub model: &'a Description,
+    report: &'a mut Report,
+    pub c: Instance,
+    /// The `Target::Second` instance, or NULL.
+    pub second: Instance,
+    opened: bool,
+    /// The main instance is a Model Exchange one.
+    pub me: bool,
+    /// The continuous states fmi3GetContinuousStates last returned.
+    pub x: Vec<f64>,
+    pub view: View,
+    pub states: FmuStates,
+    simulated: f64,
+    /// The main instance has a logMessage; discards are delivered (logStatusDiscard, logAll).
+    logger: bool,
+    discards_logged: bool,
+    all_logged: bool,
+}
+
+impl<'a> Session3<'a> {
+    pub fn new(library: &'a Library, report: &'a mut Report) -> Self {
+        Session3 {
+            fmi: &library.fmi,
+            model: &library.model,
+            report,
+            c: null_mut(),
+            second: null_mut(),
+            opened: false,
+            me: false,
+            x: Vec::new(),
+            view: View::fresh(),
+            states: FmuStates { fmi3: true, ..FmuStates::default() },
+            simulated: 0.0,
+            logger: false,
+            discards_logged: true,
+            all_logged: false,
+        }
+    }
+
+    /// Simulated seconds left for the sequence.
+    pub fn budget(&self) -> f64 {
+        SIMULATION_BUDGET - self.simulated
+    }
+
+    /// Makes one call and checks the oracle.
+    pub fn call(&mut self, op: Op3, target: Target) -> Result<(), String> {
+        let (c, on) = match target {
+            Target::Main => (self.c, ""),
+            Target::Null => (null_mut(), " on a NULL instance"),
+            Target::Second => (self.second, " on the second instance"),
+        };
+        self.report.begin(format_args!("{}{on}", op.describe()));
+        let before = LOG.with(|sink| (sink.borrow().errors, sink.borrow().discards));
+        // SAFETY: every pointer passed is NULL or points to as many elements as announced,
+        // alive for the call; the instance is one of the session's or NULL.
+        let (status, output) = unsafe { self.invoke(c, &op) };
+        self.report.end(status);
+        if let Some(s) = status.filter(|&s| s > 4) {
+            return Err(format!("returned {s}, which is not an fmi3Status (0..=4)"));
+        }
+        let (errors, discards) = LOG.with(|sink| {
+            let sink = sink.borrow();
+            (sink.errors - before.0, sink.discards - before.1)
+        });
+        if let Some(violation) = LOG.with(|sink| sink.borrow_mut().violation.take()) {
+            return Err(violation);
+        }
+        let ok = matches!(status, Some(OK | WARNING));
+        if target == Target::Null {
+            return if ok { Err("returned fmi3OK or fmi3Warning for a NULL instance".into()) } else { Ok(()) };
+        }
+        if target == Target::Main && !c.is_null() && op.takes_instance() {
+            self.check_status(&op, status, (errors, discards))?;
+        }
+        match (target, output) {
+            (Target::Main, output) => self.observe(op, status, ok, output, errors),
+            (Target::Second, Output::Stateful(StateOutput::State(p))) if ok && !p.is_null() => {
+                self.states.foreign.push(p);
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The state machine's and the logger's part of the oracle on a call to the main instance.
+    fn check_status(&self, op: &Op3, status: Option<Status>, (errors, discards): (u64, u64)) -> Result<(), String> {
+        if let (Some(why), Some(s)) = (forbidden(op, self.view.phase, self.me, self.model), status) {
+            if s != ERROR {
+                let call = op.describe();
+                let function = call.split([' ', '(']).next().unwrap_or_default();
+                return Err(format!("{function} returned {}, but the call must fail: {why}", name(s)));
+            }
+        }
+        match status {
+            Some(ERROR | 4) if self.logger && errors == 0 => Err("returned fmi3Error without a log message".into()),
+            Some(DISCARD) if self.logger && (self.discards_logged || self.all_logged) && discards == 0 => {
+                Err("returned fmi3Discard without a log message".into())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Passes the arguments of `op` through the C ABI; output buffers are temporaries of the call.
+    unsafe fn invoke(&mut self, c: Instance, op: &Op3) -> (Option<Status>, Output) {
+        let f = self.fmi;
+        let status = |s| (Some(s), Output::Nothing);
+        match op {
+            Op3::GetVersion => (None, Output::Text(f.fmi3GetVersion())),
+            Op3::SetDebugLogging { logging_on, categories } => {
+                let names = categories.map(Text::ptr);
+                status(f.fmi3SetDebugLogging(c, *logging_on, names.len(), names.ptr()))
+            }
+            Op3::Instantiate(spec) => (None, Output::Instance(self.instantiate(spec))),
+            Op3::FreeInstance { instance } => {
+                f.fmi3FreeInstance(*instance);
+                (None, Output::Nothing)
+            }
+            Op3::EnterInitializationMode(e) => status(f.fmi3EnterInitializationMode(
+                c,
+                e.tolerance_defined,
+                e.tolerance,
+                e.start,
+                e.stop_defined,
+                e.stop,
+            )),
+            Op3::ExitInitializationMode => status(f.fmi3ExitInitializationMode(c)),
+            Op3::EnterEventMode => status(f.fmi3EnterEventMode(c)),
+            Op3::Terminate => status(f.fmi3Terminate(c)),
+            Op3::Reset => status(f.fmi3Reset(c)),
+            Op3::GetFloat64 { vr, n_values, null_values } => {
+                reals(*n_values, *null_values, |p| f.fmi3GetFloat64(c, vr.ptr(), vr.len(), p, *n_values))
+            }
+            Op3::GetInt32 { vr, n_values, null_values } => {
+                let mut v = vec![0; *n_values];
+                status(f.fmi3GetInt32(c, vr.ptr(), vr.len(), out(&mut v, *null_values), *n_values))
+            }
+            Op3::GetBoolean { vr, n_values, null_values } => {
+                let mut v = vec![0u8; *n_values];
+                let s = f.fmi3GetBoolean(c, vr.ptr(), vr.len(), out(&mut v, *null_values).cast(), *n_values);
+                (Some(s), Output::Flags(if *null_values { Vec::new() } else { v }))
+            }
+            Op3::GetString { vr, n_values, null_values } => {
+                let mut v = vec![null(); *n_values];
+                let s = f.fmi3GetString(c, vr.ptr(), vr.len(), out(&mut v, *null_values), *n_values);
+                (Some(s), Output::Strings(if *null_values { Vec::new() } else { v }))
+            }
+            Op3::SetFloat64 { vr, values } => status(f.fmi3SetFloat64(c, vr.ptr(), vr.len(), values.ptr(), values.len())),
+            Op3::SetInt32 { vr, values } => status(f.fmi3SetInt32(c, vr.ptr(), vr.len(), values.ptr(), values.len())),
+            Op3::SetBoolean { vr, values } => {
+                status(f.fmi3SetBoolean(c, vr.ptr(), vr.len(), values.ptr().cast(), values.len()))
+            }
+            Op3::SetString { vr, values } => {
+                let strings = values.map(Text::ptr);
+                status(f.fmi3SetString(c, vr.ptr(), vr.len(), strings.ptr(), strings.len()))
+            }
+            Op3::OtherType { ty, set, vr } => status(crate::refused::other_type(f, c, *ty, *set, vr)),
+            Op3::Refused { function } => status(crate::refused::call(f, c, *function)),
+            Op3::State(call) => {
+                let (s, output) = call.invoke(f, c);
+                (Some(s), Output::Stateful(output))
+            }
+            Op3::Derivative { adjoint, unknowns: u, knowns: k, seed, n_sensitivity, null_sensitivity } => {
+                let (n, (seeds, n_seed)) = (*n_sensitivity, (seed.ptr(), seed.len()));
+                reals(n, *null_sensitivity, |p| match adjoint {
+                    true => f.fmi3GetAdjointDerivative(c, u.ptr(), u.len(), k.ptr(), k.len(), seeds, n_seed, p, n),
+                    false => f.fmi3GetDirectionalDerivative(c, u.ptr(), u.len(), k.ptr(), k.len(), seeds, n_seed, p, n),
+                })
+            }
+            Op3::EnterStepMode => status(f.fmi3EnterStepMode(c)),
+            Op3::DoStep { t, h, no_set_prior, null_outputs } => {
+                let (mut flags, mut last) = ([0u8; 3], f64::NAN);
+                let [a, b, e] = flags.each_mut().map(|p| if *null_outputs { null_mut() } else { p as *mut u8 });
+                let s = f.fmi3DoStep(c, *t, *h, *no_set_prior, a.cast(), b.cast(), e.cast(), &mut last);
+                (Some(s), Output::Step(flags, last))
+            }
+            Op3::UpdateDiscreteStates { null_flags } => {
+                let (mut flags, mut next) = ([0u8; 5], 0.0);
+                let p = flags.each_mut().map(|p| if *null_flags { null_mut() } else { p as *mut u8 });
+                let s = f.fmi3UpdateDiscreteStates(c, p[0].cast(), p[1].cast(), p[2].cast(), p[3].cast(), p[4].cast(), &mut next);
+                (Some(s), if *null_flags { Output::Nothing } else { Output::Event(flags, next) })
+            }
+            Op3::EnterContinuousTimeMode => status(f.fmi3EnterContinuousTimeMode(c)),
+            Op3::CompletedIntegratorStep { no_set_prior, null_flags } => {
+                let mut flags = [0u8; 2];
+                let [a, b] = flags.each_mut().map(|p| if *null_flags { null_mut() } else { p as *mut u8 });
+                let s = f.fmi3CompletedIntegratorStep(c, *no_set_prior, a.cast(), b.cast());
+                (Some(s), Output::Flags(if *null_flags { Vec::new() } else { flags.to_vec() }))
+            }
+            Op3::SetTime { t } => status(f.fmi3SetTime(c, *t)),
+            Op3::SetContinuousStates { x } => status(f.fmi3SetContinuousStates(c, x.ptr(), x.len())),
+            Op3::GetContinuousStateDerivatives { n, null } => {
+                reals(*n, *null, |p| f.fmi3GetContinuousStateDerivatives(c, p, *n))
+            }
+            Op3::GetEventIndicators { n, null } => reals(*n, *null, |p| f.fmi3GetEventIndicators(c, p, *n)),
+            Op3::GetContinuousStates { n, null } => reals(*n, *null, |p| f.fmi3GetContinuousStates(c, p, *n)),
+            Op3::GetNominalsOfContinuousStates { n, null } => {
+                reals(*n, *null, |p| f.fmi3GetNominalsOfContinuousStates(c, p, *n))
+            }
+            Op3::GetNumberOfContinuousStates { null } => count(*null, |p| f.fmi3GetNumberOfContinuousStates(c, p)),
+            Op3::GetNumberOfEventIndicators { null } => count(*null, |p| f.fmi3GetNumberOfEventIndicators(c, p)),
+        }
+    }
+
+    /// fmi3InstantiateCoSimulation, fmi3InstantiateModelExchange or
+    /// fmi3InstantiateScheduledExecution.
+    unsafe fn instantiate(&mut self, s: &Instantiation3) -> Instance {
+        let f = self.fmi;
+        let log = if s.logger { Some(log_message as unsafe extern "C" fn(_, _, _, _)) } else { None };
+        let (name, token, resources) = (s.name.ptr(), s.token.ptr(), s.resources.ptr());
+        let env = environment();
+        match s.interface {
+            Interface3::CoSimulation => {
+                let r = &s.required_intermediate;
+                let (event, early) = (s.event_mode_used, s.early_return_allowed);
+                let (visible, on) = (s.visible, s.logging_on);
+                f.fmi3InstantiateCoSimulation(name, token, resources, visible, on, event, early, r.ptr(), r.len(), env, log, None)
+            }
+            Interface3::ModelExchange => f.fmi3InstantiateModelExchange(name, token, resources, s.visible, s.logging_on, env, log),
+            Interface3::ScheduledExecution => {
+                f.fmi3InstantiateScheduledExecution(name, token, resources, s.visible, s.logging_on, env, log, None, None, None)
+            }
+        }
+    }
+
+    /// The oracle on what a call to the main instance returned, and the bookkeeping of its state.
+    fn observe(&mut self, op: Op3, status: Option<Status>, ok: bool, output: Output, errors: u64) -> Result<(), String> {
+        let phase = self.view.phase;
+        match (op, output) {
+            (Op3::GetVersion, Output::Text(p)) => expect_version(p)?,
+            (Op3::Instantiate(spec), Output::Instance(c)) => self.instantiated(&spec, c, errors)?,
+            (Op3::FreeInstance { instance }, _) if instance == self.c => {
+                self.c = null_mut();
+                self.states.live.clear();
+                self.states.stale.clear();
+            }
+            (Op3::FreeInstance { instance }, _) if instance == self.second => {
+                self.second = null_mut();
+                self.states.foreign.clear();
+            }
+            (Op3::DoStep { t, h, .. }, Output::Step(flags, last)) => self.stepped(t, h, status, flags, last)?,
+            (Op3::ExitInitializationMode, _) if status == Some(ERROR) && phase == Phase::Initialization => {
+                self.view.phase = Phase::Broken
+            }
+            (_, _) if !ok => {}
+            (Op3::SetDebugLogging { logging_on, categories }, _) => self.debug_logging(logging_on, &categories),
+            (Op3::EnterInitializationMode(e), _) => {
+                let v = &mut self.view;
+                (v.time, v.stop, v.set_up, v.phase) =
+                    (e.start, e.stop_defined.then_some(e.stop), true, Phase::Initialization);
+            }
+            (Op3::ExitInitializationMode, _) => {
+                self.view.phase = if self.me { Phase::EventMode } else { Phase::StepComplete }
+            }
+            (Op3::EnterEventMode, _) => self.view.phase = Phase::EventMode,
+            (Op3::EnterContinuousTimeMode, _) => self.view.phase = Phase::ContinuousTime,
+            (Op3::Terminate, _) => self.view.phase = Phase::Terminated,
+            (Op3::Reset, _) => self.view = View::fresh(),
+            (Op3::SetTime { t }, _) => self.view.time = t,
+            (Op3::State(call), Output::Stateful(output)) => self.states.observe(call, output, &mut self.view)?,
+            (Op3::GetFloat64 { vr, .. }, Output::Reals(v)) => finite_values(self.model, &vr, &v)?,
+            (Op3::GetContinuousStates { .. }, Output::Reals(v)) => {
+                finite(&v, "fmi3GetContinuousStates")?;
+                self.x = v;
+            }
+            (Op3::GetNominalsOfContinuousStates { .. }, Output::Reals(v)) => {
+                if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+                    return Err(format!("fmi3GetNominalsOfContinuousStates returned fmi3OK with a nominal {x}"));
+                }
+            }
+            (op, Output::Reals(v)) => finite(&v, &op.describe())?,
+            (op, Output::Flags(v)) if v.iter().any(|&b| b > 1) => {
+                return Err(format!("{} returned an fmi3Boolean {v:?}, not false (0) or true (1)", op.describe()));
+            }
+            (_, Output::Event(flags, next)) if flags.iter().any(|&b| b > 1) || (flags[4] == 1 && !next.is_finite()) => {
+                return Err(format!("fmi3UpdateDiscreteStates returned the flags {flags:?} and nextEventTime = {next}"));
+            }
+            (_, Output::Strings(p)) if p.iter().any(|s| s.is_null()) => {
+                return Err("fmi3GetString returned fmi3OK with a NULL string".into());
+            }
+            (Op3::GetNumberOfContinuousStates { null: false }, Output::Count(n)) => {
+                expect_count(n, self.model.states, "fmi3GetNumberOfContinuousStates", "ContinuousStateDerivative")?
+            }
+            (Op3::GetNumberOfEventIndicators { null: false }, Output::Count(n)) => {
+                expect_count(n, self.model.event_indicators, "fmi3GetNumberOfEventIndicators", "EventIndicator")?
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The main instance (checked against its arguments); else the second one, with an FMU state
+    /// of it; else one to free right away.
+    fn instantiated(&mut self, spec: &Instantiation3, c: Instance, errors: u64) -> Result<(), String> {
+        let function = format!("fmi3Instantiate{:?}", spec.interface);
+        let valid = crate::wild3::valid_instantiation(spec, self.model);
+        if c.is_null() && spec.logger && errors == 0 {
+            return Err(format!("{function} returned NULL without a log message"));
+        }
+        match (valid, c.is_null()) {
+            (Some(true), true) => return Err(format!("{function} returned NULL for valid arguments")),
+            (Some(false), false) => return Err(format!("{function} returned an instance for arguments it must refuse")),
+            _ => {}
+        }
+        if !self.opened {
+            self.opened = true;
+            self.c = c;
+            self.me = spec.interface == Interface3::ModelExchange;
+            (self.logger, self.all_logged) = (spec.logger, spec.logging_on);
+            Ok(())
+        } else if c.is_null() {
+            Ok(())
+        } else if self.second.is_null() {
+            self.second = c;
+            self.call(Op3::State(StateCall::Get { state: Slot::Holding(null_mut()) }), Target::Second)
+        } else {
+            self.call(Op3::FreeInstance { instance: c }, Target::Main)
+        }
+    }
+
+    /// fmi3SetDebugLogging succeeded: which of the categories that deliver discards are on.
+    fn debug_logging(&mut self, on: bool, categories: &Arr<Text>) {
+        let names: Vec<&[u8]> = match categories {
+            Arr::Items(v) => v.iter().map(|t| match t {
+                Text::Bytes(s) => s.to_bytes(),
+                Text::Null => b"",
+            }).collect(),
+            Arr::Null(_) => Vec::new(),
+        };
+        if names.is_empty() {
+            (self.discards_logged, self.all_logged) = (on, on);
+        }
+        for name in names {
+            match name {
+                b"logStatusDiscard" => self.discards_logged = on,
+                b"logAll" => self.all_logged = on,
+                _ => {}
+            }
+        }
+    }
+
+    /// fmi3DoStep(t, h) returned `status` with these outputs: the oracle and the view.
+    fn stepped(&mut self, t: f64, h: f64, status: Option<Status>, [event, _, early]: [u8; 3], last: f64) -> Result<(), String> {
+        let end = t + h;
+        let near = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y.abs().max(1.0);
+        match status {
+            Some(OK | WARNING) if event != 0 || early != 0 => {
+                return Err(format!("fmi3DoStep returned eventHandlingNeeded = {event}, earlyReturn = {early}; the FMU has no event mode and never returns early"));
+            }
+            Some(OK | WARNING) if !near(last, end) => {
+                return Err(format!("fmi3DoStep returned fmi3OK with lastSuccessfulTime = {last}, not t + h = {end}"));
+            }
+            Some(DISCARD) if !(last >= t - 1e-9 * t.abs().max(1.0) && last <= end + 1e-9 * end.abs().max(1.0)) => {
+                return Err(format!("fmi3DoStep returned fmi3Discard with lastSuccessfulTime = {last}, outside [{t}, {end}]"));
+            }
+            _ => {}
+        }
+        self.simulated += self.view.stepped(t, h, status);
+        if status == Some(DISCARD) {
+            self.view.time = last;
+        }
+        Ok(())
+    }
+}
+
+/// A status for people.
+fn name(s: Status) -> String {
+    crate::report::outcome(i64::from(s), true)
+}
+
+/// `session::reals` with its numbers as the call's output.
+unsafe fn reals(n: usize, null: bool, f: impl FnOnce(*mut f64) -> Status) -> (Option<Status>, Output) {
+    let (s, v) = crate::session::reals(n, null, f);
+    (s, Output::Reals(v))
+}
+
+/// Calls `f` with a size_t*, NULL for `null`.
+unsafe fn count(null: bool, f: impl FnOnce(*mut usize) -> Status) -> (Option<Status>, Output) {
+    let mut n = usize::MAX;
+    let s = f(if null { null_mut() } else { &mut n });
+    (Some(s), Output::Count(n))
+}
+
+/// An fmi3OK answer holds finite numbers only.
+fn finite(values: &[f64], function: &str) -> Result<(), String> {
+    match values.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(format!("{function} returned fmi3OK or fmi3Warning, but element {i} is {}", values[i])),
+        None => Ok(()),
+    }
+}
+
+/// fmi3GetFloat64 said fmi3OK or fmi3Warning: every value finite, named by its variable.
+fn finite_values(m: &Description, vr: &Arr<u32>, values: &[f64]) -> Result<(), String> {
+    let Some(i) = values.iter().position(|x| !x.is_finite()) else { return Ok(()) };
+    let name = match vr {
+        Arr::Items(v) if i < v.len() => m.variable(v[i]).map_or(format!("vr {}", v[i]), |var| format!("{} (vr {})", var.name, v[i])),
+        _ => format!("value {i}"),
+    };
+    Err(format!("fmi3GetFloat64 returned fmi3OK or fmi3Warning, but {name} = {}", values[i]))
+}
+
+fn expect_count(n: usize, expected: usize, function: &str, element: &str) -> Result<(), String> {
+    if n == expected {
+        return Ok(());
+    }
+    Err(format!("{function} returned {n}, but the model description has {expected} {element} elements"))
+}
+
+fn expect_version(p: *const c_char) -> Result<(), String> {
+    if p.is_null() {
+        return Err("fmi3GetVersion returned NULL".into());
+    }
+    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string.
+    let text = unsafe { CStr::from_ptr(p) };
+    if text.to_bytes() != b"3.0" {
+        return Err(format!("fmi3GetVersion returned {text:?}, not \"3.0\""));
+    }
+    Ok(())
+}
