@@ -44,6 +44,21 @@ pub fn xc_crit_exact(op: &OperatingPoint, lin: &Linearised) -> f64 {
     critical_stroke(op, required_ratio(op, lin))
 }
 
+/// Where along the stroke `[0, s_c]` a critical stroke `x` (stable below it) leaves the system
+/// stable, as the report says it: "123.4 mm", or that no stroke in the range is critical.
+pub fn describe_critical_stroke(op: &OperatingPoint, x: f64) -> String {
+    let range = format!("[0, {:.1}] mm", op.stroke / crate::units::MM);
+    if x.is_nan() {
+        "undefined".into()
+    } else if x <= 0.0 {
+        format!("none: unstable at every stroke in {range} (the root of eq. 2.84 is {:.1} mm)", x / crate::units::MM)
+    } else if x >= op.stroke {
+        format!("none: stable at every stroke in {range} (the root of eq. 2.84 is {:.1} mm)", x / crate::units::MM)
+    } else {
+        format!("{:.1} mm", x / crate::units::MM)
+    }
+}
+
 /// Simplified critical stroke `s_c / (1 + mu_p)` (m), eq. 2.87 (no line or dead volumes).
 pub fn xc_crit_simplified(op: &OperatingPoint) -> f64 {
     op.stroke / (1.0 + op.mu_p)
@@ -99,5 +114,25 @@ mod tests {
             }
         }
         assert!(checked > 300, "{checked}");
+    }
+
+    /// With enough extra rod-side capacitance (C1_extra = 0.13 cm^3/bar, the case) the
+    /// root of eq. 2.84 is a negative stroke: the report says that no stroke is stable, and the
+    /// closed-loop poles of eq. 2.82 agree at every stroke.
+    #[test]
+    fn a_root_outside_the_stroke_is_reported_as_such() {
+        let base = OperatingPoint { c1_extra: 0.13e-6 / crate::units::BAR, ..OperatingPoint::default() };
+        let lin = base.linearise().unwrap();
+        let x = xc_crit_exact(&base, &lin);
+        assert!(x < 0.0, "{x}");
+        assert!(describe_critical_stroke(&base, x).starts_with("none: unstable at every stroke"));
+        // Every stroke short of the full one (there C2 = 0: the piston side has no volume).
+        for i in 0..20 {
+            let op = OperatingPoint { x_c: base.stroke * i as f64 / 20.0, ..base };
+            let lin = op.linearise().unwrap();
+            assert!(!closed_loop(lin.c2, &HParams::new(&op, &lin).h()).is_stable(), "x = {}", op.x_c);
+        }
+        assert!(describe_critical_stroke(&base, 2.0 * base.stroke).starts_with("none: stable at every stroke"));
+        assert_eq!(describe_critical_stroke(&base, 0.1234), "123.4 mm");
     }
 }

@@ -122,7 +122,7 @@ pub fn text(a: &Analysis) -> String {
         "{}\nC1 = {:.4e} m^3/Pa, C2 = {:.4e} m^3/Pa, p3 = {:.2} bar, u_cbv = {:.4}\n\
          K_qu = {:.4e} m^3/s, K_qp = {:.4e} m^3/(s Pa)\n\
          H(s): kappa = {:.4e} m^4 s/kg, tau = {:.4e} s, omega_n = {:.2} rad/s, zeta = {:.4}\n\
-         uncompensated: {}; x_c,crit = {:.1} mm (exact, eq. 2.84), {:.1} mm (simplified, eq. 2.87)\n\
+         uncompensated: {}; x_c,crit = {} (exact, eq. 2.84), {} (simplified, eq. 2.87)\n\
          {:>4} {:>7} {:>11} {:>9} {:>9} {:>9} {:>8} {}\n",
         super::operating_point::describe(&a.op),
         a.lin.c1,
@@ -136,8 +136,8 @@ pub fn text(a: &Analysis) -> String {
         a.h.omega_n,
         a.h.zeta,
         if a.stable_uncompensated { "stable" } else { "unstable" },
-        a.xc_crit_exact / MM,
-        a.xc_crit_simplified / MM,
+        super::criterion::describe_critical_stroke(&a.op, a.xc_crit_exact),
+        super::criterion::describe_critical_stroke(&a.op, a.xc_crit_simplified),
         "n_K",
         "n_omega",
         "K_f",
