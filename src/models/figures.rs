@@ -3,17 +3,17 @@
 //! through the FMI layer (the same instance code an importer drives).
 
 use super::vr;
+use crate::bench::{InProcess, Slave};
 use crate::fmi2::{Value, Variable};
 use crate::fmu::chart::{chart, escape, Panel};
-use crate::fmu::instance::Instance;
-use crate::fmu::log::{num, Logger};
-use crate::fmu::state::Interface;
-use crate::fmu::variables::{BaseType, Kind};
-use crate::fmu::{Model, Version};
+use crate::fmu::log::num;
+use crate::fmu::variables::Kind;
+use crate::fmu::Model;
 use std::fmt::Write;
 
-/// A Co-Simulation run of `M` with the default experiment's start and step, to `stop`: `setup`
-/// set in Initialization Mode, `inputs(t, recorded values at t)` before each step; returns the
+/// A Co-Simulation run of `M` (in-process through the FMI layer, as `boomsim bench` runs it)
+/// with the default experiment's start, step and tolerance, to `stop`: `setup` set in
+/// Initialization Mode, `inputs(t, recorded values at t)` before each step; returns the
 /// communication times and, per `record`ed variable, its values (SI).
 pub(crate) fn run<M: Model>(
     stop: f64,
@@ -22,33 +22,25 @@ pub(crate) fn run<M: Model>(
     record: &[u32],
 ) -> Result<(Vec<f64>, Vec<Vec<f64>>), String> {
     let i = &M::INFO;
-    let log = Logger::new(None, "documentation", i.log_categories, false);
-    let mut inst = Instance::<M>::new(log, crate::fmu::guid::guid::<M>(), Version::Fmi2, Interface::CoSimulation);
-    inst.setup_experiment(None, i.start_time, Some(stop))?;
-    inst.enter_initialization_mode();
-    for (r, v) in setup {
-        inst.set(&[*r], vec![v.clone()])?;
-    }
-    inst.exit_initialization_mode()?;
+    let mut slave = InProcess::<M>::new(i.default_tolerance, setup)?;
     let n = ((stop - i.start_time) / i.step_size).round() as usize;
     let (mut t, mut out) = (Vec::with_capacity(n + 1), vec![Vec::with_capacity(n + 1); record.len()]);
-    let mut row = vec![0.0; record.len()];
+    let read = |slave: &mut InProcess<M>| record.iter().map(|&r| slave.get(r)).collect::<Result<Vec<f64>, _>>();
     for k in 0..=n {
         let time = i.start_time + k as f64 * i.step_size;
-        let read = |v: &Value| if let Value::Real(x) = v { *x } else { f64::NAN };
-        inst.get(record, &mut row, BaseType::Real, read)?;
+        let mut row = read(&mut slave)?;
         let set = inputs(time, &row);
-        for (r, x) in &set {
-            inst.set(&[*r], vec![Value::Real(*x)])?;
+        for &(r, x) in &set {
+            slave.set(r, x)?;
         }
         if !set.is_empty() {
             // The values at t with the inputs of t.
-            inst.get(record, &mut row, BaseType::Real, read)?;
+            row = read(&mut slave)?;
         }
         t.push(time);
         out.iter_mut().zip(&row).for_each(|(o, x)| o.push(*x));
         if k < n {
-            inst.do_step(time, i.step_size)?;
+            slave.step(time, i.step_size)?;
         }
     }
     Ok((t, out))
