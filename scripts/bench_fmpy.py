@@ -1,6 +1,7 @@
 """Cost of one setReal + doStep + getReal cycle of the PressureFeedbackController through fmpy
 (Python ctypes). A benchmark: it prints, it asserts nothing. Run after `boomsim pack`."""
 
+import argparse
 import math
 import pathlib
 import sys
@@ -14,7 +15,12 @@ sys.path.insert(0, str(ROOT / "scripts"))
 import cosim  # noqa: E402
 
 
-def main(n=20000):
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cycles", type=int, default=20000, help="cycles to time (default 20000)")
+    n = parser.parse_args(argv).cycles
+    if n < 1:
+        raise cosim.UsageError(f"--cycles {n}: must be at least 1")
     path = ROOT / "target" / "fmu" / "PressureFeedbackController.fmu"
     if not path.exists():
         raise cosim.UsageError(f"{path} is missing: run `cargo build --release && target/release/boomsim pack`")

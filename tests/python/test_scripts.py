@@ -63,3 +63,14 @@ def test_the_other_runners_refuse_an_unknown_scenario_in_one_line(args):
 def test_ssp_refuses_an_unknown_fmi_version_in_one_line():
     code, last = run("ssp.py", "--fmi", "4", "--no-run")
     assert code == 2 and "--fmi: invalid choice: 4 (choose from 2, 3)" in last, last
+
+
+@pytest.mark.parametrize("script,args,says", [
+    ("bench_fmpy.py", ["--bogus"], "unrecognized arguments: --bogus"),
+    ("bench_fmpy.py", ["--cycles", "0"], "--cycles 0: must be at least 1"),
+    ("instability.py", ["--bogus"], "unrecognized arguments: --bogus"),
+])
+def test_the_benchmark_and_study_scripts_refuse_bad_arguments_in_one_line(script, args, says):
+    """bench_fmpy.py took no arguments and ignored any it was given."""
+    code, last = run(script, *args)
+    assert code == 2 and says in last, last
