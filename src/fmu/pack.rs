@@ -157,12 +157,16 @@ pub fn documentation<M: Model>(version: Version, platforms: &[Platform]) -> Stri
     let i = &M::INFO;
     let rows: String = M::VARIABLES.iter().map(row).collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{id}</title><style>{STYLE}</style></head><body>\n<h1>{id} {version}</h1>\n<p>{desc}</p>\n<p>From the master's thesis <i>Stabilization of hydraulically actuated boom using pressure feedback</i> (University of Agder), exported by boomsim.</p>\n{facts}<h2>Model</h2>\n{doc}\n{figures}<h2>Variables</h2>\n<p>All values are SI; the display unit is given in brackets, and start values in it too.</p>\n<table>\n<tr><th>Name</th><th>VR</th><th>Causality</th><th>Variability</th><th>Type</th><th>Start</th><th>Unit</th><th>Range</th><th>Description</th></tr>\n{rows}</table>\n</body></html>\n",
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{id}</title><style>{STYLE}</style></head><body>\n<h1>{id} {version}</h1>\n<p>{desc}</p>\n<p>From the master's thesis <i>Stabilization of hydraulically actuated boom using pressure feedback</i> (University of Agder), exported by boomsim.</p>\n{facts}<h2>Model</h2>\n{note}{doc}\n{figures}<h2>Variables</h2>\n<p>All values are SI; the display unit is given in brackets, and start values in it too.</p>\n<table>\n<tr><th>Name</th><th>VR</th><th>Causality</th><th>Variability</th><th>Type</th><th>Start</th><th>Unit</th><th>Range</th><th>Description</th></tr>\n{rows}</table>\n</body></html>\n",
         id = i.identifier,
         version = i.version,
         desc = escape(i.description),
         facts = facts::<M>(version, platforms),
         doc = i.documentation,
         figures = M::figures(),
+        note = match version {
+            Version::Fmi2 => "",
+            Version::Fmi3 => "<p><i>The model text names FMI 2.0's functions: in FMI 3.0, fmi3DoStep and fmi3EnterInitializationMode (with the tolerance and stop time) take the roles of fmi2DoStep and fmi2SetupExperiment, and FMI 3.0 has no input derivatives: the inputs hold their value over a step.</i></p>\n",
+        },
     )
 }
