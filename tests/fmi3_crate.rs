@@ -85,8 +85,9 @@ fn plant_co_simulation_in_the_fmi_crate_equals_fmi2() {
     assert!(y3[2].is_finite() && y3[1] > 1e5, "the load is held or lowered: p4 = {} Pa", y3[1]);
 }
 
-/// Model Exchange in the fmi crate: the number of states, the states and their derivatives at
-/// moved states, equal (bitwise) through FMI 3.0 and FMI 2.0.
+/// Model Exchange in the fmi crate: the number of states and event indicators, the states, their
+/// derivatives and the event indicators at moved states, equal (bitwise) through FMI 3.0 and
+/// FMI 2.0.
 #[test]
 fn plant_model_exchange_in_the_fmi_crate_equals_fmi2() {
     use fmi::fmi2::instance::{Common as Common2, ModelExchange as Me2};
@@ -104,7 +105,9 @@ fn plant_model_exchange_in_the_fmi_crate_equals_fmi2() {
     m2.enter_continuous_time_mode().unwrap();
     let n = HydraulicBoom::STATES.len();
     assert_eq!(m3.get_number_of_continuous_states().unwrap(), n);
-    assert_eq!(m3.get_number_of_event_indicators().unwrap(), 0, "FMI 3.0 declares no event indicators");
+    // The same three event indicators, declared as variables in FMI 3.0 (ModelStructure).
+    let nz = HydraulicBoom::EVENT_INDICATORS.len();
+    assert_eq!(m3.get_number_of_event_indicators().unwrap(), nz);
     let (mut x3, mut x2) = (vec![0.0; n], vec![0.0; n]);
     m3.get_continuous_states(&mut x3).unwrap();
     m2.get_continuous_states(&mut x2).unwrap();
@@ -119,4 +122,9 @@ fn plant_model_exchange_in_the_fmi_crate_equals_fmi2() {
     m2.get_derivatives(&mut d2).unwrap();
     assert!(d3.iter().any(|d| *d != 0.0) && d3.iter().all(|d| d.is_finite()));
     assert_eq!(d3.iter().map(|d| d.to_bits()).collect::<Vec<_>>(), d2.iter().map(|d| d.to_bits()).collect::<Vec<_>>());
+    let (mut z3, mut z2) = (vec![f64::NAN; nz], vec![f64::NAN; nz]);
+    m3.get_event_indicators(&mut z3).unwrap();
+    m2.get_event_indicators(&mut z2).unwrap();
+    assert!(z3.iter().all(|z| z.is_finite()), "{z3:?}");
+    assert_eq!(z3.iter().map(|z| z.to_bits()).collect::<Vec<_>>(), z2.iter().map(|z| z.to_bits()).collect::<Vec<_>>());
 }
