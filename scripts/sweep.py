@@ -54,7 +54,9 @@ def load(path) -> dict:
             doc = tomllib.load(f)
     except (OSError, tomllib.TOMLDecodeError) as e:
         raise UsageError(f"{path}: {e}") from None
-    scenario = cosim.load_scenario(doc.get("scenario", ""))
+    if "scenario" not in doc:
+        raise UsageError(f"{path}: no scenario: give scenario = one of {', '.join(cosim.scenario_ids())}")
+    scenario = cosim.load_scenario(doc["scenario"])
     boom = doc.get("boom", "rigid")
     if boom not in ("rigid", "flexible"):
         raise UsageError(f"unknown boom \"{boom}\": rigid or flexible")
