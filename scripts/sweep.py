@@ -179,7 +179,10 @@ def client_for(args):
     from distributed import Client, LocalCluster
 
     if args.scheduler:
-        return Client(args.scheduler)
+        try:
+            return Client(args.scheduler, timeout=10)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise UsageError(f"cannot connect to the scheduler \"{args.scheduler}\": {e}") from None
     # the worker processes import this module and cosim by name
     os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(cosim.ROOT / "scripts"), os.environ.get("PYTHONPATH")]))
     n = args.workers or os.cpu_count()
@@ -201,12 +204,19 @@ def execute(sweep: dict, todo: list[dict], out: pathlib.Path, args):
     t0, done, failed, tty = time.monotonic(), 0, 0, sys.stderr.isatty()
     with client_for(args) as client:
         futures = client.map(run_point, [sweep] * len(todo), todo, pure=False)
-        for batch in as_completed(futures, with_results=True).batches():
-            rows = [r for _, r in batch]
-            write_rows(sweep, out, rows)
-            done += len(rows)
-            failed += sum(r["status"] != "ok" for r in rows)
-            progress(done, failed, len(todo), t0, tty)
+        try:
+            for batch in as_completed(futures, with_results=True).batches():
+                rows = [r for _, r in batch]
+                write_rows(sweep, out, rows)
+                done += len(rows)
+                failed += sum(r["status"] != "ok" for r in rows)
+                progress(done, failed, len(todo), t0, tty)
+        except (ModuleNotFoundError, RuntimeError) as e:
+            missing = e if isinstance(e, ModuleNotFoundError) else e.__cause__
+            if not isinstance(missing, ModuleNotFoundError):
+                raise
+            raise UsageError(f"the scheduler or a worker cannot import {missing.name}: start them from the "
+                             "checkout with PYTHONPATH=scripts") from None
 
 
 def main(argv=None):
