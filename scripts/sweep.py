@@ -151,16 +151,17 @@ def schema(sweep: dict):
 
 
 def write_rows(sweep: dict, out: pathlib.Path, rows: list[dict]):
-    """One Parquet file of finished rows under out/results/ (written to a temporary name, then
-    renamed, so a kill never leaves half a file)."""
+    """One Parquet file of finished rows under out/results/ (written to a hidden temporary name,
+    then renamed, so a kill never leaves half a file in the dataset)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     d = out / "results"
     d.mkdir(parents=True, exist_ok=True)
-    path = d / f"part-{time.time_ns()}-{os.getpid()}.parquet"
-    pq.write_table(pa.Table.from_pylist(rows, schema=schema(sweep)), str(path) + ".tmp")
-    os.replace(str(path) + ".tmp", path)
+    name = f"part-{time.time_ns()}-{os.getpid()}.parquet"
+    tmp = d / f".{name}"  # pyarrow.dataset skips names starting with "."
+    pq.write_table(pa.Table.from_pylist(rows, schema=schema(sweep)), tmp)
+    os.replace(tmp, d / name)
 
 
 def read_rows(sweep: dict, out: pathlib.Path) -> list[dict]:
