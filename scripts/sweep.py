@@ -228,6 +228,8 @@ def main(argv=None):
     ap.add_argument("--resume", action="store_true", help="run only the points DIR/results lacks")
     ap.add_argument("--out", default=None, help="output directory (default out/sweep/<file stem>)")
     args = ap.parse_args(argv)
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers} must be at least 1")
     sweep = load(args.file)
     out = pathlib.Path(args.out or cosim.ROOT / "out" / "sweep" / pathlib.Path(args.file).stem)
     if (out / "results").exists() and not args.resume:
