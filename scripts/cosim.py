@@ -317,14 +317,18 @@ def set_filter(ctrl_f: FmuFile, ctrl, cfg: dict):
 
 def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
         interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
-        tolerance: float | None = None, fmi: int = 2) -> Result:
+        tolerance: float | None = None, fmi: int = 2, params: dict | None = None) -> Result:
     """Co-simulate one scenario variant. `record_every` thins the recorded rows (default: one
     row per millisecond or per step, whichever is coarser); `fmi`: the FMUs' FMI version (3: no
-    input derivatives, so `interpolate` must be False)."""
+    input derivatives, so `interpolate` must be False); `params`: FMU parameters by variable name
+    (HydraulicBoom's or the controller's), set after the scenario's."""
     if fmi == 3 and interpolate:
         raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
+    params = params or {}
+    ctrl_params = {k: v for k, v in params.items() if k not in plant_f.vars}
+    scenario = {**scenario, "plant": {**scenario["plant"], **{k: v for k, v in params.items() if k in plant_f.vars}}}
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     step = scenario["step"] if step is None else step
     n = int(round(t_end / step))
@@ -353,6 +357,8 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
                 ctrl.setupExperiment(tolerance=tolerance, startTime=t0, stopTime=t_end)
                 ctrl.enterInitializationMode()
             set_filter(ctrl_f, ctrl, ctrl_cfg)
+            for name, value in ctrl_params.items():
+                ctrl_f.set(ctrl, name, value)
             ctrl_f.set(ctrl, "enable", feedback)
             ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, t0)])
             ctrl.exitInitializationMode()
@@ -415,6 +421,9 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
 
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
+    params = params or {}
+    ctrl_params = {k: v for k, v in params.items() if k not in plant_f.vars}
+    scenario = {**scenario, "plant": {**scenario["plant"], **{k: v for k, v in params.items() if k in plant_f.vars}}}
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     ctrl_cfg = scenario["controller"]
     fb_start = feedback_start or scenario["starts"][0]
