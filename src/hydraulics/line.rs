@@ -37,10 +37,11 @@ impl Fluid {
     /// `a = x0 * P_ATM`.
     ///
     /// Deviation from the thesis (constant `beta`): the air term models cavitation/air release
-    /// physically. At working pressures it is negligible (x0 = 0.1 %: -0.06 % at 45 bar, -1 % at
-    /// 10 bar, -25 % at 1 bar gauge); as `p_abs -> 0` the free air expands without bound and
-    /// `beta_e -> p_abs`, so `dp/dt -> 0` smoothly and a pressure never reaches absolute zero
-    /// (vapour pressure of the oil is neglected against it). With `x0 = 0` it is exactly `beta`.
+    /// physically. It softens the oil most at low pressure: by [`AIR_PRESSURES`]'s amounts,
+    /// which the README's model notes quote (checked by a test); as `p_abs -> 0` the free air
+    /// expands without bound and `beta_e -> p_abs`, so `dp/dt -> 0` smoothly and a pressure
+    /// never reaches absolute zero (vapour pressure of the oil is neglected against it). With
+    /// `x0 = 0` it is exactly `beta`.
     pub fn bulk_modulus<T: Scalar>(&self, p: T) -> T {
         let p_abs = max(p + P_ATM, P_ABS_FLOOR);
         let e = exp_small(-p / self.beta);
@@ -62,6 +63,9 @@ impl Fluid {
         (q_net - dv_dt) / (v / self.bulk_modulus(p) + c_wall)
     }
 }
+
+/// Gauge pressures (Pa) at which the README states how much the default air softens the oil.
+pub const AIR_PRESSURES: [f64; 4] = [45e5, 10e5, 1e5, 0.0];
 
 /// `exp(x)`, by its Taylor polynomial of degree 8 for `|x| <= 1/16` (truncation below
 /// `(1/16)^9 / 9! < 1e-16`, under half an ulp of the result, so the result is within an ulp or
@@ -143,6 +147,32 @@ mod tests {
         // Near absolute zero beta_e -> p_abs.
         let p_abs = 0.05;
         assert!((f.bulk_modulus(-P_ATM + p_abs) / p_abs - 1.0).abs() < 1e-3);
+    }
+
+    /// The README's model notes state the default air's effect at [`AIR_PRESSURES`]: each
+    /// number there is `1 - beta_e(p) / beta` of the law, rounded as printed (the sentence once
+    /// said 1 % at 10 bar, a tenth of what the law gives).
+    #[test]
+    fn the_readme_states_what_the_air_law_gives() {
+        let f = crate::hydraulics::circuit::Circuit::default().fluid;
+        let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+        let line = readme.lines().find(|l| l.contains("softens the oil by")).expect("the Cavitation note");
+        let stated: Vec<f64> = line
+            .split("softens the oil by ")
+            .nth(1)
+            .unwrap()
+            .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        // "a %, b %, c % and d % at 45, 10, 1 and 0 bar": the reductions, then the pressures.
+        assert_eq!(stated.len(), 2 * AIR_PRESSURES.len(), "{line}");
+        for (k, &p) in AIR_PRESSURES.iter().enumerate() {
+            let reduction = 100.0 * (1.0 - f.bulk_modulus(p) / f.beta);
+            let printed: f64 =
+                if reduction < 10.0 { format!("{reduction:.1}") } else { format!("{reduction:.0}") }.parse().unwrap();
+            assert_eq!(stated[k], printed, "at {} bar: the law gives {reduction} %", p / 1e5);
+            assert_eq!(stated[AIR_PRESSURES.len() + k], p / 1e5);
+        }
     }
 
     /// Oil mass conservation and the vacuum bound: integrate a volume driven by a prescribed

@@ -442,7 +442,7 @@ pub const PARAMS: &[Param] = &[
         "%",
         [1e-7, 0.2],
         "Free air per oil volume at atmospheric pressure (cavitation model)",
-        "not in the thesis: 0.1 %, lower end of typical entrained air"
+        "not in the thesis (constant bulk modulus): an assumed 0.1 %; README, model notes, Cavitation"
     ),
     param!(
         "line.v_l1",

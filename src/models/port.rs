@@ -202,8 +202,10 @@ mod tests {
     use crate::mechanics::rigid_boom::RigidBoom;
 
     /// Z_C's default against sqrt(k_oil m_eff) recomputed from the circuit and boom defaults at
-    /// the 480 mm start stroke (p3 ~ 70 bar, p4 ~ 0: the bulk modulus is that of the oil there,
-    /// the air term changes it by < 0.1 %). 5 %: the default is rounded.
+    /// the 480 mm start stroke, with the oil's bulk modulus (the thesis' constant beta, eq.
+    /// 2.70-2.71) in both chambers. The model's entrained air is not in it: at p3 ~ 70 bar it
+    /// changes the piston side little, but at p4 ~ 0 it takes most of the rod side's stiffness
+    /// (README, "Cavitation", whose numbers a test checks). 5 %: the default is rounded.
     #[test]
     fn default_impedance_matches_the_oil_column() {
         let c = Circuit::default();
