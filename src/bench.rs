@@ -5,12 +5,9 @@
 //! exported symbols call), through the C ABI by loading the built shared libraries with `dlopen`
 //! as an importer would.
 
-use crate::fmi2::instance::{Instance, Step};
-use crate::fmi2::log::Logger;
-use crate::fmi2::state::Interface;
 use crate::fmi2::types::*;
-use crate::fmi2::variables::BaseType;
 use crate::fmi2::{guid::guid, Model, Value};
+pub use crate::fmu::in_process::{InProcess, Slave};
 use crate::models::hydraulic_boom::vr as hb;
 use crate::models::pressure_feedback_controller::vr as pfc;
 use crate::models::{HydraulicBoom, PressureFeedbackController};
@@ -18,48 +15,6 @@ use std::ffi::{c_void, CStr, CString};
 use std::os::raw::c_int;
 use std::path::Path;
 use std::time::Instant;
-
-/// One co-simulation slave, however it is reached.
-pub trait Slave {
-    fn set(&mut self, vr: u32, x: f64) -> Result<(), String>;
-    fn get(&mut self, vr: u32) -> Result<f64, String>;
-    fn step(&mut self, t: f64, h: f64) -> Result<(), String>;
-}
-
-/// A slave called in-process through the generic FMI layer.
-pub struct InProcess<M: Model>(Instance<M>);
-
-impl<M: Model> InProcess<M> {
-    /// Instantiated, set up with `rtol`, initialised with the given Real and Boolean values.
-    pub fn new(rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
-        let log = Logger::new(None, "bench", &[], false);
-        let mut i = Instance::<M>::new(log, guid::<M>(), crate::fmu::Version::Fmi2, Interface::CoSimulation);
-        i.setup_experiment(Some(rtol), 0.0, None)?;
-        i.enter_initialization_mode();
-        for (r, x) in start {
-            i.set(&[*r], vec![x.clone()])?;
-        }
-        i.exit_initialization_mode()?;
-        Ok(InProcess(i))
-    }
-}
-
-impl<M: Model> Slave for InProcess<M> {
-    fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
-        self.0.set(&[vr], vec![Value::Real(x)])
-    }
-    fn get(&mut self, vr: u32) -> Result<f64, String> {
-        let mut x = [0.0];
-        self.0.get(&[vr], &mut x, BaseType::Real, |v| if let Value::Real(x) = v { *x } else { f64::NAN })?;
-        Ok(x[0])
-    }
-    fn step(&mut self, t: f64, h: f64) -> Result<(), String> {
-        match self.0.do_step(t, h)? {
-            Step::Done(_) => Ok(()),
-            Step::Discarded(why) => Err(why),
-        }
-    }
-}
 
 type Instantiate = unsafe extern "C" fn(
     fmi2String,

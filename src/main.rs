@@ -56,6 +56,10 @@ enum Cmd {
         /// How many of the lowest modes to print.
         #[arg(long, default_value_t = 6)]
         count: usize,
+        /// Rod-side pressure trapped at rest [bar, gauge] for the listed modes (default: tank
+        /// pressure); the `rig` entry always uses the thesis' 1 bar.
+        #[arg(long, allow_negative_numbers = true)]
+        p4: Option<f64>,
     },
     /// Write modelDescription/<ModelIdentifier>.xml (FMI 2.0) and
     /// modelDescription/fmi3/<ModelIdentifier>.xml (FMI 3.0) from the variable tables.
@@ -183,10 +187,17 @@ fn bench(json: bool, duration: f64) -> Result<(), String> {
     Ok(())
 }
 
-fn eigen(json: bool, count: usize) -> Result<(), String> {
-    use boomsim::analysis::modes::{hydraulic_boom_modes, Mode};
-    let (x0, flexible) = hydraulic_boom_modes(true)?;
-    let (_, rigid) = hydraulic_boom_modes(false)?;
+fn eigen(json: bool, count: usize, p4_bar: Option<f64>) -> Result<(), String> {
+    use boomsim::analysis::modes::{hydraulic_boom_modes, rig, Mode};
+    if let Some(p) = p4_bar {
+        if !(0.0..=100.0).contains(&p) {
+            return Err(format!("--p4 {p} bar is outside [0, 100] bar (start.p4's range)"));
+        }
+    }
+    let p4 = p4_bar.map(|p| p * 1e5);
+    let (x0, flexible) = hydraulic_boom_modes(true, p4)?;
+    let (_, rigid) = hydraulic_boom_modes(false, p4)?;
+    let rig = rig()?;
     let list = |m: &[Mode]| -> Vec<serde_json::Value> {
         m.iter()
             .take(count)
@@ -194,16 +205,47 @@ fn eigen(json: bool, count: usize) -> Result<(), String> {
             .collect()
     };
     if json {
-        let out = serde_json::json!({"stroke_mm": x0 * 1e3, "modes": list(&flexible), "rigid_modes": list(&rigid)});
+        let out = serde_json::json!({
+            "stroke_mm": x0 * 1e3,
+            "p4_bar": p4_bar.unwrap_or(0.0),
+            "modes": list(&flexible),
+            "rigid_modes": list(&rigid),
+            "rig": {
+                "conditions": rig.conditions,
+                "p4_bar": rig.p4 / 1e5,
+                "frequency_hz": rig.flexible.frequency_hz,
+                "damping_ratio": rig.flexible.damping_ratio,
+                "rigid_frequency_hz": rig.rigid.frequency_hz,
+                "measured_hz": rig.measured_hz,
+                "sensitivity": rig.sensitivity.iter().map(|(what, m)| serde_json::json!({
+                    "change": what, "frequency_hz": m.frequency_hz, "damping_ratio": m.damping_ratio,
+                })).collect::<Vec<_>>(),
+            },
+        });
         println!("{out}");
         return Ok(());
     }
-    println!("HydraulicBoom at rest, boom horizontal at stroke {:.1} mm, spool closed, no friction", x0 * 1e3);
+    println!(
+        "HydraulicBoom at rest, boom horizontal at stroke {:.1} mm, spool closed, rod side at {} bar, no friction",
+        x0 * 1e3,
+        p4_bar.unwrap_or(0.0)
+    );
     for (name, modes) in [("flexible (4 + 5)", &flexible), ("rigid", &rigid)] {
         println!("{name}:");
         for m in modes.iter().take(count) {
             println!("  {:10.3} Hz  zeta {:.4}", m.frequency_hz, m.damping_ratio);
         }
+    }
+    println!(
+        "rig (thesis 5.1.3: {}):\n  flexible {:.3} Hz, rigid {:.3} Hz; measured {} Hz ({:+.1} % flexible)",
+        rig.conditions,
+        rig.flexible.frequency_hz,
+        rig.rigid.frequency_hz,
+        rig.measured_hz,
+        100.0 * (rig.flexible.frequency_hz / rig.measured_hz - 1.0)
+    );
+    for (what, m) in &rig.sensitivity {
+        println!("  with {what}: flexible {:.3} Hz", m.frequency_hz);
     }
     Ok(())
 }
@@ -255,7 +297,7 @@ fn main() -> ExitCode {
         Cmd::Bench { json, duration, model_exchange } => {
             bench(json, duration).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
         }
-        Cmd::Eigen { json, count } => eigen(json, count),
+        Cmd::Eigen { json, count, p4 } => eigen(json, count, p4),
         Cmd::Xml { check } => xml(check),
         Cmd::Deflection { json } => deflection(json),
         Cmd::Analyze(args) => boomsim::analysis::cli::run(&args, root()),

@@ -56,12 +56,18 @@ pub fn modes(jacobian: DMatrix<f64>) -> Vec<Mode> {
 }
 
 /// The HydraulicBoom at rest with the boom horizontal (stroke where the rigid boom's theta2 = 0),
-/// full payload and the spool closed, linearised: (stroke [m], modes).
+/// full payload and the spool closed, the rod side at tank pressure or trapped at `p4` (Pa,
+/// gauge; p3 then carries the load on top of it), linearised: (stroke [m], modes).
 ///
 /// Friction is left out (`friction.c_p_bak` = `friction.p_static` = 0): Coulomb friction has no
 /// small-signal linearisation at rest; its tanh regularisation would act as a viscous damper of
 /// F/v_s ~ 5e6 N s/m and lock the cylinder. Its effect on an oscillation depends on the amplitude.
-pub fn hydraulic_boom_modes(flexible: bool) -> Result<(f64, Vec<Mode>), String> {
+pub fn hydraulic_boom_modes(flexible: bool, p4: Option<f64>) -> Result<(f64, Vec<Mode>), String> {
+    modes_with(flexible, p4, &[])
+}
+
+/// [`hydraulic_boom_modes`] with some Real parameters changed (name, value).
+fn modes_with(flexible: bool, p4: Option<f64>, changes: &[(&str, f64)]) -> Result<(f64, Vec<Mode>), String> {
     let mut values = Values::new(HydraulicBoom::VARIABLES);
     let mut set = |name: &str, v: Value| {
         let i = HydraulicBoom::VARIABLES.iter().position(|x| x.name == name).expect("variable name");
@@ -70,6 +76,9 @@ pub fn hydraulic_boom_modes(flexible: bool) -> Result<(f64, Vec<Mode>), String> 
     set("friction.c_p_bak", Value::Real(0.0));
     set("friction.p_static", Value::Real(0.0));
     set("boom.flexible", Value::Boolean(flexible));
+    for (name, x) in changes {
+        set(name, Value::Real(*x));
+    }
     let rigid = {
         let mut v = values.clone();
         v.put(v.position(vr::FLEXIBLE).expect("flexible switch"), Value::Boolean(false));
@@ -94,13 +103,82 @@ pub fn hydraulic_boom_modes(flexible: bool) -> Result<(f64, Vec<Mode>), String> 
     let x0 = 0.5 * (lo + hi);
     values.set_real(vr::X0, x0);
     let plant = Plant::from_values(&values)?;
-    let state = plant.equilibrium(x0)?;
+    let state = plant.equilibrium(x0, p4)?;
     Ok((x0, modes(jacobian(&plant, 0.0, &state, &plant.state_scale()))))
+}
+
+/// The lowest mode at the conditions of the rig's eigenfrequency measurement, thesis 5.1.3.
+pub struct Rig {
+    pub conditions: &'static str,
+    /// The trapped rod-side pressure (Pa, gauge).
+    pub p4: f64,
+    pub flexible: Mode,
+    pub rigid: Mode,
+    /// The measurement: 2.85 Hz (eq. 5.5 over the decaying p3 of Fig. 5.5).
+    pub measured_hz: f64,
+    /// What moves the flexible boom's frequency: (change, lowest mode with it).
+    pub sensitivity: Vec<(&'static str, Mode)>,
+}
+
+/// The rig's eigenfrequency measurement (thesis 5.1.3: the main boom horizontal, excited by
+/// hand, p3 logged) in the model: the boom horizontal, spool and CBV closed, full payload, and
+/// the rod side at 1 bar, the only rod-side pressure at rest the thesis gives (the initial p4 of
+/// its simulations, section 6.2); friction off, as for every small-signal mode here.
+pub fn rig() -> Result<Rig, String> {
+    const P4: f64 = 1e5;
+    let lowest = |flexible, p4, changes: &[(&str, f64)]| -> Result<Mode, String> {
+        let (_, modes) = modes_with(flexible, p4, changes)?;
+        modes.into_iter().next().ok_or_else(|| "no mode".to_string())
+    };
+    let variants: [(&'static str, Option<f64>, &[(&str, f64)]); 4] = [
+        ("rod side at tank pressure (0 bar)", None, &[]),
+        ("no entrained air (fluid.air_fraction at its minimum, 1e-7)", Some(P4), &[("fluid.air_fraction", 1e-7)]),
+        ("rigid hoses (line.c_hose = 0)", Some(P4), &[("line.c_hose", 0.0)]),
+        ("no air and rigid hoses", Some(P4), &[("fluid.air_fraction", 1e-7), ("line.c_hose", 0.0)]),
+    ];
+    let sensitivity =
+        variants.iter().map(|(what, p4, c)| Ok((*what, lowest(true, *p4, c)?))).collect::<Result<Vec<_>, String>>()?;
+    Ok(Rig {
+        sensitivity,
+        conditions: "boom horizontal, spool and CBV closed, full payload, rod side at 1 bar (thesis 6.2), no friction",
+        p4: P4,
+        flexible: lowest(true, Some(P4), &[])?,
+        rigid: lowest(false, Some(P4), &[])?,
+        measured_hz: 2.85,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rig's mode (thesis 5.1.3) as the README states it, and its physics: trapping the rod
+    /// side at 1 bar compresses its air (isothermal: the gas stiffness grows with p_abs^2), so
+    /// the mode lies above the 0 bar one and below the one without air; each softening removed
+    /// (air, hose compliance) raises it; the flexible arm is softer than the rigid boom.
+    #[test]
+    fn the_rig_mode_is_what_the_readme_says() {
+        let rig = rig().unwrap();
+        let f = |what: &str| rig.sensitivity.iter().find(|(w, _)| w.starts_with(what)).unwrap().1.frequency_hz;
+        let fl = rig.flexible.frequency_hz;
+        assert!(
+            f("rod side at tank") < fl && fl < f("no entrained air") && f("no entrained air") < f("no air and rigid")
+        );
+        assert!(fl < f("rigid hoses") && f("rigid hoses") < f("no air and rigid"));
+        assert!(fl < rig.rigid.frequency_hz);
+        let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+        let start = readme.find("- **Eigenfrequency**").expect("the README's Eigenfrequency note");
+        let note = &readme[start..start + readme[start..].find("\n- **").unwrap()];
+        let hz: Vec<f64> = note.split(" Hz").filter_map(|w| w.rsplit(' ').next()?.parse().ok()).collect();
+        let expected: Vec<f64> = [rig.measured_hz, fl, rig.rigid.frequency_hz]
+            .into_iter()
+            .chain(rig.sensitivity.iter().map(|s| s.1.frequency_hz))
+            .map(|x| (x * 100.0).round() / 100.0)
+            .collect();
+        assert_eq!(hz, expected, "{note}");
+        let off = format!("({:+.1} %)", 100.0 * (fl / rig.measured_hz - 1.0)).replace('+', "");
+        assert!(note.contains(&off), "{off} in {note}");
+    }
 
     /// Two unit masses on two unit springs (fixed-free chain) with stiffness-proportional damping,
     /// x'' = -K (x + c x'): the textbook modes w^2 = (3 -+ sqrt 5)/2 with zeta_i = c w_i / 2.

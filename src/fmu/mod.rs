@@ -8,6 +8,7 @@ pub mod abi;
 pub mod chart;
 pub mod fmu_state;
 pub mod guid;
+pub mod in_process;
 pub mod instance;
 pub mod log;
 pub mod model;

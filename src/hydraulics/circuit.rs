@@ -186,13 +186,18 @@ impl Circuit {
     /// side carries the load, `p3 = (f_load + p4 mu_c A) / A` (friction is zero at rest); the
     /// compensator, sensing tank in neutral, throttles the supply until it just feeds the P-port
     /// leakage, `Q1(p1) = Q_LP(p1)` (p1 slightly below `p_T + p_pcv + p_fc,pcv`).
-    pub fn equilibrium(&self, f_load: f64) -> Result<State, EquilibriumError> {
+    ///
+    /// `p4_trapped`: a rod side pre-charged above tank instead (the rig's runs started from
+    /// such pressures, thesis section 6.2 and chapter 8). The balance is the same; only the
+    /// rod side's leakage to tank is left, `dp4/dt = -dQ_L (p4 - p_T) / C4`, a drift of about a
+    /// minute's time constant.
+    pub fn equilibrium(&self, f_load: f64, p4_trapped: Option<f64>) -> Result<State, EquilibriumError> {
         let (p_s, p_t) = (self.supply.p_s, self.supply.p_t);
         let cyl = &self.cylinder;
         if f_load < 0.0 {
             return Err(EquilibriumError::TensileLoad);
         }
-        let p4 = p_t;
+        let p4 = p4_trapped.unwrap_or(p_t);
         let p3 = (f_load + p4 * cyl.area_b()) / cyl.area_a();
         if self.cbv.holding_opening(p3, p4, p_t) > 0.0 {
             // largest p3 with a closed valve, eq. 2.56 with u_cbv = 0
@@ -230,7 +235,7 @@ mod tests {
     fn equilibrium_is_stationary() {
         let c = Circuit::default();
         for f_load in [0.0, 10e3, 30e3, 60e3] {
-            let s = c.equilibrium(f_load).unwrap();
+            let s = c.equilibrium(f_load, None).unwrap();
             let e = c.evaluate(&s, 0.0, 0.25, 0.0);
             assert!((s[P3] - f_load / c.cylinder.area_a()).abs() < 1e-6);
             assert_eq!(e.dx[P2], 0.0);
@@ -246,9 +251,36 @@ mod tests {
         // p_set 210 bar on the piston holds 69.7 kN at most
         let max = c.cylinder.area_a() * bar(210.0);
         assert!(
-            matches!(c.equilibrium(max + 1.0), Err(EquilibriumError::CbvOpens { max_load }) if (max_load - max).abs() < 1e-6)
+            matches!(c.equilibrium(max + 1.0, None), Err(EquilibriumError::CbvOpens { max_load }) if (max_load - max).abs() < 1e-6)
         );
-        assert_eq!(c.equilibrium(-1.0), Err(EquilibriumError::TensileLoad));
+        assert_eq!(c.equilibrium(-1.0, None), Err(EquilibriumError::TensileLoad));
+    }
+
+    /// A rod side trapped at 10 bar: p3 carries the load on top of it (eq. 2.85,
+    /// p3 = p4 mu_c + F / A); everything is at rest except the rod side's leakage to tank,
+    /// dp4/dt = -dQ_L (p4 - p_T) / (V4 / beta_e(p4) + C_w4) (eq. 2.47 into the line's
+    /// continuity equation, V4 at its pressure), to 1e-12 relative.
+    #[test]
+    fn a_trapped_rod_side_only_leaks() {
+        let c = Circuit::default();
+        let (f_load, p4, x) = (30e3, bar(10.0), 0.25);
+        let s = c.equilibrium(f_load, Some(p4)).unwrap();
+        let cyl = &c.cylinder;
+        let mu_c = cyl.area_b() / cyl.area_a();
+        assert!((s[P3] - (p4 * mu_c + f_load / cyl.area_a())).abs() < 1e-9 * s[P3]);
+        assert_eq!(s[P4], p4);
+        let e = c.evaluate(&s, 0.0, x, 0.0);
+        assert_eq!((e.dx[P3], e.dx[X_V], e.dx[U_CBV]), (0.0, 0.0, 0.0));
+        assert_eq!(e.force, f_load);
+        let v4 = c.lines.v_l4 + cyl.volume_b(x);
+        let leak = c.dcv.dq_leak * (p4 - c.supply.p_t);
+        // The hose's volume at its pressure, V = V4 + C_w p (eq. 5.2), as Fluid::pressure_rate.
+        let c_w = c.lines.hose_compliance(c.lines.v_l4);
+        let expected = -leak / ((v4 + c_w * p4) / c.fluid.bulk_modulus(p4) + c_w);
+        assert!((e.dx[P4] / expected - 1.0).abs() < 1e-12, "{} vs {expected}", e.dx[P4]);
+        // The time constant of that drift: about a minute (README, "Pre-charged starts").
+        let tau = -(p4 - c.supply.p_t) / e.dx[P4];
+        assert!((20.0..200.0).contains(&tau), "{tau} s");
     }
 
     /// Steady motion of the whole circuit for a constant load `f_load` and spool reference
@@ -372,7 +404,7 @@ mod tests {
     #[test]
     fn suction_and_robustness() {
         let c = Circuit::default();
-        let mut s = c.equilibrium(0.0).unwrap();
+        let mut s = c.equilibrium(0.0, None).unwrap();
         let (x, v) = (0.25, 0.5);
         let v3 = c.lines.v_l3 + c.cylinder.volume_a(x);
         for p_abs in [1e3, 10.0, 1.0, 0.1] {

@@ -3,7 +3,7 @@
 //! through the FMI layer (the same instance code an importer drives).
 
 use super::vr;
-use crate::bench::{InProcess, Slave};
+use crate::fmu::in_process::{InProcess, Slave};
 use crate::fmi2::{Value, Variable};
 use crate::fmu::chart::{chart, escape, Panel};
 use crate::fmu::log::num;

@@ -13,7 +13,7 @@ use super::circuit::CIRCUIT_SCALE;
 use super::port::Ramp;
 use super::states::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
 use super::table::{
-    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE,
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_P4, START_STROKE,
     TIP_DEFLECTION, U_REF_INPUT,
 };
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
@@ -29,7 +29,7 @@ pub mod vr {
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 33] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
@@ -45,6 +45,7 @@ const OWN: [Variable; 33] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&SOLVER_LOCALS)
     .vars(&[
         Variable::param(vr::X0, START_STROKE).fixed(),
+        Variable::param(vr::START_P4, START_P4).fixed(),
         FLEXIBLE_SWITCH,
         TIP_DEFLECTION,
     ])
@@ -161,18 +162,20 @@ impl Plant {
         Ok(Plant { circuit, boom, u_ref: Ramp { t0: 0.0, y0: values.real(vr::U_REF), slope: 0.0 } })
     }
 
-    /// Static equilibrium at stroke `x0`: the load held at rest by the closed CBV.
-    pub fn equilibrium(&self, x0: f64) -> Result<Vec<f64>, String> {
+    /// Static equilibrium at stroke `x0`: the load held at rest by the closed CBV, the rod side
+    /// at tank pressure or trapped at `p4` (see [`crate::hydraulics::circuit::Circuit::equilibrium`]).
+    pub fn equilibrium(&self, x0: f64, p4: Option<f64>) -> Result<Vec<f64>, String> {
         let stroke = self.circuit.cylinder.stroke;
         if !(0.0..=stroke).contains(&x0) {
             return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
         }
         let b = self.boom.mechanics();
         let rest = b.equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
-        let c = self.circuit.equilibrium(rest.f_cyl).map_err(|e| {
+        let c = self.circuit.equilibrium(rest.f_cyl, p4).map_err(|e| {
             format!(
-                "no static equilibrium at start.x = {x0} m with the load of {:.0} N (payload.m, cbv.p_set): {e}",
-                rest.f_cyl
+                "no static equilibrium at start.x = {x0} m with the load of {:.0} N and start.p4 = {} Pa (payload.m, cbv.p_set): {e}",
+                rest.f_cyl,
+                p4.unwrap_or(self.circuit.supply.p_t)
             )
         })?;
         let mut s = c.to_vec();
@@ -199,7 +202,7 @@ impl HydraulicBoom {
     /// The model with the plant of `values` and the given state (the equilibrium if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
         let plant = Plant::from_values(values)?;
-        let state = super::stepping::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0)))?;
+        let state = super::stepping::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0), super::table::trapped_p4(values)))?;
         let solver = Radau5::new(plant.dim());
         Ok(HydraulicBoom { plant, state, solver })
     }

@@ -10,7 +10,7 @@
 use super::circuit::CIRCUIT_SCALE;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::states::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
-use super::table::{out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_STROKE, U_REF_INPUT};
+use super::table::{out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_P4, START_STROKE, U_REF_INPUT};
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
@@ -53,7 +53,7 @@ const START_FORCE: ParamSpec = ParamSpec {
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 37] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 38] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),
@@ -68,6 +68,7 @@ const OWN: [Variable; 37] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&SOLVER_LOCALS)
     .vars(&[
         Variable::param(vr::X0, START_STROKE).fixed(),
+        Variable::param(vr::START_P4, START_P4).fixed(),
         port::COUPLING,
         Variable::param(vr::Z_C, port::Z_C).fixed(),
         Variable::param(vr::ALPHA, port::ALPHA).fixed(),
@@ -212,8 +213,8 @@ impl HydraulicCircuit {
                 return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
             }
             let f = values.real(vr::START_F);
-            let c = sys.circuit.equilibrium(f).map_err(|e| {
-                format!("no static equilibrium with start.F = {f:.0} N (payload on the CBV, cbv.p_set): {e}")
+            let c = sys.circuit.equilibrium(f, super::table::trapped_p4(values)).map_err(|e| {
+                format!("no static equilibrium with start.F = {f:.0} N and start.p4 (payload on the CBV, cbv.p_set): {e}")
             })?;
             let rod = if sys.dim() > N_CIRCUIT { vec![x0, 0.0] } else { vec![] };
             Ok([&c[..], &rod].concat())

@@ -83,6 +83,24 @@ pub(crate) const START_STROKE: ParamSpec = ParamSpec {
     source: "Start stroke of the experiments, 480 mm (sections 6.2, chapter 7)",
 };
 
+pub(crate) const START_P4: ParamSpec = ParamSpec {
+    name: "start.p4",
+    default: 0.0,
+    unit: "Pa",
+    display_unit: "bar",
+    min: 0.0,
+    max: 100e5,
+    description: "Initial rod-side pressure (line 4), gauge, trapped by the closed spool; p3 carries the load on top of it (eq. 2.85). Above tank pressure it bleeds to tank through the spool's leakage (eq. 2.47), over about a minute",
+    source: "0: tank pressure, the valve's leakage equilibrium; the thesis' simulations of section 6.2 start at p4 = 1 bar",
+};
+
+/// The trapped rod-side pressure of `start.p4`: `None` at 0 (tank pressure, the leakage
+/// equilibrium, whatever `supply.p_t` is).
+pub(crate) fn trapped_p4(values: &Values) -> Option<f64> {
+    let p4 = values.real(vr::START_P4);
+    (p4 != 0.0).then_some(p4)
+}
+
 pub(crate) const FLEXIBLE_SWITCH: Variable = Variable::bool_param(
     "boom.flexible",
     vr::FLEXIBLE,

@@ -33,6 +33,7 @@ pub const EVENT_DEAD_BAND_UPPER: u32 = 28;
 pub const EVENT_DEAD_BAND_LOWER: u32 = 29;
 pub const X0: u32 = 30;
 pub const FLEXIBLE: u32 = 31;
+pub const START_P4: u32 = 32;
 pub const TIP_DEFLECTION: u32 = 40;
 /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
 pub const SECTIONS: u32 = 41;
