@@ -173,11 +173,16 @@ impl BenchResult {
         self.simulated_s / self.wall_s
     }
 
+    /// Wall time per communication step (s).
+    pub fn per_do_step(&self) -> f64 {
+        self.wall_s / (self.simulated_s / STEP).round()
+    }
+
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "case": self.case, "boom": self.boom, "via": self.via, "simulated_s": self.simulated_s,
             "wall_s": self.wall_s, "rtf": self.rtf(), "steps": self.steps, "rhs_evals": self.rhs_evals,
-            "jac_evals": self.jac_evals,
+            "jac_evals": self.jac_evals, "do_step_us": self.per_do_step() * 1e6,
         })
     }
 }
@@ -190,6 +195,13 @@ pub const RTOL: f64 = 1e-6;
 /// Case U (section 7.1): lowering from 480 mm with u = -0.1, no compensation, `duration` s.
 pub fn case_u(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
     plant.set(hb::U_REF, -0.1)?;
+    let n = (duration / STEP).round() as usize;
+    (0..n).try_for_each(|k| plant.step(k as f64 * STEP, STEP))
+}
+
+/// Case R, the cost floor of a communication step: the load held at rest (spool closed, every
+/// value at its start), `duration` s of 1 ms doSteps in which nothing happens.
+pub fn case_rest(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
     let n = (duration / STEP).round() as usize;
     (0..n).try_for_each(|k| plant.step(k as f64 * STEP, STEP))
 }
@@ -233,8 +245,8 @@ fn timed(
     })
 }
 
-/// Every benchmark: cases U and B with the rigid and the flexible (4 + 5) boom, in-process and
-/// through the C ABI of the libraries in `library_dir` (`lib<ModelIdentifier>.so`, as
+/// Every benchmark: cases U, B and R (at rest) with the rigid and the flexible (4 + 5) boom,
+/// in-process and through the C ABI of the libraries in `library_dir` (`lib<ModelIdentifier>.so`, as
 /// `cargo build --release` leaves them).
 pub fn run_all(library_dir: &Path, duration: f64) -> Result<Vec<BenchResult>, String> {
     let lib = |id: &str| library_dir.join(format!("lib{id}.so"));
@@ -258,6 +270,8 @@ pub fn run_all(library_dir: &Path, duration: f64) -> Result<Vec<BenchResult>, St
                 _ => Box::new(CAbi::new::<PressureFeedbackController>(&pfc_lib, RTOL, &c_start)?),
             };
             out.push(timed(("B", boom, via), p.as_mut(), |p| case_b(p, c.as_mut(), duration), duration)?);
+            let mut p = plant()?;
+            out.push(timed(("R", boom, via), p.as_mut(), |p| case_rest(p, duration), duration)?);
         }
     }
     Ok(out)

@@ -33,9 +33,9 @@ enum Cmd {
         #[arg(long, default_value = "linux64")]
         platforms: String,
     },
-    /// Time the lowering scenarios U and B in-process and through the C ABI (1 ms steps, rtol 1e-6).
+    /// Time the lowering scenarios U and B and the load at rest (R: the cost floor of a doStep) in-process and through the C ABI (1 ms steps, rtol 1e-6).
     Bench {
-        /// Print a JSON list of {case, boom, via, simulated_s, wall_s, rtf, steps, rhs_evals, jac_evals}.
+        /// Print a JSON list of {case, boom, via, simulated_s, wall_s, rtf, steps, rhs_evals, jac_evals, do_step_us}.
         #[arg(long)]
         json: bool,
         /// Simulated time per case [s], > 0.
@@ -162,23 +162,25 @@ fn bench(json: bool, duration: f64) -> Result<(), String> {
         return Ok(());
     }
     println!(
-        "{:<5} {:<8} {:<11} {:>8} {:>8} {:>8} {:>8} {:>10} {:>8}",
-        "case", "boom", "via", "sim s", "wall s", "rtf", "steps", "rhs", "jac"
+        "{:<5} {:<8} {:<11} {:>8} {:>8} {:>8} {:>9} {:>8} {:>10} {:>8}",
+        "case", "boom", "via", "sim s", "wall s", "rtf", "us/doStep", "steps", "rhs", "jac"
     );
     for r in &results {
         println!(
-            "{:<5} {:<8} {:<11} {:>8.1} {:>8.4} {:>8.0} {:>8} {:>10} {:>8}",
+            "{:<5} {:<8} {:<11} {:>8.1} {:>8.4} {:>8.0} {:>9.2} {:>8} {:>10} {:>8}",
             r.case,
             r.boom,
             r.via,
             r.simulated_s,
             r.wall_s,
             r.rtf(),
+            r.per_do_step() * 1e6,
             r.steps,
             r.rhs_evals,
             r.jac_evals
         );
     }
+    println!("R: the load held at rest, nothing happens: the cost floor of one doStep");
     println!(
         "controller setReal+doStep+getReal: {:.0} ns in-process, {:.0} ns through the C ABI",
         cycle_in * 1e9,
