@@ -315,6 +315,13 @@ def set_filter(ctrl_f: FmuFile, ctrl, cfg: dict):
             ctrl_f.set(ctrl, name, cfg[name])
 
 
+def with_params(scenario: dict, plant_f: FmuFile, params: dict | None) -> tuple[dict, dict]:
+    """The scenario with the plant's `params` among its start values, and the controller's."""
+    params = params or {}
+    plant = {k: v for k, v in params.items() if k in plant_f.vars}
+    return {**scenario, "plant": {**scenario["plant"], **plant}}, {k: v for k, v in params.items() if k not in plant}
+
+
 def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
         interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
         tolerance: float | None = None, fmi: int = 2, params: dict | None = None) -> Result:
@@ -326,9 +333,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
         raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
-    params = params or {}
-    ctrl_params = {k: v for k, v in params.items() if k not in plant_f.vars}
-    scenario = {**scenario, "plant": {**scenario["plant"], **{k: v for k, v in params.items() if k in plant_f.vars}}}
+    scenario, ctrl_params = with_params(scenario, plant_f, params)
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     step = scenario["step"] if step is None else step
     n = int(round(t_end / step))
@@ -405,7 +410,8 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
 
 
 def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
-           feedback_start: str | None = None, events: bool = True, fmi: int = 2) -> Result:
+           feedback_start: str | None = None, events: bool = True, fmi: int = 2,
+           params: dict | None = None) -> Result:
     """The scenario variant with both FMUs as Model Exchange, integrated together by fmpy's CVode
     (BDF, dense Newton with difference-quotient Jacobian, rtol `tolerance`, atol = rtol x the
     FMUs' nominal values): one ODE of the plant's and the controller's states, with
@@ -415,15 +421,14 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     and, with `events`, where one of the plant's event indicators changes sign (CVode's root
     finding: the dead-band jump of the spool demand, the load-sensing switch).
     `counts`: CVode's right-hand-side evaluations (`rhs`, fmi2GetDerivatives of each FMU) and the
-    state events (`events`). `fmi` 3: the FMI 3.0 FMUs, which declare no event indicators."""
+    state events (`events`). `fmi` 3: the FMI 3.0 FMUs (the same event indicators); `params`: as
+    for `run`."""
     from ctypes import POINTER, c_double
     from fmpy.sundials import CVodeSolver
 
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
-    params = params or {}
-    ctrl_params = {k: v for k, v in params.items() if k not in plant_f.vars}
-    scenario = {**scenario, "plant": {**scenario["plant"], **{k: v for k, v in params.items() if k in plant_f.vars}}}
+    scenario, ctrl_params = with_params(scenario, plant_f, params)
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     ctrl_cfg = scenario["controller"]
     fb_start = feedback_start or scenario["starts"][0]
@@ -438,6 +443,8 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     try:
         initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
         set_filter(ctrl_f, ctrl, ctrl_cfg)
+        for name, value in ctrl_params.items():
+            ctrl_f.set(ctrl, name, value)
         on = enable and fb_start == "t0"
         ctrl_f.set(ctrl, "enable", on)
         ctrl.setReal([vc["p"], vc["u_ref"]], [plant.getReal([vp["p4"]])[0], reference(table, 0.0)])
