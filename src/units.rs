@@ -91,3 +91,8 @@ pub const UNITS: &[Unit] = &[
 pub fn unit(name: &str) -> Option<&'static Unit> {
     UNITS.iter().find(|u| u.name == name)
 }
+
+/// The display unit `display` of SI unit `unit`, if it is one other than the unit itself.
+pub fn display_unit(unit: &str, display: &str) -> Option<&'static DisplayUnit> {
+    self::unit(unit)?.display.iter().find(|d| d.name == display && d.name != unit)
+}

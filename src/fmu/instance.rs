@@ -95,15 +95,18 @@ impl<M: Model> Default for Core<M> {
     }
 }
 
+/// Most event indicators a model may declare (the circuit has 3): their values are refreshed
+/// with the outputs after every step, on the stack.
+const MAX_EVENT_INDICATORS: usize = 8;
+
 /// Writes the outputs and locals of `model`, the event indicators' variables included.
 fn write_outputs<M: Model>(model: &M, values: &mut Values) {
     model.outputs(values);
-    if !M::EVENT_INDICATORS.is_empty() {
-        let mut z = vec![0.0; M::EVENT_INDICATORS.len()];
-        model.event_indicators(values, &mut z);
-        for (&r, z) in M::EVENT_INDICATORS.iter().zip(z) {
-            values.set_real(r, z);
-        }
+    const { assert!(M::EVENT_INDICATORS.len() <= MAX_EVENT_INDICATORS) };
+    let z = &mut [0.0; MAX_EVENT_INDICATORS][..M::EVENT_INDICATORS.len()];
+    model.event_indicators(values, z);
+    for (&r, &z) in M::EVENT_INDICATORS.iter().zip(z.iter()) {
+        values.set_real(r, z);
     }
 }
 
@@ -353,7 +356,12 @@ impl<M: Model> Instance<M> {
                 return Err(format!("known \"{}\" (vr {vr}) is not {what}", v.name));
             }
             if !dv.is_finite() {
-                return Err(format!("{} of \"{}\" = {} is not a finite number", self.version.argument("dvKnown"), v.name, num(dv)));
+                return Err(format!(
+                    "{} of \"{}\" = {} is not a finite number",
+                    self.version.argument("dvKnown"),
+                    v.name,
+                    num(dv)
+                ));
             }
         }
         if matches!(self.core.state, State::InitializationMode) {

@@ -85,7 +85,7 @@ fn row(v: &Variable) -> String {
 
 /// `x` in the display unit, as "25 l/min" (None without a display unit other than the unit).
 fn in_display_unit(x: f64, unit: &str, display_unit: &str) -> Option<String> {
-    let d = crate::units::unit(unit)?.display.iter().find(|d| d.name == display_unit && d.name != unit)?;
+    let d = crate::units::display_unit(unit, display_unit)?;
     let y = d.factor * x + d.offset;
     // Rounded to 6 significant digits: the SI value beside it is exact.
     let y: f64 = format!("{y:.5e}").parse().unwrap_or(y);

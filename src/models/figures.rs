@@ -3,9 +3,9 @@
 //! through the FMI layer (the same instance code an importer drives).
 
 use super::vr;
-use crate::fmu::in_process::{InProcess, Slave};
 use crate::fmi2::{Value, Variable};
 use crate::fmu::chart::{chart, escape, Panel};
+use crate::fmu::in_process::{InProcess, Slave};
 use crate::fmu::log::num;
 use crate::fmu::variables::Kind;
 use crate::fmu::Model;
@@ -62,8 +62,7 @@ fn shown<M: Model>(r: u32, si: &[f64]) -> (String, Vec<f64>, String) {
         Kind::Real { unit, display_unit, .. } => (unit, display_unit),
         _ => ("", ""),
     };
-    let d = crate::units::unit(unit).and_then(|u| u.display.iter().find(|d| d.name == display && d.name != unit));
-    match d {
+    match crate::units::display_unit(unit, display) {
         Some(d) => (v.name.to_owned(), si.iter().map(|x| d.factor * x + d.offset).collect(), display.to_owned()),
         None => (v.name.to_owned(), si.to_vec(), unit.to_owned()),
     }
