@@ -40,6 +40,7 @@ import dataclasses
 import math
 import pathlib
 import sys
+import time
 import tomllib
 
 import numpy as np
@@ -191,6 +192,20 @@ class FmuFile:
         self.dir = extract(self.path)
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.vr = {n: v.valueReference for n, v in self.vars.items()}
+        self._idle = []  # Co-Simulation instances handed back for reuse
+
+    def reused_slave(self, name: str):
+        """A Co-Simulation instance handed back by `give_back`, fmi2Reset to the state after
+        instantiation (every parameter at its start value), or a new one."""
+        if not self._idle:
+            return self.slave(name)
+        s = self._idle.pop()
+        s.reset()
+        return s
+
+    def give_back(self, slave):
+        """Keeps an instance of a finished run for `reused_slave`."""
+        self._idle.append(slave)
 
     @classmethod
     def get(cls, identifier: str, fmi: int = 2) -> "FmuFile":
@@ -324,11 +339,15 @@ def with_params(scenario: dict, plant_f: FmuFile, params: dict | None) -> tuple[
 
 def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
         interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
-        tolerance: float | None = None, fmi: int = 2, params: dict | None = None) -> Result:
+        tolerance: float | None = None, fmi: int = 2, params: dict | None = None, reuse: bool = False,
+        timeout: float | None = None) -> Result:
     """Co-simulate one scenario variant. `record_every` thins the recorded rows (default: one
     row per millisecond or per step, whichever is coarser); `fmi`: the FMUs' FMI version (3: no
     input derivatives, so `interpolate` must be False); `params`: FMU parameters by variable name
-    (HydraulicBoom's or the controller's), set after the scenario's."""
+    (HydraulicBoom's or the controller's), set after the scenario's. `reuse`: take the instances
+    of an earlier run with `reuse` (fmi2Reset) instead of instantiating, and keep them after a
+    run that succeeds (a failed run frees them). `timeout` [s]: a TimeoutError when the wall
+    time exceeds it, checked between communication steps (a single doStep is not interrupted)."""
     if fmi == 3 and interpolate:
         raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
@@ -348,9 +367,12 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
     enable = bool(ctrl_cfg["enable"])
     table = scenario["reference"]
 
-    plant = plant_f.slave(f"{scenario['id']}.plant")
-    ctrl = ctrl_f.slave(f"{scenario['id']}.controller")
+    deadline = time.monotonic() + timeout if timeout is not None else math.inf
+    new = (lambda f, name: f.reused_slave(name)) if reuse else (lambda f, name: f.slave(name))
+    plant = new(plant_f, f"{scenario['id']}.plant")
+    ctrl = new(ctrl_f, f"{scenario['id']}.controller")
     vp, vc = plant_f.vr, ctrl_f.vr
+    ok = False
     try:
         initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
         p4 = plant.getReal([vp["p4"]])[0]
@@ -387,6 +409,8 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
                 rows.append([t, u_ref, u_comp, u, *y])
             if k == n:
                 break
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"exceeded the timeout of {timeout:g} s at t = {t:g} s of {t_end:g} s")
             plant.doStep(t, step)
             y = plant.getReal(out_p)
             p4_next = y[i_p4]
@@ -403,8 +427,13 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
             ctrl.setReal([vc["p"], vc["u_ref"]], [p4, u_ref])
         data = np.array(rows)
         rhs = plant.getReal([vp["solver.rhs_evals"]])[0]
+        ok = True
     finally:
-        release(plant, ctrl)
+        if reuse and ok:
+            plant_f.give_back(plant)
+            ctrl_f.give_back(ctrl)
+        else:
+            release(plant, ctrl)
     return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at,
                   fb_start, counts={"rhs": int(rhs)})
 

@@ -12,13 +12,16 @@ Sweep file (TOML):
     boom = "rigid"            # default rigid
     stop_time = 15.0          # default: the scenario's
     metrics = ["p3_pp_late", "t_settle"]        # names of metrics.compute
+    timeout = 60.0            # s of wall time per point (default none): beyond it, a failed row
     samples = 20; seed = 1    # needed by Monte Carlo parameters
     [parameters]              # FMU parameters by variable name (HydraulicBoom or controller)
     K_f = {grid = [1e-11, 1.24e-11]}
     "fluid.beta" = {dist = "uniform", low = 1.2e9, high = 1.8e9}   # or {dist = "normal", mean, sd}
+    n_omega = {grid = [1.0, 2.0]}   # filter factors, instead of K_f / omega_f (FACTORS)
 The points are the product of the grids with the `samples` Monte Carlo draws (numpy
 default_rng(seed), parameters in file order). A point is identified by a hash of the scenario,
 boom, stop time and its parameter values, which `--resume` uses to skip finished points.
+Each worker keeps its two FMU instances from point to point (fmi2Reset, cosim.run's `reuse`).
 """
 
 from __future__ import annotations
@@ -26,9 +29,11 @@ from __future__ import annotations
 import argparse
 import hashlib
 import itertools
+import functools
 import json
 import os
 import pathlib
+import subprocess
 import sys
 import time
 import tomllib
@@ -40,7 +45,10 @@ import metrics as metrics_mod
 from cosim import UsageError
 
 DISTS = {"uniform": ("low", "high"), "normal": ("mean", "sd")}
-FIXED = ("id", "status", "error", "wall_time", "worker")
+#: Filter factors relative to the linear analysis at the point's operating point and the
+#: controller parameter each sets: K_f = n_K C1 mu_c mu_p (thesis eq. 6.6), omega_f = n_omega
+#: omega_n (eq. 6.7), from `boomsim analyze` (`operating_point`).
+FACTORS = {"n_K": "K_f", "n_omega": "omega_f"}
 
 
 # --------------------------------------------------------------------------- sweep file
@@ -71,10 +79,15 @@ def load(path) -> dict:
     params = doc.get("parameters", {})
     if not params:
         raise UsageError("no [parameters]: give at least one grid or distribution")
+    timeout = doc.get("timeout")
+    if timeout is not None and not (isinstance(timeout, (int, float)) and timeout > 0):
+        raise UsageError(f"timeout = {timeout!r}: give a number of seconds > 0")
     grids, dists = {}, {}
     for name, spec in params.items():
-        if name not in sweepable:
-            raise UsageError(f"unknown parameter \"{name}\": {', '.join(sweepable)}")
+        if name not in sweepable and name not in FACTORS:
+            raise UsageError(f"unknown parameter \"{name}\": {', '.join(sorted(sweepable + list(FACTORS)))}")
+        if FACTORS.get(name) in params:
+            raise UsageError(f"parameters \"{name}\" and \"{FACTORS[name]}\" both set {FACTORS[name]}: give one")
         if not isinstance(spec, dict) or ("grid" in spec) == ("dist" in spec):
             raise UsageError(f"parameter \"{name}\": give {{grid = [...]}} or {{dist = ...}}")
         if "grid" in spec:
@@ -97,9 +110,10 @@ def load(path) -> dict:
                     else rng.normal(s["mean"], s["sd"], doc["samples"])) for n, s in dists.items()}
         draws = [{n: float(c[i]) for n, c in cols.items()} for i in range(doc["samples"])]
     sweep = dict(scenario=scenario, boom=boom, stop_time=float(doc.get("stop_time", scenario["stop_time"])),
-                 metrics=keep, grids=grids, parameters=list(params))
-    sweep["points"] = [point_id(sweep, {**dict(zip(grids, g)), **d}) for g in itertools.product(*grids.values())
-                       for d in draws]
+                 metrics=keep, grids=grids, parameters=list(params), timeout=timeout,
+                 derived=[FACTORS[f] for f in FACTORS if f in params])
+    sweep["points"] = [with_filter(sweep, point_id(sweep, {**dict(zip(grids, g)), **d}))
+                       for g in itertools.product(*grids.values()) for d in draws]
     return sweep
 
 
@@ -107,6 +121,52 @@ def point_id(sweep: dict, values: dict) -> dict:
     """The point with its `id`: a hash of what determines its result."""
     key = json.dumps([sweep["scenario"]["id"], sweep["boom"], sweep["stop_time"], sorted(values.items())])
     return {"id": hashlib.sha256(key.encode()).hexdigest()[:16], **values}
+
+
+# --------------------------------------------------------------------------- filter factors
+
+
+def operating_point(sweep: dict, values: dict) -> dict:
+    """The `boomsim analyze` options of a point's operating point: stroke start.x [mm], the
+    CBV's pilot ratio and set pressure [bar], the rigid boom's payload [kg], bulk modulus [MPa]
+    and the steady lowering flow Q4 = valve.q_rated |u_ref| [l/min] of the final reference (the
+    pressure-compensated spool). Each from the point, else the scenario, else the FMU's start
+    value."""
+    sc = sweep["scenario"]
+    plant = cosim.FmuFile.get("HydraulicBoom")
+
+    def value(name: str) -> float:
+        if name in values:
+            return float(values[name])
+        if name in sc["plant"]:
+            return float(sc["plant"][name])
+        return float(sc["start_stroke"]) if name == "start.x" else float(plant.vars[name].start)
+
+    return {"xc": value("start.x") * 1e3, "mu-p": value("cbv.mu_p"), "p-set": value("cbv.p_set") / 1e5,
+            "payload": value("payload.m"), "beta": value("fluid.beta") / 1e6,
+            "q4": value("valve.q_rated") * abs(float(sc["reference"][-1, 1])) * 6e4}
+
+
+@functools.cache
+def analyze(op: tuple, n_k: tuple = (1.0,), n_omega: tuple = (1.0,)) -> dict:
+    """`boomsim analyze --json` at the operating point `op` (the items of `operating_point`)
+    for the filters n_k x n_omega."""
+    exe = cosim.ROOT / "target" / "release" / "boomsim"
+    if not exe.exists():
+        raise UsageError(f"{exe} is missing: run `cargo build --release` (n_K and n_omega need `boomsim analyze`)")
+    args = [f"--{k}={v!r}" for k, v in op] + ["--n-k", ",".join(map(repr, n_k)), "--n-omega", ",".join(map(repr, n_omega))]
+    r = subprocess.run([str(exe), "analyze", "--json", *args], capture_output=True, text=True)
+    if r.returncode:
+        raise UsageError(f"no linear analysis at {', '.join(f'{k} = {v:g}' for k, v in op)}: {r.stderr.strip()}")
+    return json.loads(r.stdout)
+
+
+def with_filter(sweep: dict, point: dict) -> dict:
+    """The point with K_f and omega_f of its filter factors n_K and n_omega (FACTORS)."""
+    if not sweep["derived"]:
+        return point
+    unit = analyze(tuple(operating_point(sweep, point).items()))["filters"][0]  # n_K = n_omega = 1
+    return {**point, **{p: point[f] * unit[p] for f, p in FACTORS.items() if f in point}}
 
 
 # --------------------------------------------------------------------------- one point
@@ -117,10 +177,11 @@ def run_point(sweep: dict, point: dict) -> dict:
     worker). Any exception, fmpy's FMICallException of an fmi2Error/Discard included, gives a
     failed row with its message."""
     t0 = time.perf_counter()
-    params = {k: v for k, v in point.items() if k != "id"}
+    params = {k: v for k, v in point.items() if k != "id" and k not in FACTORS}
     row = {**point, **{m: None for m in sweep["metrics"]}, "status": "ok", "error": ""}
     try:
-        res = cosim.run(sweep["scenario"], sweep["boom"], stop_time=sweep["stop_time"], params=params)
+        res = cosim.run(sweep["scenario"], sweep["boom"], stop_time=sweep["stop_time"], params=params,
+                        reuse=True, timeout=sweep["timeout"])
         m = metrics_mod.compute(res)
         row.update({k: m[k] for k in sweep["metrics"]})
     except Exception as e:  # noqa: BLE001 - every failure is a row
@@ -144,7 +205,7 @@ def schema(sweep: dict):
         ints = name in sweep["grids"] and all(isinstance(v, int) for v in sweep["grids"][name])
         return pa.int64() if ints else pa.float64()
 
-    return pa.schema([("id", pa.string())] + [(p, ptype(p)) for p in sweep["parameters"]]
+    return pa.schema([("id", pa.string())] + [(p, ptype(p)) for p in sweep["parameters"] + sweep["derived"]]
                      + [(m, pa.float64()) for m in sweep["metrics"]]
                      + [("status", pa.string()), ("error", pa.string()), ("wall_time", pa.float64()),
                         ("worker", pa.string())])

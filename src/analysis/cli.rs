@@ -3,7 +3,9 @@
 use super::operating_point::{p_set_for, OperatingPoint};
 use super::report::{self, Analysis, DEFAULT_FILTERS};
 use super::sweep;
-use crate::units::{bar, mm, BAR};
+use crate::mechanics::params::BoomParams;
+use crate::mechanics::rigid_boom::RigidBoom;
+use crate::units::{bar, mm, BAR, LPM};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -25,6 +27,10 @@ pub struct AnalyzeArgs {
     /// Steady rod-side pressure p4 [bar] (Table 6.1: 45).
     #[arg(long, default_value_t = 45.0)]
     pub p4: f64,
+    /// Steady lowering flow into the rod side Q4 [l/min]: p4 is the pressure that passes it
+    /// through the CBV (eq. 2.72, 2.73), replacing --p4.
+    #[arg(long)]
+    pub q4: Option<f64>,
     /// CBV pilot ratio mu_p [-] (default: 3, identified from Table 6.1).
     #[arg(long)]
     pub mu_p: Option<f64>,
@@ -37,6 +43,11 @@ pub struct AnalyzeArgs {
     /// Load force on the rod [N] (default: mass * g, eq. 2.69).
     #[arg(long)]
     pub load: Option<f64>,
+    /// Payload [kg] of the rigid boom (chapter 2 geometry): the mass is its effective mass at
+    /// the cylinder at --xc (eq. 2.68) and the load its static cylinder force (eq. 2.19),
+    /// replacing --mass and --load.
+    #[arg(long, conflicts_with_all = ["mass", "load"])]
+    pub payload: Option<f64>,
     /// Bulk modulus [MPa] (parameter list: 1300).
     #[arg(long)]
     pub beta: Option<f64>,
@@ -65,22 +76,35 @@ pub struct AnalyzeArgs {
 
 impl AnalyzeArgs {
     /// The operating point: Table 6.1 defaults overridden by the options.
-    pub fn operating_point(&self) -> OperatingPoint {
+    pub fn operating_point(&self) -> Result<OperatingPoint, String> {
         let d = OperatingPoint::default();
         let mu_p = self.mu_p.unwrap_or(d.mu_p);
-        let mass = self.mass.unwrap_or(d.mass);
-        OperatingPoint {
-            x_c: mm(self.xc),
+        let x_c = mm(self.xc);
+        let (mass, load) = match self.payload {
+            Some(m_pl) => rigid_boom_load(m_pl, x_c, d.stroke)?,
+            None => {
+                let mass = self.mass.unwrap_or(d.mass);
+                (mass, self.load.unwrap_or(d.load / d.mass * mass))
+            }
+        };
+        let op = OperatingPoint {
+            x_c,
             p4: bar(self.p4),
             mu_p,
             p_set: self.p_set.map_or_else(|| p_set_for(mu_p), bar),
             mass,
-            load: self.load.unwrap_or(d.load / d.mass * mass),
+            load,
             beta: self.beta.map_or(d.beta, |b| b * 1e6),
             c1_extra: self.c1_extra * 1e-6 / BAR,
             c2_extra: self.c2_extra * 1e-6 / BAR,
             ..d
+        };
+        let Some(q4) = self.q4 else { return Ok(op) };
+        if !(q4 > 0.0) {
+            return Err(format!("--q4 {q4} l/min must be > 0"));
         }
+        op.with_flow(q4 * LPM / op.mu_c)
+            .ok_or_else(|| format!("the CBV cannot pass --q4 {q4} l/min at this operating point, even fully open"))
     }
 
     /// `(n_K, n_omega)` pairs: the cross product of the options, or the defaults.
@@ -94,10 +118,21 @@ impl AnalyzeArgs {
     }
 }
 
+/// `(m, F)`: the effective mass at the cylinder (eq. 2.68) and the static cylinder force
+/// (eq. 2.19) of the rigid boom with the chapter 2 geometry and a payload of `m_pl` kg at stroke
+/// `x_c` of a cylinder with `stroke`.
+fn rigid_boom_load(m_pl: f64, x_c: f64, stroke: f64) -> Result<(f64, f64), String> {
+    if !(0.0..=2000.0).contains(&m_pl) {
+        return Err(format!("--payload {m_pl} kg is outside [0, 2000] kg (payload.m)"));
+    }
+    let boom = RigidBoom::new(&BoomParams { m_pl, ..BoomParams::default() }, stroke).map_err(|e| e.to_string())?;
+    Ok((boom.m_eff(x_c), boom.static_force(x_c)))
+}
+
 /// Runs `boomsim analyze`; `root` is the workspace root (for the plot script and a relative
 /// `--out`).
 pub fn run(args: &AnalyzeArgs, root: &Path) -> Result<(), String> {
-    let op = args.operating_point();
+    let op = args.operating_point()?;
     let omega_v = args.omega_v.unwrap_or_else(report::default_omega_v);
     let explicit: Vec<(f64, f64)> = args.k_f.zip(args.omega_f).into_iter().collect();
     let a = Analysis::new(op, omega_v, &args.tuned_filters(), &explicit).map_err(|e| e.to_string())?;
