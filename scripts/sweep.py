@@ -265,7 +265,9 @@ def execute(sweep: dict, todo: list[dict], out: pathlib.Path, args):
         return
     t0, done, failed, tty = time.monotonic(), 0, 0, sys.stderr.isatty()
     with client_for(args) as client:
-        futures = client.map(run_point, [sweep] * len(todo), todo, pure=False)
+        # the sweep once to every worker, without its list of points (the tasks carry theirs)
+        task_sweep = client.scatter({k: v for k, v in sweep.items() if k != "points"}, broadcast=True)
+        futures = client.map(run_point, [task_sweep] * len(todo), todo, pure=False)
         try:
             for batch in as_completed(futures, with_results=True).batches():
                 rows = [r for _, r in batch]

@@ -211,8 +211,7 @@ def draw(sweep, grid: Grid, m: str, region, rec, linear: dict, fine_xy, path: pa
     zs = [grid.worst(m, p) for p in grid.panels]
     finite = np.concatenate([z[np.isfinite(z)] for z in zs]) if zs else np.array([])
     vmin, vmax = (finite.min(), finite.max()) if len(finite) else (0.0, 1.0)
-    cmap = plt.get_cmap("viridis").copy()
-    cmap.set_over("0.6")
+    cmap = plt.get_cmap("viridis").with_extremes(over="0.6")
     log = grid.axes == ["n_K", "n_omega"] or all(min(v) > 0 for v in (grid.xs, grid.ys))
     ex, ey = (edges(v) if log else np.arange(len(v) + 1) - 0.5 for v in (grid.xs, grid.ys))
     im = None

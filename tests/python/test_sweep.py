@@ -1,16 +1,24 @@
 """scripts/sweep.py: a sweep on a LocalCluster gives the metrics of the same points run serially
 in-process, a failing point is a row with fmpy's error, --resume runs only the missing points, and
-a bad sweep file is refused in one line before anything runs. Short rigid-boom runs of B."""
+a bad sweep file is refused in one line before anything runs; the filter factors n_K / n_omega
+follow eq. 6.6 / 6.7, a point beyond its timeout is a failed row, reused FMU instances give the
+fresh instances' results bit for bit, and the summary finds the settle region and the recommended
+filter of a grid whose answer is counted by hand. Short rigid-boom runs of B."""
 
+import math
 import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
+import cosim  # noqa: E402
+import metrics  # noqa: E402
 import sweep  # noqa: E402
+import sweep_summary  # noqa: E402
 
 METRICS = ["p3_pp_max", "p3_pp_late", "u_comp_max", "v_steady"]
 
@@ -44,7 +52,7 @@ def test_two_workers_give_the_serial_metrics_exactly(tmp_path):
         assert serial["status"] == "ok" and serial["worker"] == "local"
         assert {m: rows[p["id"]][m] for m in METRICS} == {m: serial[m] for m in METRICS}
     assert "4 of 4 points run, 0 failed" in (tmp_path / "out" / "summary.md").read_text()
-    assert (tmp_path / "out" / "heatmap.png").exists()
+    assert (tmp_path / "out" / "map-p3_pp_late.png").exists()
 
 
 def test_a_failing_point_is_a_row_with_fmpys_error(tmp_path):
@@ -83,6 +91,10 @@ def test_resume_runs_only_the_missing_points(tmp_path):
     ('scenario = "B"\nsamples = 3\nseed = 1\n', 'K_f = {dist = "beta", a = 1}\n',
      ['unknown distribution "beta"', "uniform, normal"]),
     ('scenario = "B"\nmetrics = ["t_settl"]\n', "K_f = {grid = [1e-11]}\n", ['unknown metric "t_settl"', "t_settle"]),
+    ('scenario = "B"\n', "K_f = {grid = [1e-11]}\nn_K = {grid = [2.0]}\n", ['"n_K" and "K_f" both set K_f']),
+    ('scenario = "B"\ntimeout = -1\n', "n_K = {grid = [2.0]}\n", ["timeout = -1", "> 0"]),
+    ('scenario = "B"\n', "n_K = {grid = [2.0]}\n\"payload.m\" = {grid = [2500.0]}\n",
+     ["no linear analysis at", "payload = 2500", "outside [0, 2000] kg"]),
 ])
 def test_a_bad_sweep_file_is_refused_before_any_run(tmp_path, head, parameters, says):
     path = tmp_path / "bad.toml"
@@ -102,3 +114,84 @@ def test_monte_carlo_points_are_seeded_and_crossed_with_the_grid(tmp_path):
     assert a == b and len(a) == 10 and len({p["id"] for p in a}) == 10
     assert all(1.2e9 <= p["fluid.beta"] <= 1.8e9 for p in a)
     assert [p["fluid.beta"] for p in a[:5]] == [p["fluid.beta"] for p in a[5:]]  # the same draws per grid point
+
+
+def test_filter_factors_follow_eq_6_6_and_6_7(tmp_path):
+    """K_f = n_K C1 mu_c mu_p (eq. 6.6) with C1 = A x_c / beta (eq. 2.70, no extra volume, as
+    section 2.3), x_c the start stroke, the cylinder's areas of the parameter list (metrics.py);
+    omega_f = n_omega omega_n (eq. 6.7) with omega_n^2 = A^2 / (C1 m) (eq. 2.81): independent of
+    mu_p, proportional to beta, and 1 / omega_n^2 affine in the payload (the boom's effective
+    mass is J_B (dtheta/dl)^2 + m_rod, J_B affine in the payload mass). 1e-12 relative: rounding."""
+    f = sweep_file(tmp_path, 'n_K = {grid = [1.0, 3.0]}\nn_omega = {grid = [0.5, 2.0]}\n"cbv.mu_p" = {grid = [2.0, 5.0]}\n'
+                   '"payload.m" = {grid = [0.0, 200.0, 382.6]}\n"fluid.beta" = {grid = [1.3e9, 1.6e9]}\n')
+    points = sweep.load(f)["points"]
+    assert len(points) == 48
+    mu_c = metrics.A_ROD_SIDE / metrics.A_PISTON
+    omega_n = {}
+    for p in points:
+        c1 = metrics.A_PISTON * 0.480 / p["fluid.beta"]
+        assert p["K_f"] == pytest.approx(p["n_K"] * c1 * mu_c * p["cbv.mu_p"], rel=1e-12)
+        omega_n.setdefault((p["payload.m"], p["fluid.beta"]), []).append(p["omega_f"] / p["n_omega"])
+    assert all(max(w) / min(w) - 1 < 1e-12 for w in omega_n.values())  # the same for every mu_p and n_K
+    w = {k: v[0] for k, v in omega_n.items()}
+    for m in (0.0, 200.0, 382.6):
+        assert w[m, 1.6e9] ** 2 / w[m, 1.3e9] ** 2 == pytest.approx(1.6 / 1.3, rel=1e-12)
+    inv = [1 / w[m, 1.3e9] ** 2 for m in (0.0, 200.0, 382.6)]
+    assert (inv[2] - inv[0]) / 382.6 == pytest.approx((inv[1] - inv[0]) / 200.0, rel=1e-9)
+
+
+def test_a_point_beyond_its_timeout_is_a_failed_row(tmp_path):
+    """A 1 s run cannot take less than 1 ms of wall time (1000 communication steps); the next point
+    (no timeout) runs on."""
+    s = sweep.load(sweep_file(tmp_path, "K_f = {grid = [1.0e-11, 1.24e-11]}\n",
+                              head='scenario = "B"\nstop_time = 1.0\ntimeout = 0.001\n'))
+    row = sweep.run_point(s, s["points"][0])
+    assert row["status"] == "failed" and all(row[m] is None for m in METRICS)
+    assert row["error"].startswith("TimeoutError: exceeded the timeout of 0.001 s at t = "), row["error"]
+    assert sweep.run_point({**s, "timeout": None}, s["points"][1])["status"] == "ok"
+
+
+def test_reused_instances_give_the_fresh_results_bit_for_bit():
+    """fmi2Reset returns an instance to its state after instantiation: every parameter a run set
+    before (fluid.beta, cbv.mu_p, the filter) is back at its start value. A sequence of runs on
+    reused instances, a failing one (fmi2Error) and a timed-out one among them, against the same
+    runs on fresh instances: every recorded value equal."""
+    sc = cosim.load_scenario("B")
+    sequence = [{"fluid.beta": 1.4e9, "K_f": 1.0e-11}, {}, {"cbv.mu_p": 5.0, "omega_f": 50.0, "payload.m": 200.0},
+                {"fluid.beta": 5e9}, "timeout", {"u_max": 0.5}, {}]
+    for params in sequence:
+        if params == "timeout":
+            with pytest.raises(TimeoutError):
+                cosim.run(sc, stop_time=1.0, reuse=True, timeout=1e-4)
+            continue
+        if params.get("fluid.beta") == 5e9:
+            with pytest.raises(Exception, match="fmi2SetReal failed"):
+                cosim.run(sc, stop_time=1.0, params=params, reuse=True)
+            continue
+        reused = cosim.run(sc, stop_time=1.0, params=params, reuse=True)
+        fresh = cosim.run(sc, stop_time=1.0, params=params)
+        for c in cosim.COLUMNS:
+            assert np.array_equal(reused.data[c], fresh.data[c]), (params, c)
+        assert metrics.compute(reused) == metrics.compute(fresh)
+
+
+def test_summary_finds_the_region_and_the_recommendation_of_a_known_grid(tmp_path):
+    """Made-up rows on a grid of factor-2 steps: with mu_p = 3 nothing settles at n_K = 8, with
+    mu_p = 5 the cell (1, 0.5) does not; the other 8 of the 12 cells settle in both panels.
+    Counted by hand, in grid steps of ln 2 to the nearest cell outside: (1, 2) and (2, 2) are 2
+    steps away, every other cell of the region 1 or sqrt(2); t_settle = 2 - 0.1 n_K breaks the tie
+    for (2, 2): distance 2 ln 2, a factor 4."""
+    f = sweep_file(tmp_path, 'n_K = {grid = [1.0, 2.0, 4.0, 8.0]}\nn_omega = {grid = [0.5, 1.0, 2.0]}\n'
+                   '"cbv.mu_p" = {grid = [3.0, 5.0]}\n', head='scenario = "B"\nstop_time = 5.0\n')
+    s = {**sweep.load(f), "metrics": ["p3_pp_late", "t_settle"]}
+    rows = []
+    for p in s["points"]:
+        settles = not ((p["cbv.mu_p"] == 3.0 and p["n_K"] == 8.0) or (p["cbv.mu_p"] == 5.0 and p["n_K"] == 1.0 and p["n_omega"] == 0.5))
+        rows.append({**p, "p3_pp_late": 0.1 * p["n_K"], "t_settle": 2 - 0.1 * p["n_K"] if settles else None,
+                     "status": "ok", "error": "", "wall_time": 0.0, "worker": "made up"})
+    sweep_summary.write(s, rows, tmp_path)
+    text = (tmp_path / "summary.md").read_text()
+    assert "8 of 12 (n_K, n_omega) grid cells settle at every point" in text
+    assert f"**n_K = 2, n_omega = 2**, {2 * math.log(2):.3f} in log factor (a factor 4)" in text, text
+    assert "worst settling time 1.8 s" in text
+    assert (tmp_path / "map-t_settle.png").exists() and (tmp_path / "map-p3_pp_late.png").exists()
