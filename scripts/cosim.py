@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import math
 import pathlib
 import sys
@@ -49,6 +50,7 @@ from metrics import CBV_OPEN
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 FMU_DIR = ROOT / "target" / "fmu"
+BOOMSIM = ROOT / "target" / "release" / "boomsim"
 SCENARIO_DIR = ROOT / "scripts" / "scenarios"
 
 #: Names the flexible-boom switch may get in HydraulicBoom (structural parameter, Integer or
@@ -309,25 +311,27 @@ def release(*instances):
         m.freeInstance()
 
 
+def plant_start(scenario: dict, switch) -> dict:
+    """The plant's start values: the scenario's start stroke, the boom switch and its parameters."""
+    return {"start.x": scenario["start_stroke"], **dict([switch] if switch else []), **scenario["plant"]}
+
+
+def controller_start(scenario: dict, ctrl_params: dict) -> dict:
+    """The controller's start values: the scenario's filter and limits where it gives them, then
+    `ctrl_params`."""
+    cfg = scenario["controller"]
+    return {**{k: cfg[k] for k in ("K_f", "omega_f", "u_min", "u_max") if k in cfg}, **ctrl_params}
+
+
 def initialize_plant(plant_f: FmuFile, plant, ctrl, scenario: dict, switch, tolerance, t_end: float):
     """Sets both instances up and into Initialization Mode, and initialises the plant with the
     scenario's start stroke, boom and parameters (either interface)."""
     for m in (plant, ctrl):
         m.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
         m.enterInitializationMode()
-    plant_f.set(plant, "start.x", scenario["start_stroke"])
-    if switch:
-        plant_f.set(plant, *switch)
-    for name, value in scenario["plant"].items():
+    for name, value in plant_start(scenario, switch).items():
         plant_f.set(plant, name, value)
     plant.exitInitializationMode()
-
-
-def set_filter(ctrl_f: FmuFile, ctrl, cfg: dict):
-    """The scenario's filter and limits, where it gives them."""
-    for name in ("K_f", "omega_f", "u_min", "u_max"):
-        if name in cfg:
-            ctrl_f.set(ctrl, name, cfg[name])
 
 
 def with_params(scenario: dict, plant_f: FmuFile, params: dict | None) -> tuple[dict, dict]:
@@ -335,6 +339,23 @@ def with_params(scenario: dict, plant_f: FmuFile, params: dict | None) -> tuple[
     params = params or {}
     plant = {k: v for k, v in params.items() if k in plant_f.vars}
     return {**scenario, "plant": {**scenario["plant"], **plant}}, {k: v for k, v in params.items() if k not in plant}
+
+
+def schedule(scenario: dict, step, stop_time, record_every, feedback_start):
+    """(stop time, step, steps, record_every, feedback start) of a Co-Simulation run: the
+    arguments, else the scenario's; record_every defaults to one row per millisecond or per step,
+    whichever is coarser."""
+    t_end = scenario["stop_time"] if stop_time is None else stop_time
+    step = scenario["step"] if step is None else step
+    n = int(round(t_end / step))
+    if abs(n * step - t_end) > 1e-9 * t_end:
+        raise ValueError(f"stop time {t_end} is not a multiple of the step {step}")
+    if record_every is None:
+        record_every = max(1, int(round(1e-3 / step)))
+    fb_start = feedback_start or scenario["starts"][0]
+    if fb_start not in ("t0", "cbv_open"):
+        raise ValueError(f"feedback_start must be 't0' or 'cbv_open', got {fb_start!r}")
+    return t_end, step, n, record_every, fb_start
 
 
 def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
@@ -353,18 +374,8 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
     scenario, ctrl_params = with_params(scenario, plant_f, params)
-    t_end = scenario["stop_time"] if stop_time is None else stop_time
-    step = scenario["step"] if step is None else step
-    n = int(round(t_end / step))
-    if abs(n * step - t_end) > 1e-9 * t_end:
-        raise ValueError(f"stop time {t_end} is not a multiple of the step {step}")
-    if record_every is None:
-        record_every = max(1, int(round(1e-3 / step)))
-    ctrl_cfg = scenario["controller"]
-    fb_start = feedback_start or scenario["starts"][0]
-    if fb_start not in ("t0", "cbv_open"):
-        raise ValueError(f"feedback_start must be 't0' or 'cbv_open', got {fb_start!r}")
-    enable = bool(ctrl_cfg["enable"])
+    t_end, step, n, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
+    enable = bool(scenario["controller"]["enable"])
     table = scenario["reference"]
 
     deadline = time.monotonic() + timeout if timeout is not None else math.inf
@@ -383,8 +394,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
                 ctrl.reset()
                 ctrl.setupExperiment(tolerance=tolerance, startTime=t0, stopTime=t_end)
                 ctrl.enterInitializationMode()
-            set_filter(ctrl_f, ctrl, ctrl_cfg)
-            for name, value in ctrl_params.items():
+            for name, value in controller_start(scenario, ctrl_params).items():
                 ctrl_f.set(ctrl, name, value)
             ctrl_f.set(ctrl, "enable", feedback)
             ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, t0)])
@@ -438,6 +448,39 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
                   fb_start, counts={"rhs": int(rhs)})
 
 
+def run_native(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
+               interpolate: bool = True, record_every: int | None = None, feedback_start: str | None = None,
+               params: dict | None = None, timeout: float | None = None) -> Result:
+    """`run` (FMI 2.0) through `boomsim cosim`: the same coupling with the FMUs' code called
+    in-process by the Rust loop instead of through fmpy, the same rows bit for bit. `timeout`:
+    the process is killed beyond it (TimeoutError); a failure is a RuntimeError with the
+    message."""
+    import subprocess
+
+    plant_f = FmuFile.get("HydraulicBoom")
+    switch = boom_switch(plant_f, boom)
+    scenario, ctrl_params = with_params(scenario, plant_f, params)
+    t_end, step, _, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
+    request = {"stop_time": t_end, "step": step, "record_every": record_every, "interpolate": interpolate,
+               "feedback_start": fb_start, "enable": bool(scenario["controller"]["enable"]),
+               "reference": scenario["reference"].tolist(), "plant": plant_start(scenario, switch),
+               "controller": controller_start(scenario, ctrl_params)}
+    if not BOOMSIM.exists():
+        raise UsageError(f"{BOOMSIM} is missing: run `cargo build --release`")
+    try:
+        r = subprocess.run([str(BOOMSIM), "cosim"], input=json.dumps(request).encode(), capture_output=True,
+                           timeout=timeout)
+    except subprocess.TimeoutExpired:
+        raise TimeoutError(f"exceeded the timeout of {timeout:g} s (boomsim cosim killed)") from None
+    if r.returncode:
+        raise RuntimeError(r.stderr.decode().strip())
+    head, _, body = r.stdout.partition(b"\n")
+    h = json.loads(head)
+    data = np.frombuffer(body, dtype="<f8").reshape(h["rows"], h["columns"])
+    return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)},
+                  h["feedback_on_at"], fb_start, counts={"rhs": int(h["rhs"])})
+
+
 def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
            feedback_start: str | None = None, events: bool = True, fmi: int = 2,
            params: dict | None = None) -> Result:
@@ -471,8 +514,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     counts = {"rhs": 0, "events": 0}
     try:
         initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
-        set_filter(ctrl_f, ctrl, ctrl_cfg)
-        for name, value in ctrl_params.items():
+        for name, value in controller_start(scenario, ctrl_params).items():
             ctrl_f.set(ctrl, name, value)
         on = enable and fb_start == "t0"
         ctrl_f.set(ctrl, "enable", on)

@@ -13,6 +13,7 @@ Sweep file (TOML):
     stop_time = 15.0          # default: the scenario's
     metrics = ["p3_pp_late", "t_settle"]        # names of metrics.compute
     timeout = 60.0            # s of wall time per point (default none): beyond it, a failed row
+    runner = "native"         # "fmpy" (default) or "native": `boomsim cosim`, the same rows
     samples = 20; seed = 1    # needed by Monte Carlo parameters
     [parameters]              # FMU parameters by variable name (HydraulicBoom or controller)
     K_f = {grid = [1e-11, 1.24e-11]}
@@ -21,7 +22,8 @@ Sweep file (TOML):
 The points are the product of the grids with the `samples` Monte Carlo draws (numpy
 default_rng(seed), parameters in file order). A point is identified by a hash of the scenario,
 boom, stop time and its parameter values, which `--resume` uses to skip finished points.
-Each worker keeps its two FMU instances from point to point (fmi2Reset, cosim.run's `reuse`).
+With fmpy each worker keeps its two FMU instances from point to point (fmi2Reset, cosim.run's
+`reuse`); the native runner is one `boomsim cosim` process per point (cosim.run_native).
 """
 
 from __future__ import annotations
@@ -49,6 +51,8 @@ DISTS = {"uniform": ("low", "high"), "normal": ("mean", "sd")}
 #: controller parameter each sets: K_f = n_K C1 mu_c mu_p (thesis eq. 6.6), omega_f = n_omega
 #: omega_n (eq. 6.7), from `boomsim analyze` (`operating_point`).
 FACTORS = {"n_K": "K_f", "n_omega": "omega_f"}
+#: How a point is co-simulated: fmpy on instances reused from point to point, or `boomsim cosim`.
+RUNNERS = {"fmpy": lambda *a, **k: cosim.run(*a, **k, reuse=True), "native": cosim.run_native}
 
 
 # --------------------------------------------------------------------------- sweep file
@@ -82,6 +86,9 @@ def load(path) -> dict:
     timeout = doc.get("timeout")
     if timeout is not None and not (isinstance(timeout, (int, float)) and timeout > 0):
         raise UsageError(f"timeout = {timeout!r}: give a number of seconds > 0")
+    runner = doc.get("runner", "fmpy")
+    if runner not in RUNNERS:
+        raise UsageError(f"unknown runner \"{runner}\": {', '.join(RUNNERS)}")
     grids, dists = {}, {}
     for name, spec in params.items():
         if name not in sweepable and name not in FACTORS:
@@ -110,7 +117,7 @@ def load(path) -> dict:
                     else rng.normal(s["mean"], s["sd"], doc["samples"])) for n, s in dists.items()}
         draws = [{n: float(c[i]) for n, c in cols.items()} for i in range(doc["samples"])]
     sweep = dict(scenario=scenario, boom=boom, stop_time=float(doc.get("stop_time", scenario["stop_time"])),
-                 metrics=keep, grids=grids, parameters=list(params), timeout=timeout,
+                 metrics=keep, grids=grids, parameters=list(params), timeout=timeout, runner=runner,
                  derived=[FACTORS[f] for f in FACTORS if f in params])
     sweep["points"] = [with_filter(sweep, point_id(sweep, {**dict(zip(grids, g)), **d}))
                        for g in itertools.product(*grids.values()) for d in draws]
@@ -151,7 +158,7 @@ def operating_point(sweep: dict, values: dict) -> dict:
 def analyze(op: tuple, n_k: tuple = (1.0,), n_omega: tuple = (1.0,)) -> dict:
     """`boomsim analyze --json` at the operating point `op` (the items of `operating_point`)
     for the filters n_k x n_omega."""
-    exe = cosim.ROOT / "target" / "release" / "boomsim"
+    exe = cosim.BOOMSIM
     if not exe.exists():
         raise UsageError(f"{exe} is missing: run `cargo build --release` (n_K and n_omega need `boomsim analyze`)")
     args = [f"--{k}={v!r}" for k, v in op] + ["--n-k", ",".join(map(repr, n_k)), "--n-omega", ",".join(map(repr, n_omega))]
@@ -180,8 +187,8 @@ def run_point(sweep: dict, point: dict) -> dict:
     params = {k: v for k, v in point.items() if k != "id" and k not in FACTORS}
     row = {**point, **{m: None for m in sweep["metrics"]}, "status": "ok", "error": ""}
     try:
-        res = cosim.run(sweep["scenario"], sweep["boom"], stop_time=sweep["stop_time"], params=params,
-                        reuse=True, timeout=sweep["timeout"])
+        res = RUNNERS[sweep["runner"]](sweep["scenario"], sweep["boom"], stop_time=sweep["stop_time"], params=params,
+                                       timeout=sweep["timeout"])
         m = metrics_mod.compute(res)
         row.update({k: m[k] for k in sweep["metrics"]})
     except Exception as e:  # noqa: BLE001 - every failure is a row

@@ -9,6 +9,7 @@ pub mod analysis;
 #[cfg(unix)]
 pub mod bench;
 pub mod control;
+pub mod cosim;
 pub mod fmi2;
 pub mod fmi3;
 pub mod fmu;

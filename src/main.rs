@@ -74,6 +74,10 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Co-simulate HydraulicBoom with the PressureFeedbackController in-process, as
+    /// scripts/cosim.py's `run` does through fmpy (the sweeps' native runner): a JSON request on
+    /// stdin, a JSON header line and the rows as little-endian f64 on stdout.
+    Cosim,
     /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
     #[command(allow_negative_numbers = true)]
     Analyze(Box<boomsim::analysis::cli::AnalyzeArgs>),
@@ -302,6 +306,7 @@ fn main() -> ExitCode {
         Cmd::Eigen { json, count, p4 } => eigen(json, count, p4),
         Cmd::Xml { check } => xml(check),
         Cmd::Deflection { json } => deflection(json),
+        Cmd::Cosim => boomsim::cosim::main(),
         Cmd::Analyze(args) => boomsim::analysis::cli::run(&args, root()),
     };
     match result {

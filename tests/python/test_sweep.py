@@ -2,7 +2,7 @@
 in-process, a failing point is a row with fmpy's error, --resume runs only the missing points, and
 a bad sweep file is refused in one line before anything runs; the filter factors n_K / n_omega
 follow eq. 6.6 / 6.7, a point beyond its timeout is a failed row, reused FMU instances give the
-fresh instances' results bit for bit, and the summary finds the settle region and the recommended
+fresh instances' results bit for bit, so does the native runner, and the summary finds the settle region and the recommended
 filter of a grid whose answer is counted by hand. Short rigid-boom runs of B."""
 
 import math
@@ -93,6 +93,7 @@ def test_resume_runs_only_the_missing_points(tmp_path):
     ('scenario = "B"\nmetrics = ["t_settl"]\n', "K_f = {grid = [1e-11]}\n", ['unknown metric "t_settl"', "t_settle"]),
     ('scenario = "B"\n', "K_f = {grid = [1e-11]}\nn_K = {grid = [2.0]}\n", ['"n_K" and "K_f" both set K_f']),
     ('scenario = "B"\ntimeout = -1\n', "n_K = {grid = [2.0]}\n", ["timeout = -1", "> 0"]),
+    ('scenario = "B"\nrunner = "rust"\n', "n_K = {grid = [2.0]}\n", ['unknown runner "rust"', "fmpy, native"]),
     ('scenario = "B"\n', "n_K = {grid = [2.0]}\n\"payload.m\" = {grid = [2500.0]}\n",
      ["no linear analysis at", "payload = 2500", "outside [0, 2000] kg"]),
 ])
@@ -195,3 +196,20 @@ def test_summary_finds_the_region_and_the_recommendation_of_a_known_grid(tmp_pat
     assert f"**n_K = 2, n_omega = 2**, {2 * math.log(2):.3f} in log factor (a factor 4)" in text, text
     assert "worst settling time 1.8 s" in text
     assert (tmp_path / "map-t_settle.png").exists() and (tmp_path / "map-p3_pp_late.png").exists()
+
+
+@pytest.mark.parametrize("scenario,boom,kw", [
+    ("B", "rigid", {"params": {"cbv.mu_p": 5.0, "K_f": 2e-11, "payload.m": 200.0, "friction.model": 1}}),
+    ("B", "rigid", {"feedback_start": "cbv_open"}),  # the controller re-initialised mid-run
+    ("U", "flexible", {}),
+])
+def test_the_native_runner_gives_fmpys_rows_bit_for_bit(scenario, boom, kw):
+    """`boomsim cosim` makes the calls of cosim.run in the same order with the same arguments,
+    the FMUs' code in-process: every recorded value, the RHS count and the feedback start equal."""
+    sc = cosim.load_scenario(scenario)
+    a, b = cosim.run(sc, boom, stop_time=1.0, **kw), cosim.run_native(sc, boom, stop_time=1.0, **kw)
+    for c in cosim.COLUMNS:
+        assert np.array_equal(a.data[c], b.data[c]), c
+    assert (a.counts, a.feedback_on_at) == (b.counts, b.feedback_on_at)
+    with pytest.raises(TimeoutError, match="exceeded the timeout of 0.0001 s"):
+        cosim.run_native(sc, boom, stop_time=1.0, timeout=1e-4, **kw)

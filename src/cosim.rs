@@ -1,0 +1,177 @@
+//! `boomsim cosim`: the co-simulation of `scripts/cosim.py`'s `run` (HydraulicBoom and
+//! PressureFeedbackController, FMI 2.0 Co-Simulation, Gauss-Seidel, p4 interpolated in the
+//! controller) with the FMI layer called in-process instead of through fmpy: the native runner of
+//! the sweeps. The same calls in the same order with the same arguments, so the recorded rows are
+//! the Python runner's bit for bit (tests/python/test_sweep.py).
+//!
+//! Input (stdin, JSON): `stop_time`, `step`, `record_every`, `interpolate`, `feedback_start`
+//! ("t0" or "cbv_open"), `enable`, `reference` ([[t, u_ref], ...]), `plant` and `controller`
+//! (start values by variable name, set in Initialization Mode). Output (stdout): one JSON line
+//! `{"rows", "columns", "rhs", "feedback_on_at"}`, then the rows as little-endian f64.
+
+use crate::fmu::instance::{Instance, Step};
+use crate::fmu::log::Logger;
+use crate::fmu::state::Interface;
+use crate::fmu::variables::BaseType;
+use crate::fmu::{guid::guid, Model, Value, Version};
+use crate::models::pressure_feedback_controller::vr as pfc;
+use crate::models::{HydraulicBoom, PressureFeedbackController};
+use serde_json::{json, Map, Value as Json};
+use std::io::Write;
+
+/// The plant's recorded outputs, in the order of `cosim.PLANT_OUT`.
+const PLANT_OUT: [&str; 10] = ["p1", "p2", "p3", "p4", "valve.u", "cbv.u_cbv", "cylinder.x", "cylinder.v", "Q3", "Q4"];
+/// The CBV counts as open above this opening (`metrics.CBV_OPEN`).
+const CBV_OPEN: f64 = 1e-6;
+
+/// The operator's reference: piecewise linear through the rows, right-continuous at repeated
+/// times, held outside (`cosim.reference`, the same operations in the same order).
+fn reference(table: &[(f64, f64)], t: f64) -> f64 {
+    let i = table.partition_point(|&(ti, _)| ti <= t);
+    if i == 0 {
+        return table[0].1;
+    }
+    if i >= table.len() {
+        return table[table.len() - 1].1;
+    }
+    let ((t0, u0), (t1, u1)) = (table[i - 1], table[i]);
+    u0 + (u1 - u0) * (t - t0) / (t1 - t0)
+}
+
+/// A Co-Simulation instance of `M` set up for [start, stop] without a tolerance, in
+/// Initialization Mode with the `start` values (by name) set.
+fn instance<M: Model>(start: f64, stop: f64, values: &Map<String, Json>) -> Result<Instance<M>, String> {
+    let log = Logger::new(None, M::INFO.identifier, &[], false);
+    let mut i = Instance::<M>::new(log, guid::<M>(), Version::Fmi2, Interface::CoSimulation);
+    i.setup_experiment(None, start, Some(stop))?;
+    i.enter_initialization_mode();
+    for (name, value) in values {
+        let v = M::VARIABLES
+            .iter()
+            .find(|v| v.name == name)
+            .ok_or_else(|| format!("{} has no variable \"{name}\"", M::INFO.identifier))?;
+        let bad = || format!("{name} = {value}: not a {:?}", v.base_type());
+        let x = match (v.base_type(), value) {
+            (BaseType::Real, Json::Number(n)) => Value::Real(n.as_f64().ok_or_else(bad)?),
+            (BaseType::Integer, Json::Number(n)) => {
+                Value::Integer(n.as_f64().map(|x| x as i32).ok_or_else(bad)?) // int() of cosim.FmuFile.set
+            }
+            (BaseType::Boolean, Json::Bool(b)) => Value::Boolean(*b),
+            _ => return Err(bad()),
+        };
+        i.set(&[v.vr], vec![x])?;
+    }
+    Ok(i)
+}
+
+fn get<M: Model>(i: &mut Instance<M>, vrs: &[u32]) -> Result<Vec<f64>, String> {
+    let mut out = vec![0.0; vrs.len()];
+    i.get(vrs, &mut out, BaseType::Real, |v| if let Value::Real(x) = v { *x } else { f64::NAN })?;
+    Ok(out)
+}
+
+fn set<M: Model>(i: &mut Instance<M>, vrs: &[u32], xs: &[f64]) -> Result<(), String> {
+    i.set(vrs, xs.iter().map(|&x| Value::Real(x)).collect())
+}
+
+fn step<M: Model>(i: &mut Instance<M>, t: f64, h: f64) -> Result<(), String> {
+    match i.do_step(t, h)? {
+        Step::Done(_) => Ok(()),
+        Step::Discarded(why) => Err(format!("fmi2DoStep of {} at t = {t} discarded: {why}", M::INFO.identifier)),
+    }
+}
+
+/// Runs the co-simulation the JSON `request` describes; returns the header and the rows.
+pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
+    let field = |k: &str| request.get(k).ok_or_else(|| format!("the request has no \"{k}\""));
+    let num = |k: &str| field(k)?.as_f64().ok_or_else(|| format!("\"{k}\" must be a number"));
+    let (t_end, h) = (num("stop_time")?, num("step")?);
+    let record_every = num("record_every")? as usize;
+    let interpolate = field("interpolate")?.as_bool().ok_or("\"interpolate\" must be true or false")?;
+    let enable = field("enable")?.as_bool().ok_or("\"enable\" must be true or false")?;
+    let cbv_open = field("feedback_start")? == "cbv_open";
+    let table: Vec<(f64, f64)> = field("reference")?
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|r| Some((r.get(0)?.as_f64()?, r.get(1)?.as_f64()?)))
+        .collect();
+    let map = |k: &str| field(k)?.as_object().cloned().ok_or_else(|| format!("\"{k}\" must be an object"));
+    let (plant_start, ctrl_start) = (map("plant")?, map("controller")?);
+    if table.is_empty() || !(h > 0.0 && t_end > 0.0 && record_every > 0) {
+        return Err("the request needs a reference, step > 0, stop_time > 0 and record_every > 0".into());
+    }
+    let n = (t_end / h).round() as usize;
+
+    let plant_vr = vr_of::<HydraulicBoom>;
+    let (vr_p4, vr_u, vr_rhs) = (plant_vr("p4")?, plant_vr("valve.u_ref")?, plant_vr("solver.rhs_evals")?);
+    let mut plant = instance::<HydraulicBoom>(0.0, t_end, &plant_start)?;
+    plant.exit_initialization_mode()?;
+    let mut p4 = get(&mut plant, &[vr_p4])?[0];
+    // (Re-)initialises the controller at t0 from rest at the present p4 (`init_controller`).
+    let controller = |t0: f64, feedback: bool, p4: f64| -> Result<Instance<PressureFeedbackController>, String> {
+        let mut c = instance::<PressureFeedbackController>(t0, t_end, &ctrl_start)?;
+        c.set(&[pfc::ENABLE], vec![Value::Boolean(feedback)])?;
+        set(&mut c, &[pfc::P, pfc::U_REF], &[p4, reference(&table, t0)])?;
+        c.exit_initialization_mode()?;
+        Ok(c)
+    };
+    let mut on = enable && !cbv_open;
+    let mut ctrl = controller(0.0, on, p4)?;
+    let mut feedback_on_at = if on { Some(0.0) } else { None };
+
+    let out_p: Vec<u32> = PLANT_OUT.iter().map(|name| plant_vr(name)).collect::<Result<_, _>>()?;
+    let (i_p4, i_cbv) = (3, 5);
+    let mut rows = Vec::with_capacity((n / record_every + 1) * (4 + PLANT_OUT.len()));
+    let mut y = get(&mut plant, &out_p)?;
+    let mut u_ref = reference(&table, 0.0);
+    for k in 0..=n {
+        let t = k as f64 * h;
+        let uc = get(&mut ctrl, &[pfc::U, pfc::U_COMP])?;
+        set(&mut plant, &[vr_u], &[uc[0]])?;
+        if k % record_every == 0 {
+            rows.extend_from_slice(&[t, u_ref, uc[1], uc[0]]);
+            rows.extend_from_slice(&y);
+        }
+        if k == n {
+            break;
+        }
+        step(&mut plant, t, h)?;
+        y = get(&mut plant, &out_p)?;
+        let p4_next = y[i_p4];
+        if interpolate {
+            ctrl.set_input_derivatives(&[pfc::P], &[1], &[(p4_next - p4) / h])?;
+        }
+        step(&mut ctrl, t, h)?;
+        p4 = p4_next;
+        u_ref = reference(&table, t + h);
+        if enable && !on && y[i_cbv] > CBV_OPEN {
+            on = true;
+            feedback_on_at = Some(t + h);
+            ctrl = controller(t + h, true, p4)?;
+        }
+        set(&mut ctrl, &[pfc::P, pfc::U_REF], &[p4, u_ref])?;
+    }
+    let rhs = get(&mut plant, &[vr_rhs])?[0];
+    let columns = 4 + PLANT_OUT.len();
+    let header =
+        json!({"rows": rows.len() / columns, "columns": columns, "rhs": rhs, "feedback_on_at": feedback_on_at});
+    Ok((header, rows))
+}
+
+fn vr_of<M: Model>(name: &str) -> Result<u32, String> {
+    M::VARIABLES
+        .iter()
+        .find(|v| v.name == name)
+        .map(|v| v.vr)
+        .ok_or_else(|| format!("{} has no variable \"{name}\"", M::INFO.identifier))
+}
+
+/// `boomsim cosim`: the request from stdin, the result to stdout.
+pub fn main() -> Result<(), String> {
+    let request: Json = serde_json::from_reader(std::io::stdin().lock()).map_err(|e| format!("the request: {e}"))?;
+    let (header, rows) = run(&request)?;
+    let mut out = std::io::stdout().lock();
+    let bytes: Vec<u8> = rows.iter().flat_map(|x| x.to_le_bytes()).collect();
+    writeln!(out, "{header}").and_then(|()| out.write_all(&bytes)).map_err(|e| e.to_string())
+}
