@@ -166,3 +166,41 @@ fn plot(root: &Path, dir: &Path) -> Result<(), String> {
         Err(format!("plot_analysis.py failed ({status}); the CSV files are written"))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::LPM;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: AnalyzeArgs,
+    }
+
+    fn op(args: &str) -> Result<OperatingPoint, String> {
+        Cli::try_parse_from(format!("analyze {args}").split_whitespace())
+            .map_err(|e| e.to_string())?
+            .args
+            .operating_point()
+    }
+
+    /// `--payload`: at Table 6.1's stroke the rigid boom's static force over g is the 2456 kg the
+    /// table implies (1 %: section "Table 6.1's hidden inputs"), and the effective mass is larger
+    /// (the payload and arm swing about the joint, the cylinder's lever is short). `--q4`: the
+    /// steady state carries that flow, Q3 = Q4 / mu_c (continuity, eq. 2.70, 2.71 at rest;
+    /// 1e-9: the bisection's tolerance). Bad values are refused with the option's name.
+    #[test]
+    fn payload_and_flow_give_the_operating_point() {
+        let g = BoomParams::default().g;
+        let p = op("--xc 250 --payload 382.6").unwrap();
+        assert!((p.load / g / 2456.0 - 1.0).abs() < 0.01, "{}", p.load / g);
+        assert!(p.mass > p.load / g);
+        let p = op("--xc 480 --payload 382.6 --q4 1.25").unwrap();
+        assert!((p.flow().unwrap() * p.mu_c / (1.25 * LPM) - 1.0).abs() < 1e-9);
+        assert!(op("--payload 2500").unwrap_err().contains("--payload 2500 kg is outside [0, 2000] kg"));
+        assert!(op("--q4 0").unwrap_err().contains("--q4 0 l/min must be > 0"));
+        assert!(op("--payload 300 --mass 2000").is_err());
+    }
+}
