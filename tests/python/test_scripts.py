@@ -69,6 +69,7 @@ def test_ssp_refuses_an_unknown_fmi_version_in_one_line():
     ("bench_fmpy.py", ["--bogus"], "unrecognized arguments: --bogus"),
     ("bench_fmpy.py", ["--cycles", "0"], "--cycles 0: must be at least 1"),
     ("instability.py", ["--bogus"], "unrecognized arguments: --bogus"),
+    ("bench_sweep.py", ["--repeat", "0"], "--duration must be > 0 and --repeat at least 1"),
 ])
 def test_the_benchmark_and_study_scripts_refuse_bad_arguments_in_one_line(script, args, says):
     """bench_fmpy.py took no arguments and ignored any it was given."""
