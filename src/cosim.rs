@@ -1,8 +1,9 @@
 //! `boomsim cosim`: the co-simulation of `scripts/cosim.py`'s `run` (HydraulicBoom and
 //! PressureFeedbackController, FMI 2.0 Co-Simulation, Gauss-Seidel, p4 interpolated in the
 //! controller) with the FMI layer called in-process instead of through fmpy: the native runner of
-//! the sweeps. The same calls in the same order with the same arguments, so the recorded rows are
-//! the Python runner's bit for bit (tests/python/test_sweep.py).
+//! the sweeps. The same calls with the same arguments in the same order from the end of
+//! initialisation on (the start values are set in Initialization Mode, where their order does not
+//! matter), so the recorded rows are the Python runner's bit for bit (tests/python/test_sweep.py).
 //!
 //! Input (stdin, JSON): `stop_time`, `step`, `record_every`, `interpolate`, `feedback_start`
 //! ("t0" or "cbv_open"), `enable`, `reference` ([[t, u_ref], ...]), `plant` and `controller`
