@@ -28,6 +28,15 @@ pub struct Dcv {
     /// Laminar leakage coefficient `dQ_L` (m^3/(s Pa)): 25 cm^3/min at 100 bar = 4.17e-14
     /// (data sheet, Table D.1; eq. 2.46-2.48).
     pub dq_leak: f64,
+    /// Gain of the PVES spool position loop (rad/s); 0 selects the thesis' first-order lag
+    /// (eq. 2.45) instead. See [`Dcv::spool_rate`].
+    pub omega_loop: f64,
+    /// Largest spool speed away from neutral (m/s) with the position loop: full travel in the
+    /// rated reaction time neutral -> max, 7 mm / 0.120 s (Table 4.2).
+    pub v_open: f64,
+    /// Largest spool speed toward neutral (m/s) with the position loop: 7 mm / 0.090 s, the
+    /// rated reaction time max -> neutral (Table 4.2).
+    pub v_close: f64,
 }
 
 impl Dcv {
@@ -53,13 +62,30 @@ impl Dcv {
         }
     }
 
-    /// Spool velocity of the first-order lag `G_v(s) = 1 / (s / omega_v + 1)` (eq. 2.45)
-    /// acting on the spool position: `dx_v/dt = omega_v * (x_ref(u_ref) - x_v)`.
+    /// Spool velocity toward the demanded position `x_ref(u_ref)`, by one of two models:
     ///
-    /// The thesis applies the lag to the opening (3.2.2); applying it to the spool position
-    /// makes the spool cross the dead band, which delays the flow after a step as on the rig.
+    /// - `omega_loop = 0` (default): the first-order lag `G_v(s) = 1 / (s / omega_v + 1)` of
+    ///   eq. 2.45 acting on the spool position, `dx_v/dt = omega_v (x_ref - x_v)`. The thesis
+    ///   applies the lag to the opening (3.2.2); applying it to the spool position makes the
+    ///   spool cross the dead band, which delays the flow after a step as on the rig.
+    /// - `omega_loop > 0`: the PVES electronics, which hold the spool at its demanded position
+    ///   with their own closed loop (4.2.1; the data sheet's spool travel is proportional to the
+    ///   signal), driven by pilot flow: `dx_v/dt = omega_loop (x_ref - x_v)`, limited to
+    ///   `v_open` away from neutral and `v_close` toward it, the speeds that cover the 7 mm travel
+    ///   in Table 4.2's rated reaction times. A large step is then a ramp that takes the rated
+    ///   reaction time, as eq. 2.45's settling time assumes, while a small correction is
+    ///   followed within a few `1 / omega_loop`, where eq. 2.45 lags it by `1 / omega_v` = 30 ms.
+    ///   Neither the thesis nor the data sheet gives the loop's gain; from about 1000 rad/s on
+    ///   the speed limits decide (README, model notes, "Valve electronics").
     pub fn spool_rate<T: Scalar>(&self, x_v: T, u_ref: T) -> T {
-        (self.spool_reference(u_ref) - x_v) * self.omega_v
+        let error = self.spool_reference(u_ref) - x_v;
+        if self.omega_loop == 0.0 {
+            return error * self.omega_v;
+        }
+        let rate = error * self.omega_loop;
+        let toward_neutral = (rate < 0.0 && x_v > 0.0) || (rate > 0.0 && x_v < 0.0);
+        let limit = if toward_neutral { self.v_close } else { self.v_open };
+        clamp(rate, -limit, limit)
     }
 
     /// Main spool opening from the spool travel, eq. 2.44, branch by branch:
@@ -166,6 +192,42 @@ mod tests {
         // explicit Euler with 1 us steps: relative error ~ omega dt / 2 = 2e-5
         let expected = d.x_max * (1.0 - (-1.0f64).exp());
         assert!((x / expected - 1.0).abs() < 1e-4);
+    }
+
+    /// Integrates the spool from `x0` toward `u_ref` with 1 us explicit Euler steps and returns
+    /// the time at which it first comes within `tol` of `target`.
+    fn time_to(d: &Dcv, x0: f64, u_ref: f64, target: f64, tol: f64) -> f64 {
+        let (mut x, mut t, dt) = (x0, 0.0, 1e-6);
+        while (x - target).abs() > tol {
+            x += dt * d.spool_rate(x, u_ref);
+            t += dt;
+            assert!(t < 1.0, "the spool never reached {target}");
+        }
+        t
+    }
+
+    /// The PVES position loop (`valve.omega_loop` > 0). A full step is a ramp at the speeds of
+    /// Table 4.2, so the spool covers 98 % of its 7 mm travel (the 2 % settling of eq. 2.45's
+    /// 4 time constants) in 98 % of the rated reaction times, 0.120 s out of neutral and 0.090 s
+    /// back: the loop leaves the speed limit only within v / omega_loop <= 0.08 mm, less than the
+    /// 0.14 mm band. A small correction stays below the limits and decays as e^(-omega_loop t).
+    #[test]
+    fn pves_position_loop_table_4_2() {
+        let d = Dcv { omega_loop: 1000.0, ..Circuit::default().dcv };
+        let tol = 0.02 * d.x_max;
+        // Euler with 1 us steps: the ramp's time is exact to a step or two
+        assert!((time_to(&d, 0.0, 1.0, d.x_max, tol) - 0.98 * 0.120).abs() < 3e-6);
+        assert!((time_to(&d, 0.0, -1.0, -d.x_max, tol) - 0.98 * 0.120).abs() < 3e-6);
+        assert!((time_to(&d, d.x_max, 0.0, 0.0, tol) - 0.98 * 0.090).abs() < 3e-6);
+        assert!((time_to(&d, -d.x_max, 0.0, 0.0, tol) - 0.98 * 0.090).abs() < 3e-6);
+        // a 0.02 mm correction at 3 mm: error e^-1 after one 1/omega_loop = 1 ms
+        let u_ref = d.opening(mm(3.02));
+        let t = time_to(&d, mm(3.0), u_ref, mm(3.02), mm(0.02) * (-1.0f64).exp());
+        assert!((t - 1e-3).abs() < 3e-6, "{t}");
+        // the thesis' lag needs 1/omega_v = 30 ms for the same correction
+        let lag = Circuit::default().dcv;
+        let t = time_to(&lag, mm(3.0), u_ref, mm(3.02), mm(0.02) * (-1.0f64).exp());
+        assert!((t - 1.0 / lag.omega_v).abs() < 3e-5, "{t}");
     }
 
     /// Solves the shorted circuit of Fig. 2.11 (P->A shorted to B->T, fully open spool,

@@ -173,6 +173,12 @@ mod tests {
             assert_eq!(stated[k], printed, "at {} bar: the law gives {reduction} %", p / 1e5);
             assert_eq!(stated[AIR_PRESSURES.len() + k], p / 1e5);
         }
+        // the comparison with Simscape's default air content, 0.5 %
+        let line = readme.lines().find(|l| l.contains("0.5 % would soften it by")).expect("the 0.5 % comparison");
+        let stated: f64 = line.split("soften it by ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+        let simscape = Fluid { air_fraction: 5e-3, ..f };
+        let reduction = 100.0 * (1.0 - simscape.bulk_modulus(AIR_PRESSURES[0]) / f.beta);
+        assert_eq!(stated, format!("{reduction:.1}").parse::<f64>().unwrap(), "the law gives {reduction} %");
     }
 
     /// Oil mass conservation and the vacuum bound: integrate a volume driven by a prescribed

@@ -442,7 +442,7 @@ pub const PARAMS: &[Param] = &[
         "%",
         [1e-7, 0.2],
         "Free air per oil volume at atmospheric pressure (cavitation model)",
-        "not in the thesis (constant bulk modulus): an assumed 0.1 %; README, model notes, Cavitation"
+        "not in the thesis (constant bulk modulus); a fifth of Simscape's 0.5 % for the same law: README, Cavitation"
     ),
     param!(
         "line.v_l1",
@@ -504,6 +504,36 @@ pub const PARAMS: &[Param] = &[
         "Transition pressure of the regularised orifice root",
         "not in the thesis: regularisation, exact root above it"
     ),
+    param!(
+        "valve.omega_loop",
+        dcv.omega_loop,
+        0.0,
+        "rad/s",
+        "",
+        [0.0, 1e4],
+        "Gain of the PVES spool position loop; 0 = the first-order lag of eq. 2.45 (valve.omega_v)",
+        "4.2.1 (internal spool position control); gain not in the thesis or data sheet: README, Valve electronics"
+    ),
+    param!(
+        "valve.v_open",
+        dcv.v_open,
+        7.0 * MM / 0.120,
+        "m/s",
+        "mm/s",
+        [1.0 * MM, 10.0],
+        "Largest spool speed away from neutral, with valve.omega_loop > 0",
+        "Table 4.2: 7 mm in the rated reaction time neutral -> max, 0.120 s"
+    ),
+    param!(
+        "valve.v_close",
+        dcv.v_close,
+        7.0 * MM / 0.090,
+        "m/s",
+        "mm/s",
+        [1.0 * MM, 10.0],
+        "Largest spool speed toward neutral, with valve.omega_loop > 0",
+        "Table 4.2: 7 mm in the rated reaction time max -> neutral, 0.090 s"
+    ),
 ];
 
 impl Default for Circuit {
@@ -512,7 +542,17 @@ impl Default for Circuit {
         let mut c = Circuit {
             supply: Supply { p_s: 0.0, p_t: 0.0 },
             pcv: Pcv { p_spring: 0.0, p_fc: 0.0, q_nom: 0.0, dp_nom: 0.0 },
-            dcv: Dcv { x_max: 0.0, x_db: 0.0, omega_v: 0.0, q_rated: 0.0, dp_rated: 0.0, dq_leak: 0.0 },
+            dcv: Dcv {
+                x_max: 0.0,
+                x_db: 0.0,
+                omega_v: 0.0,
+                q_rated: 0.0,
+                dp_rated: 0.0,
+                dq_leak: 0.0,
+                omega_loop: 0.0,
+                v_open: 0.0,
+                v_close: 0.0,
+            },
             cbv: Cbv {
                 p_cv: 0.0,
                 p_fo_cv: 0.0,

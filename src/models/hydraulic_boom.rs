@@ -64,7 +64,8 @@ const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .build();
 
 const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
-PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48), counterbalance valve with check valve and
+PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48; with <code>valve.omega_loop</code> &gt; 0 the
+PVES's own position loop, speed-limited by the reaction times of Table 4.2), counterbalance valve with check valve and
 piloted load-holding valve (eq. 2.55-2.59), asymmetric cylinder with end stops and friction (eq. 2.60-2.65), line
 volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving the boom, by default the lumped flexible
 arm of sections 2.1.4 and 3.1.2 (<code>boom.n2</code> + <code>boom.n3</code> sections, eq. 2.34-2.39), or with
@@ -83,7 +84,8 @@ its angle theta2 in every slot (Co-Simulation integrates it in the stroke). Thre
 right-hand side jumps: the spool reference through zero (the dead band) and the spool at either edge of the dead
 band (the load-sensing switch), readable as <code>event.spool_reference</code>, <code>event.dead_band_upper</code> and
 <code>event.dead_band_lower</code>; elsewhere the model is continuous (regularised orifices and friction, end stops as
-stiff springs). Directional derivatives are exact (forward-mode dual numbers through the same equations).</p>"#;
+stiff springs), except that with <code>valve.omega_loop</code> &gt; 0 the spool's speed limit switches where a
+saturated spool passes neutral, inside the dead band, where no oil flows. Directional derivatives are exact (forward-mode dual numbers through the same equations).</p>"#;
 
 /// Circuit + boom as one ODE, with the operator's reference held.
 #[derive(Debug, Clone)]
