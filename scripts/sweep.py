@@ -19,6 +19,7 @@ Sweep file (TOML):
     K_f = {grid = [1e-11, 1.24e-11]}
     "fluid.beta" = {dist = "uniform", low = 1.2e9, high = 1.8e9}   # or {dist = "normal", mean, sd}
     n_omega = {grid = [1.0, 2.0]}   # filter factors, instead of K_f / omega_f (FACTORS)
+    step = {grid = [1e-3, 5e-3]}    # the communication step [s] (SETTINGS)
 The points are the product of the grids with the `samples` Monte Carlo draws (numpy
 default_rng(seed), parameters in file order). A point is identified by a hash of the scenario,
 boom, stop time and its parameter values, which `--resume` uses to skip finished points.
@@ -51,6 +52,8 @@ DISTS = {"uniform": ("low", "high"), "normal": ("mean", "sd")}
 #: controller parameter each sets: K_f = n_K C1 mu_c mu_p (thesis eq. 6.6), omega_f = n_omega
 #: omega_n (eq. 6.7), from `boomsim analyze` (`operating_point`).
 FACTORS = {"n_K": "K_f", "n_omega": "omega_f"}
+#: Sweepable settings of the co-simulation itself, passed to the runner by keyword.
+SETTINGS = {"step": "communication step [s]; the stop time must be a multiple of it"}
 #: How a point is co-simulated: fmpy on instances reused from point to point, or `boomsim cosim`.
 RUNNERS = {"fmpy": lambda *a, **k: cosim.run(*a, **k, reuse=True), "native": cosim.run_native}
 
@@ -91,8 +94,9 @@ def load(path) -> dict:
         raise UsageError(f"unknown runner \"{runner}\": {', '.join(RUNNERS)}")
     grids, dists = {}, {}
     for name, spec in params.items():
-        if name not in sweepable and name not in FACTORS:
-            raise UsageError(f"unknown parameter \"{name}\": {', '.join(sorted(sweepable + list(FACTORS)))}")
+        if name not in sweepable and name not in FACTORS and name not in SETTINGS:
+            known = sorted(sweepable + list(FACTORS) + list(SETTINGS))
+            raise UsageError(f"unknown parameter \"{name}\": {', '.join(known)}")
         if FACTORS.get(name) in params:
             raise UsageError(f"parameters \"{name}\" and \"{FACTORS[name]}\" both set {FACTORS[name]}: give one")
         if not isinstance(spec, dict) or ("grid" in spec) == ("dist" in spec):
@@ -184,11 +188,12 @@ def run_point(sweep: dict, point: dict) -> dict:
     worker). Any exception, fmpy's FMICallException of an fmi2Error/Discard included, gives a
     failed row with its message."""
     t0 = time.perf_counter()
-    params = {k: v for k, v in point.items() if k != "id" and k not in FACTORS}
+    params = {k: v for k, v in point.items() if k != "id" and k not in FACTORS and k not in SETTINGS}
+    settings = {k: v for k, v in point.items() if k in SETTINGS}
     row = {**point, **{m: None for m in sweep["metrics"]}, "status": "ok", "error": ""}
     try:
         res = RUNNERS[sweep["runner"]](sweep["scenario"], sweep["boom"], stop_time=sweep["stop_time"], params=params,
-                                       timeout=sweep["timeout"])
+                                       timeout=sweep["timeout"], **settings)
         m = metrics_mod.compute(res)
         row.update({k: m[k] for k in sweep["metrics"]})
     except Exception as e:  # noqa: BLE001 - every failure is a row

@@ -152,6 +152,18 @@ def test_a_point_beyond_its_timeout_is_a_failed_row(tmp_path):
     assert sweep.run_point({**s, "timeout": None}, s["points"][1])["status"] == "ok"
 
 
+def test_the_communication_step_is_a_sweep_parameter(tmp_path):
+    """`step` runs each point at its communication step: the rows equal cosim.run's metrics at
+    that step, and a step the stop time is not a multiple of is a failed row saying so."""
+    s = sweep.load(sweep_file(tmp_path, "step = {grid = [1e-3, 5e-3, 3e-3]}\n"))
+    rows = [sweep.run_point(s, p) for p in s["points"]]
+    for p, row in zip(s["points"][:2], rows):
+        ref = metrics.compute(cosim.run(s["scenario"], "rigid", step=p["step"], stop_time=1.0))
+        assert row["status"] == "ok" and {m: row[m] for m in METRICS} == {m: ref[m] for m in METRICS}
+    assert rows[0]["p3_pp_max"] != rows[1]["p3_pp_max"]
+    assert rows[2]["status"] == "failed" and "not a multiple of the step 0.003" in rows[2]["error"]
+
+
 def test_reused_instances_give_the_fresh_results_bit_for_bit():
     """fmi2Reset returns an instance to its state after instantiation: every parameter a run set
     before (fluid.beta, cbv.mu_p, the filter) is back at its start value. A sequence of runs on
