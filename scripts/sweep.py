@@ -5,7 +5,7 @@ Usage:
     .venv/bin/python scripts/sweep.py scripts/sweeps/filter.toml [--workers N]
         [--scheduler ADDRESS] [--resume] [--out DIR]
 writes DIR/results/*.parquet (one file per batch of finished points), DIR/summary.md and, when
-exactly two parameters vary on a grid, DIR/heatmap.png of the first metric over them.
+two or more parameters vary on a grid, maps DIR/map-<metric>.png (scripts/sweep_summary.py).
 
 Sweep file (TOML):
     scenario = "B"            # an id of scripts/scenarios/ (or a .toml path), as cosim.py takes

@@ -1,7 +1,7 @@
 """The outputs of a sweep (scripts/sweep.py): DIR/summary.md (points, failures, the metrics'
 min / median / max over the points that ran) and maps of p3_pp_late and t_settle (else the first
 metric) over two grid parameters, DIR/map-<metric>.png: over (n_K, n_omega) when both are grids,
-else when exactly two parameters vary on a grid.
+else over the first two parameters that vary on a grid.
 
 A cell of a map holds the worst value (the largest; "not settled" for t_settle when any point
 has none; blank when any point failed) over the points that share its two values and its panel:
@@ -57,7 +57,7 @@ def map_axes(sweep: dict) -> list[str] | None:
     varying = [p for p, g in sweep["grids"].items() if len(g) > 1]
     if all(f in varying for f in ("n_K", "n_omega")):
         return ["n_K", "n_omega"]
-    return varying if len(varying) == 2 else None
+    return varying[:2] if len(varying) >= 2 else None
 
 
 class Grid:

@@ -40,18 +40,19 @@ def rows_by_id(s, out):
 
 
 def test_two_workers_give_the_serial_metrics_exactly(tmp_path):
-    f = sweep_file(tmp_path, "K_f = {grid = [1.0e-11, 1.24e-11]}\nomega_f = {grid = [30.0, 35.8]}\n")
+    f = sweep_file(tmp_path, "K_f = {grid = [1.0e-11, 1.24e-11]}\nomega_f = {grid = [30.0, 35.8]}\n"
+                             '"cbv.mu_p" = {grid = [3.0, 4.0]}\n')
     code, err = cli(f, "--workers", "2", "--out", tmp_path / "out")
     assert code == 0, err
     s = sweep.load(f)
     rows = rows_by_id(s, tmp_path / "out")
-    assert len(rows) == 4 and {r["status"] for r in rows.values()} == {"ok"}
+    assert len(rows) == 8 and {r["status"] for r in rows.values()} == {"ok"}
     assert "local" not in {r["worker"] for r in rows.values()}  # ran on the cluster
     for p in s["points"]:
         serial = sweep.run_point(s, p)
         assert serial["status"] == "ok" and serial["worker"] == "local"
         assert {m: rows[p["id"]][m] for m in METRICS} == {m: serial[m] for m in METRICS}
-    assert "4 of 4 points run, 0 failed" in (tmp_path / "out" / "summary.md").read_text()
+    assert "8 of 8 points run, 0 failed" in (tmp_path / "out" / "summary.md").read_text()
     assert (tmp_path / "out" / "map-p3_pp_late.png").exists()
 
 
