@@ -124,3 +124,20 @@ fn bad_solver_settings_are_refused() {
         refuse::<BoomMechanics>(vr, x, says);
     }
 }
+
+/// The README's table of the real-time mode states the RHS evaluations per doStep of `boomsim
+/// bench --realtime` (10 identical runs of 10 s; their quantiles are those of one run) and its
+/// count of inaccurate closing steps: they must be this code's.
+#[test]
+fn readme_states_the_counts_of_the_benchmark() {
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    for d in boomsim::bench::step_distributions(1, 10.0).unwrap() {
+        let rhs = d.rhs.map(|x| format!("{x}")).join(" / ");
+        let row = format!("| {} | {} | {} | {rhs} |", d.case, d.boom, d.mode);
+        assert!(readme.contains(&row), "README, Real-time mode: no row {row}");
+        if d.inaccurate > 0 {
+            let says = format!("{} closing steps above the tolerance in 10^5 doSteps", 10 * d.inaccurate);
+            assert!(readme.contains(&says), "README, Real-time mode: {says} ({} {})", d.case, d.boom);
+        }
+    }
+}
