@@ -71,10 +71,11 @@ pub(crate) const SOLVER_LOCALS: [Variable; 8] = [
     Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
     Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
     Variable::int_param("solver.mode", vr::SOLVER_MODE, 0, (0, 1),
-        "Integrator of fmi2DoStep: 0 adaptive (error control with the tolerance of fmi2SetupExperiment, as many steps \
-         as that needs), 1 real-time (the same within solver.rhs_budget right-hand-side evaluations per communication \
-         step, a bounded cost: when the budget runs short, one closing step of bounded work reaches the communication \
-         point and its accuracy is reported in solver.accuracy_loss instead of a rejected step)"),
+        "Integrator of the Co-Simulation doStep (no effect in Model Exchange): 0 adaptive (error control with the \
+         experiment's tolerance, as many steps as that needs), 1 real-time (the same within solver.rhs_budget \
+         right-hand-side evaluations per communication step, a bounded cost: when the budget runs short, one closing \
+         step of bounded work reaches the communication point and its accuracy is reported in solver.accuracy_loss \
+         instead of a rejected step)"),
     Variable::int_param("solver.rhs_budget", vr::RHS_BUDGET, 400, (100, 1_000_000),
         "Real-time mode: right-hand-side evaluations (Jacobian columns included) per communication step, at most"),
     Variable::real_local("solver.accuracy_loss", vr::ACCURACY_LOSS, "1", "",
