@@ -162,6 +162,17 @@ impl Importer {
 /// fmi2Instantiate, fmi2SetupExperiment and the initialisation, with `boom.flexible` set in
 /// initialisation mode when `flexible` is given: an instance ready to step at t = 0.
 unsafe fn initialized<M: Model>(imp: &Importer, flexible: Option<bool>) -> fmi2Component {
+    let c = initializing::<M>(imp);
+    if let Some(f) = flexible {
+        let b = if f { FMI2_TRUE } else { FMI2_FALSE };
+        assert_eq!(api::set_boolean::<M>(c, &FLEXIBLE, 1, &b), OK);
+    }
+    assert_eq!(api::exit_initialization_mode::<M>(c), OK);
+    c
+}
+
+/// fmi2Instantiate, fmi2SetupExperiment and fmi2EnterInitializationMode.
+unsafe fn initializing<M: Model>(imp: &Importer) -> fmi2Component {
     let c = api::instantiate::<M>(
         imp.name.as_ptr(),
         FMI2_COSIMULATION,
@@ -174,11 +185,6 @@ unsafe fn initialized<M: Model>(imp: &Importer, flexible: Option<bool>) -> fmi2C
     assert!(!c.is_null(), "fmi2Instantiate of {}", M::INFO.identifier);
     assert_eq!(api::setup_experiment::<M>(c, 0, 0.0, 0.0, 0, 0.0), OK);
     assert_eq!(api::enter_initialization_mode::<M>(c), OK);
-    if let Some(f) = flexible {
-        let b = if f { FMI2_TRUE } else { FMI2_FALSE };
-        assert_eq!(api::set_boolean::<M>(c, &FLEXIBLE, 1, &b), OK);
-    }
-    assert_eq!(api::exit_initialization_mode::<M>(c), OK);
     c
 }
 
@@ -338,17 +344,7 @@ fn real_time_steps(cycles: usize) -> (Run, f64) {
     use boomsim::models::hydraulic_boom::vr as hb;
     let imp = Importer::of::<HydraulicBoom>();
     unsafe {
-        let c = api::instantiate::<HydraulicBoom>(
-            imp.name.as_ptr(),
-            FMI2_COSIMULATION,
-            imp.guid.as_ptr(),
-            std::ptr::null(),
-            &imp.callbacks,
-            0,
-            0,
-        );
-        assert_eq!(api::setup_experiment::<HydraulicBoom>(c, 0, 0.0, 0.0, 0, 0.0), OK);
-        assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(c), OK);
+        let c = initializing::<HydraulicBoom>(&imp);
         let (refs, ints) = ([hb::SOLVER_MODE, hb::RHS_BUDGET], [1, 100]);
         assert_eq!(api::set_integer::<HydraulicBoom>(c, refs.as_ptr(), 2, ints.as_ptr()), OK);
         assert_eq!(api::set_real::<HydraulicBoom>(c, &hb::U_REF, 1, &-0.1), OK);
