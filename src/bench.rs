@@ -195,13 +195,13 @@ pub const RTOL: f64 = 1e-6;
 /// Case U (section 7.1): lowering from 480 mm with u = -0.1, no compensation, `duration` s.
 pub fn case_u(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
     plant.set(hb::U_REF, -0.1)?;
-    steps(plant, None, duration, None)
+    steps(plant, None, 0.0, duration, None)
 }
 
 /// Case R, the cost floor of a communication step: the load held at rest (spool closed, every
 /// value at its start), `duration` s of 1 ms doSteps in which nothing happens.
 pub fn case_rest(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
-    steps(plant, None, duration, None)
+    steps(plant, None, 0.0, duration, None)
 }
 
 /// Case B (Table 7.2): lowering with u_ref = -0.05 through the controller with the experiment-B
@@ -209,21 +209,23 @@ pub fn case_rest(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
 /// feedthrough, so there is no algebraic loop).
 pub fn case_b(plant: &mut dyn Slave, controller: &mut dyn Slave, duration: f64) -> Result<(), String> {
     controller.set(pfc::U_REF, -0.05)?;
-    steps(plant, Some(controller), duration, None)
+    steps(plant, Some(controller), 0.0, duration, None)
 }
 
-/// `duration` s of 1 ms communication steps of `plant`, coupled to `controller` if given (case
-/// B); with `record`, each plant doStep's wall and thread CPU time [s] and RHS evaluations.
+/// `duration` s of 1 ms communication steps of `plant` from `t0`, coupled to `controller` if
+/// given (case B); with `record`, each plant doStep's wall and thread CPU time [s] and RHS
+/// evaluations.
 fn steps(
     plant: &mut dyn Slave,
     mut controller: Option<&mut dyn Slave>,
+    t0: f64,
     duration: f64,
     mut record: Option<&mut Vec<[f64; 3]>>,
 ) -> Result<(), String> {
     let n = (duration / STEP).round() as usize;
-    let mut rhs = 0.0;
+    let mut rhs = if record.is_some() { plant.get(hb::SOLVER_RHS)? } else { 0.0 };
     for k in 0..n {
-        let t = k as f64 * STEP;
+        let t = t0 + k as f64 * STEP;
         if let Some(c) = controller.as_deref_mut() {
             c.set(pfc::P, plant.get(hb::P4)?)?;
             plant.set(hb::U_REF, c.get(pfc::U)?)?;
@@ -278,14 +280,35 @@ pub struct StepDistribution {
     pub inaccurate: u64,
 }
 
-/// Cases U and B with the rigid and the flexible boom, adaptive and real-time (`solver.mode`
-/// 0 and 1, default `solver.rhs_budget`), each run `repeats` times from the start for `duration`
-/// s on fresh instances (in-process): the distribution of the plant's doStep over all of them.
+/// Case "random", the worst case of a hardware-in-the-loop run: the operator's reference switched
+/// every 0.5 s to a value drawn uniformly from [-1, 1] (a fixed-seed linear congruential
+/// generator), lifting when the stroke is below 150 mm and lowering above 600 mm, `duration` s.
+fn case_random(plant: &mut dyn Slave, duration: f64, record: &mut Vec<[f64; 3]>) -> Result<(), String> {
+    let mut seed = 12345u64;
+    for k in 0..(duration / 0.5).round() as usize {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let x = plant.get(hb::X)?;
+        plant.set(hb::U_REF, if x < 0.15 { u.abs() } else if x > 0.6 { -u.abs() } else { u })?;
+        steps(plant, None, k as f64 * 0.5, 0.5, Some(record))?;
+    }
+    Ok(())
+}
+
+/// Cases U, B (rigid and flexible boom) and random (flexible), adaptive and real-time
+/// (`solver.mode` 0 and 1, default `solver.rhs_budget`), each run `repeats` times from the start
+/// for `duration` s on fresh instances (in-process): the distribution of the plant's doStep over
+/// all of them.
 pub fn step_distributions(repeats: usize, duration: f64) -> Result<Vec<StepDistribution>, String> {
     let mut out = Vec::new();
-    for (case, boom, flexible) in
-        [("U", "rigid", false), ("B", "rigid", false), ("U", "flexible", true), ("B", "flexible", true)]
-    {
+    let cases = [
+        ("U", "rigid", false),
+        ("B", "rigid", false),
+        ("U", "flexible", true),
+        ("B", "flexible", true),
+        ("random", "flexible", true),
+    ];
+    for (case, boom, flexible) in cases {
         for (mode, code) in [("adaptive", 0), ("realtime", 1)] {
             let start = [(hb::FLEXIBLE, Value::Boolean(flexible)), (hb::SOLVER_MODE, Value::Integer(code))];
             let (mut record, mut inaccurate) = (Vec::with_capacity(repeats * (duration / STEP) as usize), 0);
@@ -293,12 +316,14 @@ pub fn step_distributions(repeats: usize, duration: f64) -> Result<Vec<StepDistr
                 let mut p = InProcess::<HydraulicBoom>::new(RTOL, &start)?;
                 if case == "U" {
                     p.set(hb::U_REF, -0.1)?;
-                    steps(&mut p, None, duration, Some(&mut record))?;
-                } else {
+                    steps(&mut p, None, 0.0, duration, Some(&mut record))?;
+                } else if case == "B" {
                     let c_start = [(pfc::P, Value::Real(p.get(hb::P4)?))];
                     let mut c = InProcess::<PressureFeedbackController>::new(RTOL, &c_start)?;
                     c.set(pfc::U_REF, -0.05)?;
-                    steps(&mut p, Some(&mut c), duration, Some(&mut record))?;
+                    steps(&mut p, Some(&mut c), 0.0, duration, Some(&mut record))?;
+                } else {
+                    case_random(&mut p, duration, &mut record)?;
                 }
                 inaccurate += p.get(hb::INACCURATE_STEPS)? as u64;
             }

@@ -47,8 +47,9 @@ enum Cmd {
         #[arg(long)]
         model_exchange: bool,
         /// Instead: the distribution of one doStep's wall time, thread CPU time and RHS
-        /// evaluations (median, p99, p99.9, max) in cases U and B, rigid and flexible, adaptive
-        /// and real-time (`solver.mode`), over `--repeats` runs of `--duration` s (in-process).
+        /// evaluations (median, p99, p99.9, max) in cases U and B, rigid and flexible, and with
+        /// the spool reference switched at random every 0.5 s (flexible), adaptive and real-time
+        /// (`solver.mode`), over `--repeats` runs of `--duration` s (in-process).
         #[arg(long)]
         realtime: bool,
         /// Runs per case of `--realtime`, > 0.
@@ -203,13 +204,13 @@ fn bench_realtime(repeats: usize, duration: f64) -> Result<(), String> {
          wall and thread CPU time [us] and RHS evaluations per doStep (median / p99 / p99.9 / max)"
     );
     println!(
-        "{:<5} {:<8} {:<8} {:>7}  {:>27}  {:>27}  {:>19}  {:>7}  {:>10}",
+        "{:<6} {:<8} {:<8} {:>7}  {:>27}  {:>27}  {:>19}  {:>7}  {:>10}",
         "case", "boom", "mode", "doSteps", "wall us", "CPU us", "RHS", "p99.9 %", "inaccurate"
     );
     let row = |q: [f64; 4], p: usize| q.map(|x| format!("{x:.p$}")).join(" / ");
     for d in boomsim::bench::step_distributions(repeats, duration)? {
         println!(
-            "{:<5} {:<8} {:<8} {:>7}  {:>27}  {:>27}  {:>19}  {:>7.1}  {:>10}",
+            "{:<6} {:<8} {:<8} {:>7}  {:>27}  {:>27}  {:>19}  {:>7.1}  {:>10}",
             d.case,
             d.boom,
             d.mode,
