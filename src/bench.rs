@@ -285,12 +285,13 @@ pub struct StepDistribution {
 /// generator), lifting when the stroke is below 150 mm and lowering above 600 mm, `duration` s.
 fn case_random(plant: &mut dyn Slave, duration: f64, record: &mut Vec<[f64; 3]>) -> Result<(), String> {
     let mut seed = 12345u64;
-    for k in 0..(duration / 0.5).round() as usize {
+    for k in 0..(duration / 0.5).ceil() as usize {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
         let x = plant.get(hb::X)?;
         plant.set(hb::U_REF, if x < 0.15 { u.abs() } else if x > 0.6 { -u.abs() } else { u })?;
-        steps(plant, None, k as f64 * 0.5, 0.5, Some(record))?;
+        let t0 = k as f64 * 0.5;
+        steps(plant, None, t0, (duration - t0).min(0.5), Some(record))?;
     }
     Ok(())
 }
