@@ -6,6 +6,9 @@ scripts/baselines/tolerances.toml and writes a Markdown report with the plots.
     scripts/regress --update        re-baseline (explicit, never automatic)
     scripts/regress --only B,U      a subset (ids)
     scripts/regress --step-sweep ""  without the sweep of the communication step (default: B)
+    scripts/regress --only U,B --step-sweep "" --param solver.mode=1 --rel 0.05 --out out/realtime
+                                    a variant with FMU parameters against the same baselines, each
+                                    metric within 5 % (+ its abs floor): the real-time mode's accuracy
 
 Report: out/regress/report.md (+ one PNG and CSV per variant).
 """
@@ -142,7 +145,18 @@ def main(argv=None) -> int:
     ap.add_argument("--step-sweep", default="B",
                     help="scenario id for the communication-step sweep (default B; '' skips it)")
     ap.add_argument("--out", default=str(OUT))
+    ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                    help="an FMU parameter for every variant (repeatable), e.g. solver.mode=1")
+    ap.add_argument("--rel", type=float, default=None,
+                    help="compare every metric within this relative tolerance (plus its abs floor) "
+                         "instead of tolerances.toml's")
     args = ap.parse_args(argv)
+    try:
+        params = {k: float(v) for k, v in (p.split("=", 1) for p in args.param)}
+    except ValueError:
+        ap.error(f"--param {' '.join(args.param)}: expected NAME=VALUE with a number")
+    if args.update and (params or args.rel is not None):
+        ap.error("--update writes the baselines of the default FMUs: no --param or --rel with it")
     only = {s for s in args.only.split(",") if s}
     unknown = sorted(only - set(cosim.scenario_ids()))
     if unknown:  # a filter that matches nothing must not pass (nor overwrite the report)
@@ -153,6 +167,8 @@ def main(argv=None) -> int:
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tol = load_tolerances()
+    if args.rel is not None:
+        tol = {k: {**rule, "rel": args.rel} for k, rule in tol.items()}
     info = fmu_info()
 
     results, failures, skipped, lines = {}, [], [], []
@@ -166,7 +182,7 @@ def main(argv=None) -> int:
             return f"[{k:2d}/{len(todo)} {time.time() - t_start:5.0f} s]"
 
         try:
-            res = cosim.run(sc, boom, feedback_start=fb)
+            res = cosim.run(sc, boom, feedback_start=fb, params=params)
         except cosim.Skip as e:
             skipped.append(f"{name}: {e}")
             print(f"{progress()} {name:18s} skipped: {e}")
@@ -216,6 +232,9 @@ def main(argv=None) -> int:
 def write_report(path, lines, results, failures, skipped, sweep, args, info, wall):
     r = ["# boomsim co-simulation regression report", ""]
     r.append("FMUs: " + ", ".join(f"{k} {v['version']} ({v['guid']})" for k, v in info.items()))
+    if args.param or args.rel is not None:
+        r.append(f"Parameters: {', '.join(args.param) or 'none'}; tolerance: "
+                 f"{'tolerances.toml' if args.rel is None else f'{args.rel:g} relative + the abs floors of tolerances.toml'}.")
     r.append(f"Mode: {'re-baseline (--update)' if args.update else 'compare with scripts/baselines/'}; "
              f"{len(results)} variants run, {len(skipped)} skipped, {len(failures)} regression(s); {wall:.0f} s.")
     r.append("")

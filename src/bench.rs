@@ -195,15 +195,13 @@ pub const RTOL: f64 = 1e-6;
 /// Case U (section 7.1): lowering from 480 mm with u = -0.1, no compensation, `duration` s.
 pub fn case_u(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
     plant.set(hb::U_REF, -0.1)?;
-    let n = (duration / STEP).round() as usize;
-    (0..n).try_for_each(|k| plant.step(k as f64 * STEP, STEP))
+    steps(plant, None, 0.0, duration, None)
 }
 
 /// Case R, the cost floor of a communication step: the load held at rest (spool closed, every
 /// value at its start), `duration` s of 1 ms doSteps in which nothing happens.
 pub fn case_rest(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
-    let n = (duration / STEP).round() as usize;
-    (0..n).try_for_each(|k| plant.step(k as f64 * STEP, STEP))
+    steps(plant, None, 0.0, duration, None)
 }
 
 /// Case B (Table 7.2): lowering with u_ref = -0.05 through the controller with the experiment-B
@@ -211,15 +209,131 @@ pub fn case_rest(plant: &mut dyn Slave, duration: f64) -> Result<(), String> {
 /// feedthrough, so there is no algebraic loop).
 pub fn case_b(plant: &mut dyn Slave, controller: &mut dyn Slave, duration: f64) -> Result<(), String> {
     controller.set(pfc::U_REF, -0.05)?;
+    steps(plant, Some(controller), 0.0, duration, None)
+}
+
+/// `duration` s of 1 ms communication steps of `plant` from `t0`, coupled to `controller` if
+/// given (case B); with `record`, each plant doStep's wall and thread CPU time [s] and RHS
+/// evaluations.
+fn steps(
+    plant: &mut dyn Slave,
+    mut controller: Option<&mut dyn Slave>,
+    t0: f64,
+    duration: f64,
+    mut record: Option<&mut Vec<[f64; 3]>>,
+) -> Result<(), String> {
     let n = (duration / STEP).round() as usize;
+    let mut rhs = if record.is_some() { plant.get(hb::SOLVER_RHS)? } else { 0.0 };
     for k in 0..n {
-        let t = k as f64 * STEP;
-        controller.set(pfc::P, plant.get(hb::P4)?)?;
-        plant.set(hb::U_REF, controller.get(pfc::U)?)?;
-        plant.step(t, STEP)?;
-        controller.step(t, STEP)?;
+        let t = t0 + k as f64 * STEP;
+        if let Some(c) = controller.as_deref_mut() {
+            c.set(pfc::P, plant.get(hb::P4)?)?;
+            plant.set(hb::U_REF, c.get(pfc::U)?)?;
+        }
+        match record.as_deref_mut() {
+            None => plant.step(t, STEP)?,
+            Some(r) => {
+                let (wall, cpu) = (Instant::now(), thread_cpu_time());
+                plant.step(t, STEP)?;
+                let (cpu, wall) = (thread_cpu_time() - cpu, wall.elapsed().as_secs_f64());
+                let total = plant.get(hb::SOLVER_RHS)?;
+                r.push([wall, cpu, total - rhs]);
+                rhs = total;
+            }
+        }
+        if let Some(c) = controller.as_deref_mut() {
+            c.step(t, STEP)?;
+        }
     }
     Ok(())
+}
+
+/// CPU time of the calling thread [s]: unlike wall time, it leaves out the time the thread
+/// waits for a core on a loaded machine.
+fn thread_cpu_time() -> f64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: a valid timespec for the call to fill.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// Median, 99th and 99.9th percentile (nearest rank) and maximum of `v`.
+pub fn quantiles(v: &mut [f64]) -> [f64; 4] {
+    v.sort_by(f64::total_cmp);
+    let rank = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+    [rank(0.5), rank(0.99), rank(0.999), v[v.len() - 1]]
+}
+
+/// The doStep distribution of one case, boom and `solver.mode` (`boomsim bench --realtime`).
+#[derive(Debug, Clone)]
+pub struct StepDistribution {
+    pub case: &'static str,
+    pub boom: &'static str,
+    pub mode: &'static str,
+    pub do_steps: usize,
+    /// Quantiles ([`quantiles`]) of the wall time, the thread CPU time [s] and the RHS
+    /// evaluations of one plant doStep.
+    pub wall: [f64; 4],
+    pub cpu: [f64; 4],
+    pub rhs: [f64; 4],
+    /// Closing steps of the real-time mode over the run, and those above the tolerance.
+    pub inaccurate: u64,
+}
+
+/// Case "random", the worst case of a hardware-in-the-loop run: the operator's reference switched
+/// every 0.5 s to a value drawn uniformly from [-1, 1] (a fixed-seed linear congruential
+/// generator), lifting when the stroke is below 150 mm and lowering above 600 mm, `duration` s.
+fn case_random(plant: &mut dyn Slave, duration: f64, record: &mut Vec<[f64; 3]>) -> Result<(), String> {
+    let mut seed = 12345u64;
+    for k in 0..(duration / 0.5).ceil() as usize {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let x = plant.get(hb::X)?;
+        plant.set(hb::U_REF, if x < 0.15 { u.abs() } else if x > 0.6 { -u.abs() } else { u })?;
+        let t0 = k as f64 * 0.5;
+        steps(plant, None, t0, (duration - t0).min(0.5), Some(record))?;
+    }
+    Ok(())
+}
+
+/// Cases U, B (rigid and flexible boom) and random (flexible), adaptive and real-time
+/// (`solver.mode` 0 and 1, default `solver.rhs_budget`), each run `repeats` times from the start
+/// for `duration` s on fresh instances (in-process): the distribution of the plant's doStep over
+/// all of them.
+pub fn step_distributions(repeats: usize, duration: f64) -> Result<Vec<StepDistribution>, String> {
+    let mut out = Vec::new();
+    let cases = [
+        ("U", "rigid", false),
+        ("B", "rigid", false),
+        ("U", "flexible", true),
+        ("B", "flexible", true),
+        ("random", "flexible", true),
+    ];
+    for (case, boom, flexible) in cases {
+        for (mode, code) in [("adaptive", 0), ("realtime", 1)] {
+            let start = [(hb::FLEXIBLE, Value::Boolean(flexible)), (hb::SOLVER_MODE, Value::Integer(code))];
+            let (mut record, mut inaccurate) = (Vec::with_capacity(repeats * (duration / STEP) as usize), 0);
+            for _ in 0..repeats {
+                let mut p = InProcess::<HydraulicBoom>::new(RTOL, &start)?;
+                if case == "U" {
+                    p.set(hb::U_REF, -0.1)?;
+                    steps(&mut p, None, 0.0, duration, Some(&mut record))?;
+                } else if case == "B" {
+                    let c_start = [(pfc::P, Value::Real(p.get(hb::P4)?))];
+                    let mut c = InProcess::<PressureFeedbackController>::new(RTOL, &c_start)?;
+                    c.set(pfc::U_REF, -0.05)?;
+                    steps(&mut p, Some(&mut c), 0.0, duration, Some(&mut record))?;
+                } else {
+                    case_random(&mut p, duration, &mut record)?;
+                }
+                inaccurate += p.get(hb::INACCURATE_STEPS)? as u64;
+            }
+            let column = |i: usize| quantiles(&mut record.iter().map(|r| r[i]).collect::<Vec<_>>());
+            let (wall, cpu, rhs) = (column(0), column(1), column(2));
+            out.push(StepDistribution { case, boom, mode, do_steps: record.len(), wall, cpu, rhs, inaccurate });
+        }
+    }
+    Ok(out)
 }
 
 /// Runs `case` on `plant` and reads the solver counters afterwards.

@@ -46,6 +46,15 @@ enum Cmd {
         /// --only interfaces, 7 to 10 minutes; needs the venv of scripts/setup and `boomsim pack`).
         #[arg(long)]
         model_exchange: bool,
+        /// Instead: the distribution of one doStep's wall time, thread CPU time and RHS
+        /// evaluations (median, p99, p99.9, max) in cases U and B, rigid and flexible, and with
+        /// the spool reference switched at random every 0.5 s (flexible), adaptive and real-time
+        /// (`solver.mode`), over `--repeats` runs of `--duration` s (in-process).
+        #[arg(long)]
+        realtime: bool,
+        /// Runs per case of `--realtime`, > 0.
+        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+        repeats: u32,
     },
     /// Modes of the HydraulicBoom linearised at rest with the boom horizontal (full payload,
     /// spool closed): the flexible boom (default n2 = 4, n3 = 5) and, for comparison, the rigid one.
@@ -193,6 +202,35 @@ fn bench(json: bool, duration: f64) -> Result<(), String> {
     Ok(())
 }
 
+fn bench_realtime(repeats: usize, duration: f64) -> Result<(), String> {
+    println!(
+        "doStep distributions: {repeats} x {duration} s per row, 1 ms steps, rtol 1e-6, in-process; \
+         wall and thread CPU time [us] and RHS evaluations per doStep (median / p99 / p99.9 / max)"
+    );
+    println!(
+        "{:<6} {:<8} {:<8} {:>7}  {:>27}  {:>27}  {:>19}  {:>7}  {:>10}",
+        "case", "boom", "mode", "doSteps", "wall us", "CPU us", "RHS", "p99.9 %", "inaccurate"
+    );
+    let row = |q: [f64; 4], p: usize| q.map(|x| format!("{x:.p$}")).join(" / ");
+    for d in boomsim::bench::step_distributions(repeats, duration)? {
+        println!(
+            "{:<6} {:<8} {:<8} {:>7}  {:>27}  {:>27}  {:>19}  {:>7.1}  {:>10}",
+            d.case,
+            d.boom,
+            d.mode,
+            d.do_steps,
+            row(d.wall.map(|x| x * 1e6), 1),
+            row(d.cpu.map(|x| x * 1e6), 1),
+            row(d.rhs, 0),
+            d.cpu[2] / boomsim::bench::STEP * 100.0,
+            d.inaccurate
+        );
+    }
+    println!("p99.9 %: the 99.9th percentile of the CPU time as a share of the 1 ms communication step");
+    println!("inaccurate: closing steps of the real-time mode above the tolerance (solver.inaccurate_steps)");
+    Ok(())
+}
+
 fn eigen(json: bool, count: usize, p4_bar: Option<f64>) -> Result<(), String> {
     use boomsim::analysis::modes::{hydraulic_boom_modes, rig, Mode};
     if let Some(p) = p4_bar {
@@ -300,7 +338,8 @@ fn main() -> ExitCode {
     }
     let result = match Cli::parse().command {
         Cmd::Pack { out, platforms } => pack(&out, &platforms),
-        Cmd::Bench { json, duration, model_exchange } => {
+        Cmd::Bench { realtime: true, duration, repeats, .. } => bench_realtime(repeats as usize, duration),
+        Cmd::Bench { json, duration, model_exchange, .. } => {
             bench(json, duration).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
         }
         Cmd::Eigen { json, count, p4 } => eigen(json, count, p4),

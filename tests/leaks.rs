@@ -19,7 +19,10 @@
 //!    fmi2DeSerializeFMUstate) and never frees them returns, in fmi2FreeInstance, to exactly the
 //!    live bytes before its fmi2Instantiate;
 //! 4. a state overwritten in place (fmi2GetFMUstate with *FMUstate a state of this instance,
-//!    section 2.1.8) between steps does not grow memory.
+//!    section 2.1.8) between steps does not grow memory;
+//! 5. fmi2DoStep in the real-time mode (`solver.mode` = 1, the flexible boom lowering with the
+//!    smallest `solver.rhs_budget`, so closing steps occur) makes no allocator call at all: a
+//!    hardware-in-the-loop step must not wait for the allocator.
 //!
 //! The counts are global (every thread), so the checks run in one #[test] function: the binary
 //! contains no other test, and nothing prints while a measurement is open (captured output
@@ -159,6 +162,17 @@ impl Importer {
 /// fmi2Instantiate, fmi2SetupExperiment and the initialisation, with `boom.flexible` set in
 /// initialisation mode when `flexible` is given: an instance ready to step at t = 0.
 unsafe fn initialized<M: Model>(imp: &Importer, flexible: Option<bool>) -> fmi2Component {
+    let c = initializing::<M>(imp);
+    if let Some(f) = flexible {
+        let b = if f { FMI2_TRUE } else { FMI2_FALSE };
+        assert_eq!(api::set_boolean::<M>(c, &FLEXIBLE, 1, &b), OK);
+    }
+    assert_eq!(api::exit_initialization_mode::<M>(c), OK);
+    c
+}
+
+/// fmi2Instantiate, fmi2SetupExperiment and fmi2EnterInitializationMode.
+unsafe fn initializing<M: Model>(imp: &Importer) -> fmi2Component {
     let c = api::instantiate::<M>(
         imp.name.as_ptr(),
         FMI2_COSIMULATION,
@@ -171,11 +185,6 @@ unsafe fn initialized<M: Model>(imp: &Importer, flexible: Option<bool>) -> fmi2C
     assert!(!c.is_null(), "fmi2Instantiate of {}", M::INFO.identifier);
     assert_eq!(api::setup_experiment::<M>(c, 0, 0.0, 0.0, 0, 0.0), OK);
     assert_eq!(api::enter_initialization_mode::<M>(c), OK);
-    if let Some(f) = flexible {
-        let b = if f { FMI2_TRUE } else { FMI2_FALSE };
-        assert_eq!(api::set_boolean::<M>(c, &FLEXIBLE, 1, &b), OK);
-    }
-    assert_eq!(api::exit_initialization_mode::<M>(c), OK);
     c
 }
 
@@ -329,6 +338,32 @@ fn overwrite<M: Model>(case: &'static str, flexible: Option<bool>, cycles: usize
     }
 }
 
+/// Phase 5: `cycles` real-time doSteps of HydraulicBoom (flexible, u_ref = -0.1, budget 100)
+/// after a warm-up step; returns the run and the closing steps above the tolerance.
+fn real_time_steps(cycles: usize) -> (Run, f64) {
+    use boomsim::models::hydraulic_boom::vr as hb;
+    let imp = Importer::of::<HydraulicBoom>();
+    unsafe {
+        let c = initializing::<HydraulicBoom>(&imp);
+        let (refs, ints) = ([hb::SOLVER_MODE, hb::RHS_BUDGET], [1, 100]);
+        assert_eq!(api::set_integer::<HydraulicBoom>(c, refs.as_ptr(), 2, ints.as_ptr()), OK);
+        assert_eq!(api::set_real::<HydraulicBoom>(c, &hb::U_REF, 1, &-0.1), OK);
+        assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(c), OK);
+        assert_eq!(api::do_step::<HydraulicBoom>(c, 0.0, H, 1), OK);
+        let before = live();
+        let t0 = Instant::now();
+        for k in 1..=cycles {
+            assert_eq!(api::do_step::<HydraulicBoom>(c, k as f64 * H, H, 1), OK);
+        }
+        let seconds = t0.elapsed().as_secs_f64();
+        let after = live();
+        let mut inaccurate = 0.0;
+        assert_eq!(api::get_real::<HydraulicBoom>(c, &hb::INACCURATE_STEPS, 1, &mut inaccurate), OK);
+        api::free_instance::<HydraulicBoom>(c);
+        (Run { phase: "realtime", case: "HydraulicBoom flexible doStep", cycles, seconds, before, after }, inaccurate)
+    }
+}
+
 /// Orphans: an instance that makes `n` / 2 states with fmi2GetFMUstate and `n` / 2 with
 /// fmi2DeSerializeFMUstate, frees none, and is freed. `before` is taken before fmi2Instantiate
 /// and `after` after fmi2FreeInstance; also returns the live bytes just before the free.
@@ -431,6 +466,8 @@ fn no_memory_growth() {
         peaks.push((case, run.before.bytes, peak));
         runs.push(run);
     }
+    let (real_time, inaccurate) = real_time_steps(3000);
+    runs.push(real_time);
     let messages = MESSAGES.load(Relaxed);
 
     // Measurements done: print, then check.
@@ -448,4 +485,6 @@ fn no_memory_growth() {
         assert!(peak - before > 100 * 64, "{case}: the 100 states held only {} bytes", peak - before);
     }
     runs.iter().for_each(Run::assert_no_growth);
+    assert!(inaccurate > 0.0, "the real-time run had closing steps beyond the tolerance");
+    assert_eq!(real_time.after.calls, real_time.before.calls, "allocator calls in real-time doSteps");
 }

@@ -299,7 +299,7 @@ impl Model for BoomMechanics {
         for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
             values.set_real(r, y);
         }
-        super::stepping::solver_outputs(self.solver.stats(), values);
+        super::stepping::solver_outputs(&self.solver, values);
         sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
 
@@ -318,10 +318,9 @@ impl Model for BoomMechanics {
             &mut self.solver,
             sys,
             &mut self.state,
-            t,
-            h,
-            tolerance,
+            (t, h, tolerance),
             || sys.boom.scale().collect(),
+            values,
             log,
         )?;
         self.t = t + h;

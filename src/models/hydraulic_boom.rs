@@ -13,8 +13,8 @@ use super::circuit::CIRCUIT_SCALE;
 use super::port::Ramp;
 use super::states::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
 use super::table::{
-    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_P4, START_STROKE,
-    TIP_DEFLECTION, U_REF_INPUT,
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_P4,
+    START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
 };
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
@@ -29,7 +29,7 @@ pub mod vr {
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 34] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 38] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
@@ -204,7 +204,9 @@ impl HydraulicBoom {
     /// The model with the plant of `values` and the given state (the equilibrium if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
         let plant = Plant::from_values(values)?;
-        let state = super::stepping::checked_state(plant.dim(), state, || plant.equilibrium(values.real(vr::X0), super::table::trapped_p4(values)))?;
+        let state = super::stepping::checked_state(plant.dim(), state, || {
+            plant.equilibrium(values.real(vr::X0), super::table::trapped_p4(values))
+        })?;
         let solver = Radau5::new(plant.dim());
         Ok(HydraulicBoom { plant, state, solver })
     }
@@ -294,7 +296,7 @@ impl Model for HydraulicBoom {
         for (r, y) in self.plant.output_rows(values.real(vr::U_REF), &self.state) {
             values.set_real(r, y);
         }
-        super::stepping::solver_outputs(self.solver.stats(), values);
+        super::stepping::solver_outputs(&self.solver, values);
     }
 
     fn do_step(
@@ -308,7 +310,8 @@ impl Model for HydraulicBoom {
     ) -> Result<(), StepError> {
         self.plant.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
         let plant = &self.plant;
-        super::stepping::advance(&mut self.solver, plant, &mut self.state, t, h, tolerance, || plant.state_scale(), log)
+        let scale = || plant.state_scale();
+        super::stepping::advance(&mut self.solver, plant, &mut self.state, (t, h, tolerance), scale, values, log)
     }
 
     fn save(&self) -> Vec<f64> {

@@ -10,7 +10,9 @@
 use super::circuit::CIRCUIT_SCALE;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::states::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
-use super::table::{out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_P4, START_STROKE, U_REF_INPUT};
+use super::table::{
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_P4, START_STROKE, U_REF_INPUT,
+};
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
@@ -53,7 +55,7 @@ const START_FORCE: ParamSpec = ParamSpec {
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 38] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 42] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),
@@ -214,7 +216,9 @@ impl HydraulicCircuit {
             }
             let f = values.real(vr::START_F);
             let c = sys.circuit.equilibrium(f, super::table::trapped_p4(values)).map_err(|e| {
-                format!("no static equilibrium with start.F = {f:.0} N and start.p4 (payload on the CBV, cbv.p_set): {e}")
+                format!(
+                    "no static equilibrium with start.F = {f:.0} N and start.p4 (payload on the CBV, cbv.p_set): {e}"
+                )
             })?;
             let rod = if sys.dim() > N_CIRCUIT { vec![x0, 0.0] } else { vec![] };
             Ok([&c[..], &rod].concat())
@@ -319,7 +323,7 @@ impl Model for HydraulicCircuit {
         let (e, f_line) = sys.evaluate(self.t, s);
         let c_h = if sys.coupling == Coupling::Plain { f_line } else { self.c_h };
         super::circuit::circuit_outputs(s[..N_CIRCUIT].try_into().expect("circuit slice"), &e, values);
-        super::stepping::solver_outputs(self.solver.stats(), values);
+        super::stepping::solver_outputs(&self.solver, values);
         for (r, y) in [(vr::C_H, c_h), (port::vr::F, f_line), (vr::PORT_X, x), (vr::PORT_V, v)] {
             values.set_real(r, y);
         }
@@ -344,10 +348,9 @@ impl Model for HydraulicCircuit {
             &mut self.solver,
             &self.sys,
             &mut self.state,
-            t,
-            h,
-            tolerance,
+            (t, h, tolerance),
             || Self::state_scale(n),
+            values,
             log,
         )?;
         self.t = t + h;

@@ -8,12 +8,18 @@ use super::vr;
 use crate::fmi2::{Log, StepError, Values};
 use crate::solver::{OdeSystem, Radau5, SolverStats};
 
-/// Writes the integrator's counters.
-pub(crate) fn solver_outputs(stats: &SolverStats, values: &mut Values) {
+/// `solver.mode` of the real-time mode (0, the default, is the adaptive integrator).
+pub const REALTIME: i32 = 1;
+
+/// Writes the integrator's counters and accuracy indicator.
+pub(crate) fn solver_outputs(solver: &Radau5, values: &mut Values) {
+    let stats = solver.stats();
     values.set_real(vr::SOLVER_STEPS, stats.accepted_steps as f64);
     values.set_real(vr::SOLVER_REJECTED, stats.rejected_steps as f64);
     values.set_real(vr::SOLVER_RHS, stats.rhs_evals as f64);
     values.set_real(vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64);
+    values.set_real(vr::ACCURACY_LOSS, solver.accuracy_loss());
+    values.set_real(vr::INACCURATE_STEPS, stats.inaccurate_steps as f64);
 }
 
 /// `state` if given and `dim` finite numbers, else `start()`.
@@ -31,22 +37,27 @@ pub(crate) fn checked_state(
 
 /// Advances `state` of `sys` from `t` to `t + h` with relative tolerance `rtol` and absolute
 /// tolerances `rtol * scale` (evaluated only when `rtol` changes), logging the integrator
-/// statistics of the step.
-#[allow(clippy::too_many_arguments)]
+/// statistics of the step. `solver.mode` of `values` picks the integration: adaptive
+/// ([`Radau5::integrate`]: error control, steps rejected and repeated as needed) or real-time
+/// ([`Radau5::integrate_bounded`]: the same within `solver.rhs_budget` RHS evaluations, the
+/// accuracy of its closing step reported instead of enforced). Neither allocates.
 pub(crate) fn advance<S: OdeSystem>(
     solver: &mut Radau5,
     sys: &S,
     state: &mut [f64],
-    t: f64,
-    h: f64,
-    rtol: f64,
+    (t, h, rtol): (f64, f64, f64),
     scale: impl FnOnce() -> Vec<f64>,
+    values: &Values,
     log: &mut dyn Log,
 ) -> Result<(), StepError> {
     let fail = |time, message: String| StepError { time, message };
     solver.set_tolerance(rtol, scale).map_err(|e| fail(t, e.to_string()))?;
     let before = *solver.stats();
-    solver.integrate(sys, t, state, t + h).map_err(|e| fail(e.t, e.to_string()))?;
+    let result = match values.integer(vr::SOLVER_MODE) {
+        REALTIME => solver.integrate_bounded(sys, t, state, t + h, values.integer(vr::RHS_BUDGET) as u64),
+        _ => solver.integrate(sys, t, state, t + h),
+    };
+    result.map_err(|e| fail(e.t, e.to_string()))?;
     log_step(log, t + h, &before, solver.stats());
     Ok(())
 }

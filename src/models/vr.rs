@@ -34,6 +34,12 @@ pub const EVENT_DEAD_BAND_LOWER: u32 = 29;
 pub const X0: u32 = 30;
 pub const FLEXIBLE: u32 = 31;
 pub const START_P4: u32 = 32;
+/// The integrator of doStep ([`crate::models::stepping`]): mode, the real-time mode's accuracy
+/// indicator, its budget per communication step, its inaccurate steps.
+pub const SOLVER_MODE: u32 = 33;
+pub const ACCURACY_LOSS: u32 = 34;
+pub const RHS_BUDGET: u32 = 35;
+pub const INACCURATE_STEPS: u32 = 36;
 pub const TIP_DEFLECTION: u32 = 40;
 /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
 pub const SECTIONS: u32 = 41;

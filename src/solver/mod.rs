@@ -15,7 +15,7 @@ pub mod radau5;
 mod tests;
 
 pub use iteration::SecondOrder;
-pub use radau5::{plan, Radau5};
+pub use radau5::{plan, tail_rhs, Radau5, NEWTON_BUDGET};
 
 /// An ODE `dx/dt = f(t, x)` of fixed dimension.
 pub trait OdeSystem {
@@ -55,6 +55,9 @@ pub struct SolverStats {
     pub lu_decompositions: u64,
     /// Simplified Newton iterations (each solves both linear systems once).
     pub newton_iterations: u64,
+    /// Closing steps of the real-time mode ([`Radau5::integrate_bounded`]) whose accuracy-loss
+    /// indicator exceeded 1: steps the adaptive mode would have rejected.
+    pub inaccurate_steps: u64,
 }
 
 /// Why a step could not be completed.
@@ -85,6 +88,9 @@ pub enum SolveErrorKind {
     NonFiniteJacobian,
     /// `rhs` is not finite at the initial state of the call.
     NonFiniteInitialRhs,
+    /// The closing step of the real-time mode ([`Radau5::integrate_bounded`]) could not be
+    /// completed; it has no smaller step to try.
+    FixedStepFailed(FailureCause),
     /// The arguments are invalid (wrong dimension, `t_end < t0`, non-finite values).
     InvalidArgument(String),
 }
@@ -124,6 +130,7 @@ impl fmt::Display for SolveError {
             SolveErrorKind::NonFiniteInitialRhs => {
                 f.write_str("right-hand side is NaN or infinite at the initial state")
             }
+            SolveErrorKind::FixedStepFailed(c) => write!(f, "real-time step failed ({c})"),
             SolveErrorKind::InvalidArgument(m) => write!(f, "invalid argument: {m}"),
         }
     }

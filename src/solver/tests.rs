@@ -356,3 +356,76 @@ fn second_order_elimination_keeps_the_solution() {
     assert!(max_abs_diff(&full, &reduced) < 1e-10, "{full:?} vs {reduced:?}");
     assert!(max_abs_diff(&reduced[..3], &exact) < 20.0 * 1e-8, "{reduced:?} vs {exact:?}");
 }
+
+/// The real-time mode with a budget that always suffices is the adaptive integration, bit for
+/// bit: on the oil column in 1 ms calls (up to ~20 steps per call) with a budget of 10^6 RHS.
+#[test]
+fn bounded_with_ample_budget_is_adaptive() {
+    let (mut a, mut b) = (Radau5::new(3), Radau5::new(3));
+    oil_tolerances(&mut a, 1e-6);
+    oil_tolerances(&mut b, 1e-6);
+    let (mut xa, mut xb) = ([4e6, 0.0, 0.0], [4e6, 0.0, 0.0]);
+    for k in 0..200 {
+        let (t0, t1) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);
+        a.integrate(&OilColumn, t0, &mut xa, t1).unwrap();
+        b.integrate_bounded(&OilColumn, t0, &mut xb, t1, 1_000_000).unwrap();
+        assert_eq!(b.accuracy_loss(), 0.0);
+    }
+    assert_eq!(xa.map(f64::to_bits), xb.map(f64::to_bits));
+    assert_eq!(a.stats(), b.stats());
+}
+
+/// A budget that binds: the oil column in 10 ms calls (the adaptive integration takes ~70
+/// RHS evaluations per call) with a budget of 60 RHS. No call exceeds it (counted, not
+/// timed), and the indicator accounts for the error: the closing steps' accuracy losses are
+/// local error estimates in tolerance units (RMS over the states), and on this lightly damped
+/// (0.5 %) oscillator local errors propagate with a factor near 1, so the global error at
+/// t = 0.2 s (max over the states, at most sqrt(3) x the RMS) stays below sqrt(3) x their sum
+/// plus the 3 units the adaptive steps may leave (`communication_step_does_not_change_trajectory`).
+#[test]
+fn bounded_never_exceeds_its_budget() {
+    let (reference, _) = run_oil(1e-10, 0.2, 0.2);
+    let (_, st) = run_oil(1e-6, 1e-2, 0.2);
+    assert!(st.rhs_evals > 20 * 60, "the adaptive calls need more than the budget: {st:?}");
+    let mut s = Radau5::new(3);
+    oil_tolerances(&mut s, 1e-6);
+    let mut x = [4e6, 0.0, 0.0];
+    let (mut losses, budget) = (0.0, 60);
+    for k in 0..20 {
+        let before = *s.stats();
+        s.integrate_bounded(&OilColumn, k as f64 * 1e-2, &mut x, (k + 1) as f64 * 1e-2, budget).unwrap();
+        let used = s.stats().rhs_evals - before.rhs_evals;
+        assert!(used <= budget, "call {k}: {used} RHS evaluations > {budget}");
+        losses += s.accuracy_loss();
+    }
+    assert!(s.stats().inaccurate_steps > 0, "the budget bound: {:?}", s.stats());
+    let e = oil_err(&x, &reference);
+    assert!(e < 3f64.sqrt() * losses + 3.0, "weighted error {e}, losses {losses}, {x:?} vs {reference:?}");
+}
+
+/// Below the minimum (`1 + n + 3·NIT + 2 + tail_rhs(n)`), every call is one closing step, a
+/// Radau IIA step with a fresh Jacobian: on the linear problem (exact Jacobian, so Newton
+/// converges in one iteration) its error at t = 1 falls as h^5, as
+/// in `convergence_order_is_five`.
+#[test]
+fn closing_steps_have_order_five() {
+    let mut errs = Vec::new();
+    for h in [0.1, 0.05, 0.025] {
+        let mut s = Radau5::new(3);
+        s.set_rtol(1e-3).unwrap();
+        s.set_atol(&[1e-3; 3]).unwrap();
+        let mut x = Linear::exact(0.0);
+        let n = (1.0 / h) as usize;
+        for k in 0..n {
+            let before = s.stats().rhs_evals;
+            s.integrate_bounded(&Linear, k as f64 * h, &mut x, (k + 1) as f64 * h, 10).unwrap();
+            assert!(s.stats().rhs_evals - before <= 1 + tail_rhs(3), "one closing step per call");
+        }
+        assert_eq!(s.stats().accepted_steps, n as u64);
+        errs.push(max_abs_diff(&x, &Linear::exact(1.0)));
+    }
+    for k in 0..2 {
+        let order = (errs[k] / errs[k + 1]).log2();
+        assert!((order - 5.0).abs() < 0.3, "measured order {order}, errors {errs:?}");
+    }
+}

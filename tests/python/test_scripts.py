@@ -36,6 +36,18 @@ def test_regress_refuses_a_filter_that_matches_nothing(tmp_path):
     assert not (tmp_path / "report.md").exists()
 
 
+@pytest.mark.parametrize("args,says", [
+    (["--param", "solver.mode"], ["--param solver.mode: expected NAME=VALUE with a number"]),
+    (["--param", "solver.mode=realtime"], ["expected NAME=VALUE with a number"]),
+    (["--update", "--param", "solver.mode=1"], ["--update writes the baselines of the default FMUs"]),
+])
+def test_regress_refuses_bad_parameters_in_one_line(tmp_path, args, says):
+    """A variant with FMU parameters (the real-time mode's accuracy) never re-baselines."""
+    code, last = run("regress.py", *args, "--out", str(tmp_path))
+    assert code == 2 and all(s in last for s in says), last
+    assert not (tmp_path / "report.md").exists()
+
+
 def test_a_missing_fmu_names_the_command_that_builds_it(tmp_path):
     with pytest.raises(cosim.UsageError, match="boomsim pack"):
         cosim.FmuFile("HydraulicBoom", fmu_dir=tmp_path)
