@@ -265,6 +265,32 @@ fn slots_beyond_the_last_section_repeat_it() {
     }
 }
 
+/// A rigid boom's rate state the boom cannot hold (the fuzzer's case: omega = f64::MAX with the
+/// boom horizontal, where omega / dtheta2/dl_cyl * dtheta2/dl_cyl rounds to inf) is refused with
+/// its name, and the instance keeps the states it had: fmi2GetContinuousStates once returned inf.
+#[test]
+fn a_rate_state_beyond_the_largest_number_is_refused() {
+    let s = model::<HydraulicBoom>("overflow");
+    unsafe {
+        assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), OK);
+        assert_eq!(s.set_boolean(vr::FLEXIBLE, false), OK);
+        assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(s.c), OK);
+        assert_eq!(api::enter_continuous_time_mode::<HydraulicBoom>(s.c), OK);
+        let n = HydraulicBoom::STATES.len();
+        let (mut x, mut after) = (vec![0.0; n], vec![0.0; n]);
+        assert_eq!(api::get_continuous_states::<HydraulicBoom>(s.c, x.as_mut_ptr(), n), OK);
+        let mut bad = vec![0.0; n];
+        bad[6..38].fill(0.0); // theta2 = 0: horizontal
+        bad[38..].fill(f64::MAX);
+        bad[0] = 7e6;
+        assert_eq!(api::set_continuous_states::<HydraulicBoom>(s.c, bad.as_ptr(), n), ERR);
+        assert!(s.last_error().contains("boom.section[1].omega = 1.7976931348623157e308 rad/s"), "{}", s.last_error());
+        assert_eq!(api::get_continuous_states::<HydraulicBoom>(s.c, after.as_mut_ptr(), n), OK);
+        assert_eq!(after, x);
+    }
+}
+
 /// Model Exchange runs the plain port only; the TLM port is refused at the end of
 /// initialisation with the reason.
 #[test]

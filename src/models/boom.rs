@@ -120,7 +120,16 @@ impl Boom {
                     )
                 })?;
                 let (_, d1, _) = t.theta2_derivatives(l);
-                (q[0], qd[0]) = (l - b.l_cyl(0.0), omega[0] / d1);
+                let v = omega[0] / d1;
+                if !v.re().is_finite() || !(v * d1).re().is_finite() {
+                    return Err(format!(
+                        "boom.section[1].omega = {} rad/s at boom.section[1].phi = {} rad is beyond the largest \
+                         number the rigid boom can hold (v = omega / dtheta2/dl_cyl and back)",
+                        num(omega[0].re()),
+                        num(phi[0].re())
+                    ));
+                }
+                (q[0], qd[0]) = (l - b.l_cyl(0.0), v);
             }
             Boom::Flexible(_) => {
                 let n = q.len();

@@ -248,8 +248,9 @@ impl Model for HydraulicBoom {
         let dof = self.plant.boom.mechanics().dof();
         let (c, boom) = self.state.split_at_mut(N_CIRCUIT);
         let (q, qd) = boom.split_at_mut(dof);
+        self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)?;
         c.copy_from_slice(&x[..N_CIRCUIT]);
-        self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)
+        Ok(())
     }
 
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
