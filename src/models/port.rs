@@ -118,7 +118,9 @@ pub const COUPLING: Variable = Variable::int_param(
 
 /// Default characteristic impedance: sqrt(k_oil m_eff) at the 480 mm start stroke with the
 /// thesis parameters, k_oil = A^2/C_3 + A_B^2/C_4 = 8.3e6 N/m (C = V/beta + hose compliance,
-/// eq. 5.2) and the rigid boom's m_eff = 16.9 t (test `default_impedance_matches_the_oil_column`).
+/// eq. 5.2) and the rigid boom's m_eff = 16.9 t (test `default_impedance_matches_the_oil_column`);
+/// the same within 5 % with the model's own stiffness, entrained air included, at a lowering's
+/// pressures (test `default_impedance_holds_with_the_models_own_stiffness_while_lowering`).
 pub const Z_C: ParamSpec = ParamSpec {
     name: "port.Z_c",
     default: 3.75e5,
@@ -218,6 +220,31 @@ mod tests {
         let z = (k * m).sqrt();
         assert!((z / Z_C.default - 1.0).abs() < 0.05, "k = {k:.3e} N/m, m_eff = {m:.0} kg, sqrt(k m) = {z:.3e}");
         assert!((k / 8.3e6 - 1.0).abs() < 0.05 && (m / 16.9e3 - 1.0).abs() < 0.05, "k = {k:.3e}, m = {m:.0}");
+    }
+
+    /// Z_C's default with the model's own stiffness, entrained air included, where the TLM port
+    /// works: a lowering, whose rod side sits between the CBV's cracking and full opening (eq.
+    /// 2.73 with p3 = mu_c p4 + F / A of eq. 2.85, the rigid boom's static force at 480 mm),
+    /// 37 bar and up, where the air softens the oil by under 1 % (README, "Cavitation"). 5 %:
+    /// the default is rounded.
+    #[test]
+    fn default_impedance_holds_with_the_models_own_stiffness_while_lowering() {
+        let c = Circuit::default();
+        let (cyl, ln, fl, cbv) = (&c.cylinder, &c.lines, &c.fluid, &c.cbv);
+        let x = 0.48;
+        let boom = RigidBoom::new(&BoomParams::default(), cyl.stroke).unwrap();
+        let (load, mu_c) = (boom.static_force(x) / cyl.area_a(), cyl.area_b() / cyl.area_a());
+        let p4_crack = (cbv.p_set - load) / (cbv.mu_p + mu_c);
+        let p4_open = (cbv.p_set + cbv.p_fo_cbv - load) / (cbv.mu_p + mu_c);
+        assert!(p4_crack > 30e5 && p4_open > p4_crack, "rod side {p4_crack:.3e}-{p4_open:.3e} Pa");
+        for p4 in [p4_crack, p4_open] {
+            let p3 = mu_c * p4 + load;
+            let c3 = (ln.v_l3 + cyl.volume_a(x)) / fl.bulk_modulus(p3) + ln.hose_compliance(ln.v_l3);
+            let c4 = (ln.v_l4 + cyl.volume_b(x)) / fl.bulk_modulus(p4) + ln.hose_compliance(ln.v_l4);
+            let k = cyl.area_a().powi(2) / c3 + cyl.area_b().powi(2) / c4;
+            let z = (k * boom.m_eff(x)).sqrt();
+            assert!((z / Z_C.default - 1.0).abs() < 0.05, "p4 = {p4:.3e} Pa: sqrt(k m) = {z:.3e}");
+        }
     }
 
     #[test]
