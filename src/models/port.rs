@@ -225,8 +225,8 @@ mod tests {
     /// Z_C's default with the model's own stiffness, entrained air included, where the TLM port
     /// works: a lowering, whose rod side sits between the CBV's cracking and full opening (eq.
     /// 2.73 with p3 = mu_c p4 + F / A of eq. 2.85, the rigid boom's static force at 480 mm),
-    /// 37 bar and up, where the air softens the oil by under 1 % (README, "Cavitation"). 5 %:
-    /// the default is rounded.
+    /// above 30 bar, where the air softens the oil by about 1 % (README, "Cavitation"). 5 %: the
+    /// default is rounded.
     #[test]
     fn default_impedance_holds_with_the_models_own_stiffness_while_lowering() {
         let c = Circuit::default();
