@@ -34,12 +34,18 @@ MODELS = {"lag": {}, "PVES loop": {"valve.omega_loop": LOOP_GAIN}}
 CATALOGUE = ["A", "B", "C1.1", "C1.2", "C1.3", "C2.1", "C2.2", "C2.3", "C3.1", "C3.2", "C3.3"]
 
 
-def row(scenario: dict, model: str, step: float, boom: str, p4: float | None) -> dict:
-    """One run at `step` with the valve model `model`, the feedback from the step (t0)."""
+def run(scenario: dict, model: str, step: float = RIG_STEP, boom: str = "rigid", p4: float | None = None):
+    """One run at `step` with the valve model `model`, the feedback from the step (t0), the
+    rod side pre-charged to `p4` bar if given."""
     params = dict(MODELS[model])
     if p4 is not None:
         params["start.p4"] = p4 * metrics.BAR
-    m = metrics.compute(cosim.run(scenario, boom, step=step, feedback_start="t0", params=params))
+    return cosim.run(scenario, boom, step=step, feedback_start="t0", params=params)
+
+
+def row(scenario: dict, model: str, step: float, boom: str, p4: float | None) -> dict:
+    """The table's numbers of one run (`run`)."""
+    m = metrics.compute(run(scenario, model, step, boom, p4))
     return {
         "speed": m["v_steady"] / m["v_expected"],
         "p3_pp_late": m["p3_pp_late"],

@@ -10,11 +10,9 @@
 //! (start values by variable name, set in Initialization Mode). Output (stdout): one JSON line
 //! `{"rows", "columns", "rhs", "feedback_on_at"}`, then the rows as little-endian f64.
 
-use crate::fmu::instance::{Instance, Step};
-use crate::fmu::log::Logger;
-use crate::fmu::state::Interface;
+use crate::fmu::in_process::{InProcess, Slave};
 use crate::fmu::variables::BaseType;
-use crate::fmu::{guid::guid, Model, Value, Version};
+use crate::fmu::{Model, Value};
 use crate::models::pressure_feedback_controller::vr as pfc;
 use crate::models::{HydraulicBoom, PressureFeedbackController};
 use serde_json::{json, Map, Value as Json};
@@ -39,18 +37,11 @@ fn reference(table: &[(f64, f64)], t: f64) -> f64 {
     u0 + (u1 - u0) * (t - t0) / (t1 - t0)
 }
 
-/// A Co-Simulation instance of `M` set up for [start, stop] without a tolerance, in
-/// Initialization Mode with the `start` values (by name) set.
-fn instance<M: Model>(start: f64, stop: f64, values: &Map<String, Json>) -> Result<Instance<M>, String> {
-    let log = Logger::new(None, M::INFO.identifier, &[], false);
-    let mut i = Instance::<M>::new(log, guid::<M>(), Version::Fmi2, Interface::CoSimulation);
-    i.setup_experiment(None, start, Some(stop))?;
-    i.enter_initialization_mode();
+/// The start values by name as (value reference, value) of `M`'s variables.
+fn start_values<M: Model>(values: &Map<String, Json>) -> Result<Vec<(u32, Value)>, String> {
+    let mut out = Vec::with_capacity(values.len());
     for (name, value) in values {
-        let v = M::VARIABLES
-            .iter()
-            .find(|v| v.name == name)
-            .ok_or_else(|| format!("{} has no variable \"{name}\"", M::INFO.identifier))?;
+        let v = variable::<M>(name)?;
         let bad = || format!("{name} = {value}: not a {:?}", v.base_type());
         let x = match (v.base_type(), value) {
             (BaseType::Real, Json::Number(n)) => Value::Real(n.as_f64().ok_or_else(bad)?),
@@ -60,26 +51,20 @@ fn instance<M: Model>(start: f64, stop: f64, values: &Map<String, Json>) -> Resu
             (BaseType::Boolean, Json::Bool(b)) => Value::Boolean(*b),
             _ => return Err(bad()),
         };
-        i.set(&[v.vr], vec![x])?;
+        out.push((v.vr, x));
     }
-    Ok(i)
-}
-
-fn get<M: Model>(i: &mut Instance<M>, vrs: &[u32]) -> Result<Vec<f64>, String> {
-    let mut out = vec![0.0; vrs.len()];
-    i.get(vrs, &mut out, BaseType::Real, |v| if let Value::Real(x) = v { *x } else { f64::NAN })?;
     Ok(out)
 }
 
-fn set<M: Model>(i: &mut Instance<M>, vrs: &[u32], xs: &[f64]) -> Result<(), String> {
-    i.set(vrs, xs.iter().map(|&x| Value::Real(x)).collect())
+/// A Co-Simulation instance of `M` set up for [t0, stop] without a tolerance, in Initialization
+/// Mode with the `start` values set.
+fn instance<M: Model>(t0: f64, stop: f64, start: &[(u32, Value)]) -> Result<InProcess<M>, String> {
+    InProcess::initializing(None, t0, Some(stop), start)
 }
 
-fn step<M: Model>(i: &mut Instance<M>, t: f64, h: f64) -> Result<(), String> {
-    match i.do_step(t, h)? {
-        Step::Done(_) => Ok(()),
-        Step::Discarded(why) => Err(format!("fmi2DoStep of {} at t = {t} discarded: {why}", M::INFO.identifier)),
-    }
+/// `fmi2DoStep`, a discarded step an error naming the model and the time.
+fn step(i: &mut dyn Slave, id: &str, t: f64, h: f64) -> Result<(), String> {
+    i.step(t, h).map_err(|why| format!("fmi2DoStep of {id} at t = {t} discarded: {why}"))
 }
 
 /// Runs the co-simulation the JSON `request` describes; returns the header and the rows.
@@ -104,16 +89,21 @@ pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
     }
     let n = (t_end / h).round() as usize;
 
-    let plant_vr = vr_of::<HydraulicBoom>;
+    let plant_vr = |name: &str| variable::<HydraulicBoom>(name).map(|v| v.vr);
     let (vr_p4, vr_u, vr_rhs) = (plant_vr("p4")?, plant_vr("valve.u_ref")?, plant_vr("solver.rhs_evals")?);
-    let mut plant = instance::<HydraulicBoom>(0.0, t_end, &plant_start)?;
+    let (plant_id, ctrl_id) = (HydraulicBoom::INFO.identifier, PressureFeedbackController::INFO.identifier);
+    let mut plant = instance::<HydraulicBoom>(0.0, t_end, &start_values::<HydraulicBoom>(&plant_start)?)?;
     plant.exit_initialization_mode()?;
-    let mut p4 = get(&mut plant, &[vr_p4])?[0];
+    let mut p4 = plant.get(vr_p4)?;
+    let ctrl_start = start_values::<PressureFeedbackController>(&ctrl_start)?;
     // (Re-)initialises the controller at t0 from rest at the present p4 (`init_controller`).
-    let controller = |t0: f64, feedback: bool, p4: f64| -> Result<Instance<PressureFeedbackController>, String> {
-        let mut c = instance::<PressureFeedbackController>(t0, t_end, &ctrl_start)?;
-        c.set(&[pfc::ENABLE], vec![Value::Boolean(feedback)])?;
-        set(&mut c, &[pfc::P, pfc::U_REF], &[p4, reference(&table, t0)])?;
+    let controller = |t0: f64, feedback: bool, p4: f64| -> Result<InProcess<PressureFeedbackController>, String> {
+        let own = [
+            (pfc::ENABLE, Value::Boolean(feedback)),
+            (pfc::P, Value::Real(p4)),
+            (pfc::U_REF, Value::Real(reference(&table, t0))),
+        ];
+        let mut c = instance::<PressureFeedbackController>(t0, t_end, &[&ctrl_start[..], &own].concat())?;
         c.exit_initialization_mode()?;
         Ok(c)
     };
@@ -122,28 +112,31 @@ pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
     let mut feedback_on_at = if on { Some(0.0) } else { None };
 
     let out_p: Vec<u32> = PLANT_OUT.iter().map(|name| plant_vr(name)).collect::<Result<_, _>>()?;
-    let (i_p4, i_cbv) = (3, 5);
+    let at = |name: &str| PLANT_OUT.iter().position(|&n| n == name).expect("a recorded output");
+    let (i_p4, i_cbv) = (at("p4"), at("cbv.u_cbv"));
+    let outputs =
+        |plant: &mut InProcess<HydraulicBoom>| out_p.iter().map(|&r| plant.get(r)).collect::<Result<Vec<_>, _>>();
     let mut rows = Vec::with_capacity((n / record_every + 1) * (4 + PLANT_OUT.len()));
-    let mut y = get(&mut plant, &out_p)?;
+    let mut y = outputs(&mut plant)?;
     let mut u_ref = reference(&table, 0.0);
     for k in 0..=n {
         let t = k as f64 * h;
-        let uc = get(&mut ctrl, &[pfc::U, pfc::U_COMP])?;
-        set(&mut plant, &[vr_u], &[uc[0]])?;
+        let (u, u_comp) = (ctrl.get(pfc::U)?, ctrl.get(pfc::U_COMP)?);
+        plant.set(vr_u, u)?;
         if k % record_every == 0 {
-            rows.extend_from_slice(&[t, u_ref, uc[1], uc[0]]);
+            rows.extend_from_slice(&[t, u_ref, u_comp, u]);
             rows.extend_from_slice(&y);
         }
         if k == n {
             break;
         }
-        step(&mut plant, t, h)?;
-        y = get(&mut plant, &out_p)?;
+        step(&mut plant, plant_id, t, h)?;
+        y = outputs(&mut plant)?;
         let p4_next = y[i_p4];
         if interpolate {
-            ctrl.set_input_derivatives(&[pfc::P], &[1], &[(p4_next - p4) / h])?;
+            ctrl.set_slope(pfc::P, (p4_next - p4) / h)?;
         }
-        step(&mut ctrl, t, h)?;
+        step(&mut ctrl, ctrl_id, t, h)?;
         p4 = p4_next;
         u_ref = reference(&table, t + h);
         if enable && !on && y[i_cbv] > CBV_OPEN {
@@ -151,20 +144,21 @@ pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
             feedback_on_at = Some(t + h);
             ctrl = controller(t + h, true, p4)?;
         }
-        set(&mut ctrl, &[pfc::P, pfc::U_REF], &[p4, u_ref])?;
+        ctrl.set(pfc::P, p4)?;
+        ctrl.set(pfc::U_REF, u_ref)?;
     }
-    let rhs = get(&mut plant, &[vr_rhs])?[0];
+    let rhs = plant.get(vr_rhs)?;
     let columns = 4 + PLANT_OUT.len();
     let header =
         json!({"rows": rows.len() / columns, "columns": columns, "rhs": rhs, "feedback_on_at": feedback_on_at});
     Ok((header, rows))
 }
 
-fn vr_of<M: Model>(name: &str) -> Result<u32, String> {
+/// `M`'s variable `name`.
+fn variable<M: Model>(name: &str) -> Result<&'static crate::fmu::Variable, String> {
     M::VARIABLES
         .iter()
         .find(|v| v.name == name)
-        .map(|v| v.vr)
         .ok_or_else(|| format!("{} has no variable \"{name}\"", M::INFO.identifier))
 }
 

@@ -20,6 +20,14 @@ fn model<M: Model>(name: &str) -> Slave<M> {
     Slave::<M>::try_new(name, &boomsim::fmi2::guid::guid::<M>(), FMI2_MODEL_EXCHANGE).expect("instantiates")
 }
 
+/// A HydraulicBoom ME instance set up at t = 0, in Initialization Mode.
+unsafe fn plant_initializing(name: &str) -> Slave<HydraulicBoom> {
+    let s = model::<HydraulicBoom>(name);
+    assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), OK);
+    assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), OK);
+    s
+}
+
 /// The states an ME instance reaches, in order, with the calls that lead there from the previous.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum St {
@@ -243,10 +251,8 @@ fn split_models_derivatives_follow_the_co_simulation_trajectory() {
 /// derivatives with section 9's: the importer's solver keeps them equal.
 #[test]
 fn slots_beyond_the_last_section_repeat_it() {
-    let s = model::<HydraulicBoom>("slots");
     unsafe {
-        assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), OK);
-        assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), OK);
+        let s = plant_initializing("slots");
         assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(s.c), OK);
         assert_eq!(s.set_real(vr::U_REF, -0.2), OK);
         let n = HydraulicBoom::STATES.len();
@@ -270,10 +276,8 @@ fn slots_beyond_the_last_section_repeat_it() {
 /// its name, and the instance keeps the states it had: fmi2GetContinuousStates once returned inf.
 #[test]
 fn a_rate_state_beyond_the_largest_number_is_refused() {
-    let s = model::<HydraulicBoom>("overflow");
     unsafe {
-        assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), OK);
-        assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), OK);
+        let s = plant_initializing("overflow");
         assert_eq!(s.set_boolean(vr::FLEXIBLE, false), OK);
         assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(s.c), OK);
         assert_eq!(api::enter_continuous_time_mode::<HydraulicBoom>(s.c), OK);
@@ -315,11 +319,9 @@ fn tlm_port_is_refused_in_model_exchange() {
 /// load-sensing switch), with x_db the FMU's own `valve.x_db`.
 #[test]
 fn event_indicators_mark_the_dead_band() {
-    let s = model::<HydraulicBoom>("events");
     let x_db_vr = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "valve.x_db").unwrap().vr;
     unsafe {
-        assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), OK);
-        assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), OK);
+        let s = plant_initializing("events");
         assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(s.c), OK);
         let x_db = s.real(x_db_vr);
         assert_eq!(s.set_real(vr::U_REF, -0.2), OK);

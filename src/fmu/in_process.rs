@@ -21,15 +21,32 @@ pub struct InProcess<M: Model>(Instance<M>);
 impl<M: Model> InProcess<M> {
     /// Instantiated, set up with `rtol`, initialised with the given Real and Boolean values.
     pub fn new(rtol: f64, start: &[(u32, Value)]) -> Result<Self, String> {
-        let log = Logger::new(None, "bench", &[], false);
+        let mut s = Self::initializing(Some(rtol), 0.0, None, start)?;
+        s.exit_initialization_mode()?;
+        Ok(s)
+    }
+
+    /// Instantiated, set up for `[t0, stop]` with `rtol` (None: the model's default), in
+    /// Initialization Mode with the `start` values set.
+    pub fn initializing(rtol: Option<f64>, t0: f64, stop: Option<f64>, start: &[(u32, Value)]) -> Result<Self, String> {
+        let log = Logger::new(None, M::INFO.identifier, &[], false);
         let mut i = Instance::<M>::new(log, guid::<M>(), crate::fmu::Version::Fmi2, Interface::CoSimulation);
-        i.setup_experiment(Some(rtol), 0.0, None)?;
+        i.setup_experiment(rtol, t0, stop)?;
         i.enter_initialization_mode();
         for (r, x) in start {
             i.set(&[*r], vec![x.clone()])?;
         }
-        i.exit_initialization_mode()?;
         Ok(InProcess(i))
+    }
+
+    /// Leaves Initialization Mode.
+    pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
+        self.0.exit_initialization_mode()
+    }
+
+    /// The slope of Real input `vr` over the next step (fmi2SetRealInputDerivatives, order 1).
+    pub fn set_slope(&mut self, vr: u32, slope: f64) -> Result<(), String> {
+        self.0.set_input_derivatives(&[vr], &[1], &[slope])
     }
 }
 

@@ -584,9 +584,7 @@ impl Radau5 {
             // rejects the step. The last step of a call skips it: the next call evaluates f
             // there itself (with its own inputs), and the Newton iteration's last evaluation
             // of the final stage lies within its tolerance of this state.
-            for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(&self.z[2]) {
-                *x = y + z;
-            }
+            self.stage_end();
             if !last {
                 sys.rhs(tph, &self.tmp, &mut self.ftmp);
                 self.stats.rhs_evals += 1;
@@ -612,13 +610,10 @@ impl Radau5 {
             erracc = err.max(1e-2);
             hold = h;
             t = tph;
-            self.y.copy_from_slice(&self.tmp);
             if !last {
                 self.y0.copy_from_slice(&self.ftmp);
             }
-            self.update_scal();
-            self.update_cont();
-            (self.h_cont, self.t_cont) = (h, t);
+            self.accept(h, t);
 
             if last {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
@@ -697,19 +692,31 @@ impl Radau5 {
             }
             err.max(left)
         };
-        for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(&self.z[2]) {
-            *x = y + z;
-        }
+        self.stage_end();
         if !all_finite(&self.tmp) {
             return failed(FailureCause::NonFiniteRhs);
         }
         self.stats.accepted_steps += 1;
         self.stats.inaccurate_steps += (loss > 1.0) as u64;
+        self.accept(h, t_end);
+        self.theta = theta;
+        Ok(loss)
+    }
+
+    /// The step's end state `y + Z_3` into `tmp`.
+    fn stage_end(&mut self) {
+        for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(&self.z[2]) {
+            *x = y + z;
+        }
+    }
+
+    /// Takes the step of size `h` that ended at `t` with state `tmp`: the new state, its error
+    /// weights and the collocation polynomial the next step extrapolates.
+    fn accept(&mut self, h: f64, t: f64) {
         self.y.copy_from_slice(&self.tmp);
         self.update_scal();
         self.update_cont();
-        (self.h_cont, self.t_cont, self.theta) = (h, t_end, theta);
-        Ok(loss)
+        (self.h_cont, self.t_cont) = (h, t);
     }
 
     /// The closing step's fallback when its Newton iteration fails: the state is held (`Z = 0`)

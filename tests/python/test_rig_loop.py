@@ -18,8 +18,7 @@ import rig_loop  # noqa: E402
 
 
 def run(sid: str, model: str):
-    return cosim.run(cosim.load_scenario(sid), "rigid", step=rig_loop.RIG_STEP, feedback_start="t0",
-                     params=rig_loop.MODELS[model])
+    return rig_loop.run(cosim.load_scenario(sid), model)
 
 
 @pytest.mark.parametrize("sid", ["B", "C1.1", "C2.1"])
