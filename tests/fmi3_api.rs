@@ -731,3 +731,34 @@ fn a_discarded_step_leaves_the_instance_as_it_was() {
         assert_eq!(i.get(plant::P3).to_bits(), twin.get(plant::P3).to_bits());
     }
 }
+
+/// FMI 3.0, 2.3.3: fmi3GetDirectionalDerivative and fmi3GetAdjointDerivative are among
+/// Initialization Mode's calls. At the rigid boom's start equilibrium (p3 A_p = F + p4 A_r, eq.
+/// 2.72 at rest) dp3/d(start.p4) = A_r / A_p = 1 - (d_rod / d_piston)^2 from the FMU's own
+/// bore and rod, both ways; 1e-6 relative: the central difference's error and the equilibrium
+/// solve's tolerance.
+#[test]
+fn derivatives_in_initialization_mode() {
+    use boomsim::models::vr as plant;
+    let (start_p4, d_piston, d_rod): (u32, u32, u32) = (32, 120, 121);
+    for me in [false, true] {
+        let i = Inst::<HydraulicBoom>::new(me);
+        unsafe {
+            assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(i.c, false, 0.0, 0.0, false, 0.0), OK);
+            assert_eq!(api::set_boolean::<HydraulicBoom>(i.c, &plant::FLEXIBLE, 1, &0, 1), OK);
+        }
+        let ratio = 1.0 - (i.get(d_rod) / i.get(d_piston)).powi(2);
+        let (mut forward, mut adjoint) = (f64::NAN, f64::NAN);
+        unsafe {
+            let p3 = (&plant::P3 as *const u32, 1);
+            let known = (&start_p4 as *const u32, 1);
+            let dd = api::get_directional_derivative::<HydraulicBoom>(i.c, p3, known, (&1.0, 1), (&mut forward, 1));
+            assert_eq!(dd, OK, "{}", i.last_error());
+            let ad = api::get_adjoint_derivative::<HydraulicBoom>(i.c, p3, known, (&1.0, 1), (&mut adjoint, 1));
+            assert_eq!(ad, OK, "{}", i.last_error());
+        }
+        for d in [forward, adjoint] {
+            assert!((d - ratio).abs() <= 1e-6 * ratio, "ME {me}: {d} vs A_r/A_p = {ratio}");
+        }
+    }
+}
