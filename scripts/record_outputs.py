@@ -1,6 +1,7 @@
 """Records every output a refactor must leave unchanged, for `scripts/same-outputs`: the time
 series of every scenario variant of the regression (Co-Simulation, FMI 2.0), of scenario B over
-the regression's communication steps, of U and B in FMI 3.0 Co-Simulation (inputs held) and in
+the regression's communication steps, of U and B through `boomsim cosim` (the native runner), in
+FMI 3.0 Co-Simulation (inputs held) and in
 Model Exchange under fmpy's CVode (FMI 2.0 and 3.0, rigid boom, 1 s), with the work counts of each
 run, and the counts of `boomsim bench --json` (steps, right-hand sides, Jacobians; not its
 times).
@@ -45,6 +46,7 @@ def record(path: pathlib.Path) -> None:
     for sid in ("U", "B"):
         sc = cosim.load_scenario(sid)
         runs.append((f"fmi3/{sid}", lambda sc=sc: cosim.run(sc, "rigid", fmi=3, interpolate=False)))
+        runs.append((f"native/{sid}", lambda sc=sc: cosim.run_native(sc, "rigid")))
         for fmi in (2, 3):
             runs.append((f"me{fmi}/{sid}", lambda sc=sc, fmi=fmi: cosim.run_me(sc, "rigid", stop_time=1.0, fmi=fmi)))
     for k, (name, run) in enumerate(runs, 1):
