@@ -67,7 +67,7 @@ type Call = fn(fmi2Component) -> fmi2Status;
 
 /// The ten ME functions and the states the standard's table (FMI 2.0.5, section 3.2.3, with
 /// the 2.0.1 to 2.0.3 errata) allows them in, written from the standard independently of
-/// `src/fmi2/state.rs`: fmi2SetTime in Event Mode only for a pure discrete-time FMU (note 8);
+/// `src/fmi2/machine.rs`: fmi2SetTime in Event Mode only for a pure discrete-time FMU (note 8);
 /// fmi2GetDerivatives and fmi2GetNominalsOfContinuousStates in Initialization Mode too.
 #[rustfmt::skip]
 fn me_functions() -> Vec<(&'static str, Call, &'static [St])> {

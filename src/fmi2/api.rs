@@ -1,12 +1,12 @@
 //! The 44 FMI 2.0 functions (25 common, 9 Co-Simulation, 10 Model Exchange), generic over the
 //! model. The export macro ([`crate::export_fmu`]) forwards each `#[no_mangle] extern "C"` symbol
-//! here; what FMI 3.0 does alike is in [`crate::fmu::abi`], called with the function's FMI 2.0
+//! here; what FMI 3.0 does alike is in [`crate::fmu::calls`], called with the function's FMI 2.0
 //! name and its rule of [`allowed`].
 #![allow(clippy::missing_safety_doc)]
 
-use super::state::{allowed, Interface, Rule, State};
+use super::machine::{allowed, Interface, Rule, Mode};
 use super::types::*;
-use crate::fmu::abi::{self, call, slice, Call};
+use crate::fmu::calls::{self, call, slice, Call};
 use crate::fmu::guid::guid;
 use crate::fmu::log::Logger;
 use crate::fmu::model::Model;
@@ -64,13 +64,13 @@ pub unsafe fn instantiate<M: Model>(
     catch_unwind(|| {
         let f = functions.as_ref().copied()?;
         let sink = Box::new(Sink(f.logger, f.componentEnvironment));
-        let logger = Logger::new(Some(sink), abi::text(name).unwrap_or(""), M::INFO.log_categories, logging_on != 0);
+        let logger = Logger::new(Some(sink), calls::text(name).unwrap_or(""), M::INFO.log_categories, logging_on != 0);
         let fail = |message: String| {
             logger.status(fmi2Status::Error, &format!("fmi2Instantiate: {message}"));
             None
         };
         let expected = guid::<M>();
-        if let Err(e) = abi::instance_name(name) {
+        if let Err(e) = calls::instance_name(name) {
             return fail(e);
         }
         let interface = match fmu_type {
@@ -82,10 +82,10 @@ pub unsafe fn instantiate<M: Model>(
                 ))
             }
         };
-        if let Err(e) = abi::check_identity(fmu_guid, "fmuGUID", "GUID", &expected) {
+        if let Err(e) = calls::check_identity(fmu_guid, "fmuGUID", "GUID", &expected) {
             return fail(e);
         }
-        Some(abi::new_instance::<M>(logger, expected, Version::Fmi2, interface))
+        Some(calls::new_instance::<M>(logger, expected, Version::Fmi2, interface))
     })
     .ok()
     .flatten()
@@ -94,7 +94,7 @@ pub unsafe fn instantiate<M: Model>(
 
 /// fmi2FreeInstance, with every FMU state of the instance the importer did not free.
 pub unsafe fn free_instance<M: Model>(c: fmi2Component) {
-    abi::free_instance::<M>(c, at("fmi2FreeInstance", allowed::FREE_INSTANCE))
+    calls::free_instance::<M>(c, at("fmi2FreeInstance", allowed::FREE_INSTANCE))
 }
 
 pub unsafe fn set_debug_logging<M: Model>(
@@ -103,7 +103,7 @@ pub unsafe fn set_debug_logging<M: Model>(
     n: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    abi::set_debug_logging::<M>(c, at("fmi2SetDebugLogging", allowed::SET_DEBUG_LOGGING), on != 0, n, categories)
+    calls::set_debug_logging::<M>(c, at("fmi2SetDebugLogging", allowed::SET_DEBUG_LOGGING), on != 0, n, categories)
 }
 
 pub unsafe fn setup_experiment<M: Model>(
@@ -117,54 +117,54 @@ pub unsafe fn setup_experiment<M: Model>(
     let f = at("fmi2SetupExperiment", allowed::SETUP_EXPERIMENT);
     call::<M>(c, f, |inst| {
         let (tolerance, stop) = ((tolerance_defined != 0).then_some(tolerance), (stop_defined != 0).then_some(stop));
-        abi::setup_experiment(inst, f.function, tolerance, start, stop)
+        calls::setup_experiment(inst, f.function, tolerance, start, stop)
     })
 }
 
 pub unsafe fn enter_initialization_mode<M: Model>(c: fmi2Component) -> fmi2Status {
-    abi::enter_initialization_mode::<M>(c, at("fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION_MODE))
+    calls::enter_initialization_mode::<M>(c, at("fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION_MODE))
 }
 
 pub unsafe fn exit_initialization_mode<M: Model>(c: fmi2Component) -> fmi2Status {
-    abi::exit_initialization_mode::<M>(c, at("fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE))
+    calls::exit_initialization_mode::<M>(c, at("fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE))
 }
 
 pub unsafe fn terminate<M: Model>(c: fmi2Component) -> fmi2Status {
-    abi::enter::<M>(c, at("fmi2Terminate", allowed::TERMINATE), State::Terminated)
+    calls::enter::<M>(c, at("fmi2Terminate", allowed::TERMINATE), Mode::Terminated)
 }
 
 pub unsafe fn reset<M: Model>(c: fmi2Component) -> fmi2Status {
-    abi::reset::<M>(c, at("fmi2Reset", allowed::RESET))
+    calls::reset::<M>(c, at("fmi2Reset", allowed::RESET))
 }
 
 pub unsafe fn get_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut f64) -> fmi2Status {
-    abi::get::<M, f64>(c, at("fmi2GetReal", allowed::GET), vr, n, value, BaseType::Real, abi::real)
+    calls::get::<M, f64>(c, at("fmi2GetReal", allowed::GET), vr, n, value, BaseType::Real, calls::real)
 }
 
 pub unsafe fn get_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> fmi2Status {
-    abi::get::<M, c_int>(c, at("fmi2GetInteger", allowed::GET), vr, n, value, BaseType::Integer, abi::integer)
+    calls::get::<M, c_int>(c, at("fmi2GetInteger", allowed::GET), vr, n, value, BaseType::Integer, calls::integer)
 }
 
 pub unsafe fn get_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> fmi2Status {
-    abi::get::<M, c_int>(c, at("fmi2GetBoolean", allowed::GET), vr, n, value, BaseType::Boolean, |v| {
+    calls::get::<M, c_int>(c, at("fmi2GetBoolean", allowed::GET), vr, n, value, BaseType::Boolean, |v| {
         matches!(v, Value::Boolean(true)) as c_int
     })
 }
 
 pub unsafe fn get_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut fmi2String) -> fmi2Status {
-    abi::get_string::<M>(c, at("fmi2GetString", allowed::GET), vr, n, value)
+    calls::get_string::<M>(c, at("fmi2GetString", allowed::GET), vr, n, value)
 }
 
 pub unsafe fn set_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const f64) -> fmi2Status {
-    abi::set::<M, f64>(c, at("fmi2SetReal", allowed::SET_REAL), vr, n, value, |x| Ok(Value::Real(x)))
+    calls::set::<M, f64>(c, at("fmi2SetReal", allowed::SET_REAL), vr, n, value, |x| Ok(Value::Real(x)))
 }
 
 pub unsafe fn set_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
-    abi::set::<M, c_int>(c, at("fmi2SetInteger", allowed::SET_DISCRETE), vr, n, value, |x| Ok(Value::Integer(x)))
+    calls::set::<M, c_int>(c, at("fmi2SetInteger", allowed::SET_DISCRETE), vr, n, value, |x| Ok(Value::Integer(x)))
 }
 
 pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
-    abi::set::<M, c_int>(c, at("fmi2SetBoolean", allowed::SET_DISCRETE), vr, n, value, |x| match x {
+    calls::set::<M, c_int>(c, at("fmi2SetBoolean", allowed::SET_DISCRETE), vr, n, value, |x| match x {
         FMI2_FALSE => Ok(Value::Boolean(false)),
         FMI2_TRUE => Ok(Value::Boolean(true)),
         _ => Err(format!("{x} is not an fmi2Boolean; valid values are fmi2False (0) and fmi2True (1)")),
@@ -172,19 +172,19 @@ pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, 
 }
 
 pub unsafe fn set_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const fmi2String) -> fmi2Status {
-    abi::set::<M, fmi2String>(c, at("fmi2SetString", allowed::SET_DISCRETE), vr, n, value, |p| abi::string_value(p))
+    calls::set::<M, fmi2String>(c, at("fmi2SetString", allowed::SET_DISCRETE), vr, n, value, |p| calls::string_value(p))
 }
 
 pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
-    abi::get_fmu_state::<M>(c, at("fmi2GetFMUstate", allowed::FMU_STATE), state)
+    calls::get_fmu_state::<M>(c, at("fmi2GetFMUstate", allowed::FMU_STATE), state)
 }
 
 pub unsafe fn set_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
-    abi::set_fmu_state::<M>(c, at("fmi2SetFMUstate", allowed::FMU_STATE), state)
+    calls::set_fmu_state::<M>(c, at("fmi2SetFMUstate", allowed::FMU_STATE), state)
 }
 
 pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
-    abi::free_fmu_state::<M>(c, at("fmi2FreeFMUstate", allowed::FMU_STATE), state)
+    calls::free_fmu_state::<M>(c, at("fmi2FreeFMUstate", allowed::FMU_STATE), state)
 }
 
 pub unsafe fn serialized_fmu_state_size<M: Model>(
@@ -192,7 +192,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
     state: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    abi::serialized_fmu_state_size::<M>(c, at("fmi2SerializedFMUstateSize", allowed::FMU_STATE), state, size)
+    calls::serialized_fmu_state_size::<M>(c, at("fmi2SerializedFMUstateSize", allowed::FMU_STATE), state, size)
 }
 
 pub unsafe fn serialize_fmu_state<M: Model>(
@@ -201,7 +201,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     bytes: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    abi::serialize_fmu_state::<M>(c, at("fmi2SerializeFMUstate", allowed::FMU_STATE), state, bytes as *mut u8, size)
+    calls::serialize_fmu_state::<M>(c, at("fmi2SerializeFMUstate", allowed::FMU_STATE), state, bytes as *mut u8, size)
 }
 
 pub unsafe fn deserialize_fmu_state<M: Model>(
@@ -211,7 +211,7 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
     let f = at("fmi2DeSerializeFMUstate", allowed::FMU_STATE);
-    abi::deserialize_fmu_state::<M>(c, f, bytes as *const u8, size, state)
+    calls::deserialize_fmu_state::<M>(c, f, bytes as *const u8, size, state)
 }
 
 /// fmi2GetDirectionalDerivative (FMI 2.0, 2.1.9), for the models that provide it.
@@ -225,7 +225,7 @@ pub unsafe fn get_directional_derivative<M: Model>(
     dv_unknown: *mut f64,
 ) -> fmi2Status {
     let f = at("fmi2GetDirectionalDerivative", allowed::DIRECTIONAL_DERIVATIVE);
-    abi::get_directional_derivative::<M>(c, f, (unknown, n_unknown), (known, n_known), dv_known, dv_unknown)
+    calls::get_directional_derivative::<M>(c, f, (unknown, n_unknown), (known, n_known), dv_known, dv_unknown)
 }
 
 pub unsafe fn set_real_input_derivatives<M: Model>(
@@ -236,7 +236,7 @@ pub unsafe fn set_real_input_derivatives<M: Model>(
     value: *const f64,
 ) -> fmi2Status {
     call::<M>(c, at("fmi2SetRealInputDerivatives", allowed::SET_INPUT_DERIVATIVES), |inst| {
-        let limit = abi::references::<M>();
+        let limit = calls::references::<M>(Version::Fmi2);
         let (vr, order, value) =
             (slice(vr, n, limit, "vr")?, slice(order, n, limit, "order")?, slice(value, n, limit, "value")?);
         inst.set_input_derivatives(vr, order, value)?;
@@ -246,31 +246,31 @@ pub unsafe fn set_real_input_derivatives<M: Model>(
 
 pub unsafe fn get_real_output_derivatives<M: Model>(c: fmi2Component) -> fmi2Status {
     let f = at("fmi2GetRealOutputDerivatives", allowed::GET_OUTPUT_DERIVATIVES);
-    abi::unsupported::<M>(c, f, "maxOutputDerivativeOrder=\"0\"")
+    calls::unsupported::<M>(c, f, "maxOutputDerivativeOrder=\"0\"")
 }
 
 pub unsafe fn do_step<M: Model>(c: fmi2Component, t: f64, h: f64, _no_set_prior: fmi2Boolean) -> fmi2Status {
     let f = at("fmi2DoStep", allowed::DO_STEP);
-    call::<M>(c, f, |inst| abi::do_step(inst, f.function, t, h))
+    call::<M>(c, f, |inst| calls::do_step(inst, f.function, t, h))
 }
 
 pub unsafe fn cancel_step<M: Model>(c: fmi2Component) -> fmi2Status {
     let f = at("fmi2CancelStep", allowed::CANCEL_STEP);
-    abi::unsupported::<M>(c, f, "doStep is synchronous (canRunAsynchronuously=\"false\")")
+    calls::unsupported::<M>(c, f, "doStep is synchronous (canRunAsynchronuously=\"false\")")
 }
 
 pub unsafe fn get_status<M: Model>(c: fmi2Component) -> fmi2Status {
     let f = at("fmi2GetStatus", allowed::GET_STATUS);
-    abi::unsupported::<M>(c, f, "no fmi2Status kind is defined for a synchronous slave")
+    calls::unsupported::<M>(c, f, "no fmi2Status kind is defined for a synchronous slave")
 }
 
 pub unsafe fn get_integer_status<M: Model>(c: fmi2Component) -> fmi2Status {
-    abi::unsupported::<M>(c, at("fmi2GetIntegerStatus", allowed::GET_STATUS), "FMI 2.0 defines no integer status")
+    calls::unsupported::<M>(c, at("fmi2GetIntegerStatus", allowed::GET_STATUS), "FMI 2.0 defines no integer status")
 }
 
 pub unsafe fn get_string_status<M: Model>(c: fmi2Component) -> fmi2Status {
     let f = at("fmi2GetStringStatus", allowed::GET_STATUS);
-    abi::unsupported::<M>(c, f, "no string status (fmi2PendingStatus needs an asynchronous doStep)")
+    calls::unsupported::<M>(c, f, "no string status (fmi2PendingStatus needs an asynchronous doStep)")
 }
 
 pub unsafe fn get_real_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut f64) -> fmi2Status {
@@ -289,13 +289,13 @@ pub unsafe fn get_boolean_status<M: Model>(c: fmi2Component, kind: c_int, value:
             return Err(format!("status kind {kind} is not available; only fmi2Terminated (3) is"));
         }
         // The slave asks to end the simulation only once a step has failed.
-        *value.as_mut().ok_or("value is NULL")? = (inst.core.state == State::StepFailed) as fmi2Boolean;
+        *value.as_mut().ok_or("value is NULL")? = (inst.core.mode == Mode::StepFailed) as fmi2Boolean;
         Ok(fmi2Status::OK)
     })
 }
 
 pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> fmi2Status {
-    abi::enter::<M>(c, at("fmi2EnterEventMode", allowed::ENTER_EVENT_MODE), State::EventMode)
+    calls::enter::<M>(c, at("fmi2EnterEventMode", allowed::ENTER_EVENT_MODE), Mode::EventMode)
 }
 
 /// fmi2NewDiscreteStates. The models have no discrete states and no time events; at a state
@@ -311,7 +311,7 @@ pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut fmi2Eve
 
 pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi2Component) -> fmi2Status {
     let f = at("fmi2EnterContinuousTimeMode", allowed::ENTER_CONTINUOUS_TIME_MODE);
-    abi::enter::<M>(c, f, State::ContinuousTimeMode)
+    calls::enter::<M>(c, f, Mode::ContinuousTimeMode)
 }
 
 /// fmi2CompletedIntegratorStep: no step events (`completedIntegratorStepNotNeeded="true"`).
@@ -322,32 +322,32 @@ pub unsafe fn completed_integrator_step<M: Model>(
     terminate: *mut fmi2Boolean,
 ) -> fmi2Status {
     let f = at("fmi2CompletedIntegratorStep", allowed::COMPLETED_INTEGRATOR_STEP);
-    abi::completed_integrator_step::<M, fmi2Boolean>(c, f, enter_event_mode, terminate)
+    calls::completed_integrator_step::<M, fmi2Boolean>(c, f, enter_event_mode, terminate)
 }
 
 pub unsafe fn set_time<M: Model>(c: fmi2Component, time: f64) -> fmi2Status {
-    abi::set_time::<M>(c, at("fmi2SetTime", allowed::SET_TIME), time)
+    calls::set_time::<M>(c, at("fmi2SetTime", allowed::SET_TIME), time)
 }
 
 pub unsafe fn set_continuous_states<M: Model>(c: fmi2Component, x: *const f64, nx: usize) -> fmi2Status {
-    abi::set_continuous_states::<M>(c, at("fmi2SetContinuousStates", allowed::SET_CONTINUOUS_STATES), x, nx)
+    calls::set_continuous_states::<M>(c, at("fmi2SetContinuousStates", allowed::SET_CONTINUOUS_STATES), x, nx)
 }
 
 pub unsafe fn get_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
-    abi::get_continuous_states::<M>(c, at("fmi2GetContinuousStates", allowed::GET_CONTINUOUS_STATES), x, nx)
+    calls::get_continuous_states::<M>(c, at("fmi2GetContinuousStates", allowed::GET_CONTINUOUS_STATES), x, nx)
 }
 
 /// fmi2GetDerivatives; fmi2Discard (FMI 2.0, 2.1.3: retry with a smaller step) where the
 /// states are outside the model's domain.
 pub unsafe fn get_derivatives<M: Model>(c: fmi2Component, dx: *mut f64, nx: usize) -> fmi2Status {
-    abi::get_derivatives::<M>(c, at("fmi2GetDerivatives", allowed::GET_DERIVATIVES), dx, nx)
+    calls::get_derivatives::<M>(c, at("fmi2GetDerivatives", allowed::GET_DERIVATIVES), dx, nx)
 }
 
 pub unsafe fn get_event_indicators<M: Model>(c: fmi2Component, z: *mut f64, ni: usize) -> fmi2Status {
-    abi::get_event_indicators::<M>(c, at("fmi2GetEventIndicators", allowed::GET_EVENT_INDICATORS), z, ni)
+    calls::get_event_indicators::<M>(c, at("fmi2GetEventIndicators", allowed::GET_EVENT_INDICATORS), z, ni)
 }
 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
     let f = at("fmi2GetNominalsOfContinuousStates", allowed::GET_NOMINALS);
-    abi::get_nominals_of_continuous_states::<M>(c, f, x, nx)
+    calls::get_nominals_of_continuous_states::<M>(c, f, x, nx)
 }

@@ -4,10 +4,10 @@
 
 pub mod api;
 mod export;
-pub mod state;
+pub mod machine;
 pub mod types;
 pub mod xml;
 
-pub use crate::fmu::{fmu_state, guid, instance, log, model, pack, structure, variables};
+pub use crate::fmu::{guid, instance, log, model, pack, snapshot, structure, variables};
 pub use crate::fmu::{Causality, ContinuousState, Fmu, Initial, Kind, Log, Model, ModelInfo, StepError, Value};
 pub use crate::fmu::{Values, Variability, Variable};

@@ -1,12 +1,12 @@
 //! The FMI 3.0 functions of Model Exchange and Co-Simulation (and, refused, those of Scheduled
 //! Execution, clocks and early return), generic over the model. The export macro
 //! ([`crate::export_fmi3`]) forwards each symbol here; what FMI 2.0 does alike is in
-//! [`crate::fmu::abi`], called with the function's FMI 3.0 name and its rule of [`allowed`].
+//! [`crate::fmu::calls`], called with the function's FMI 3.0 name and its rule of [`allowed`].
 #![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
 
-use super::state::{allowed, Interface, Rule, State};
+use super::machine::{allowed, Interface, Rule, Mode};
 use super::types::*;
-use crate::fmu::abi::{self, call, slice, slice_mut, Call};
+use crate::fmu::calls::{self, call, slice, slice_mut, Call};
 use crate::fmu::guid::token;
 use crate::fmu::instance::Instance;
 use crate::fmu::log::Logger;
@@ -55,15 +55,15 @@ unsafe fn instantiate<M: Model>(
 ) -> fmi3Instance {
     catch_unwind(std::panic::AssertUnwindSafe(|| {
         let sink = Box::new(Sink(log_message, environment));
-        let logger = Logger::new(Some(sink), abi::text(name).unwrap_or(""), M::INFO.log_categories, logging_on);
+        let logger = Logger::new(Some(sink), calls::text(name).unwrap_or(""), M::INFO.log_categories, logging_on);
         let expected = token::<M>();
-        let checked = abi::instance_name(name)
+        let checked = calls::instance_name(name)
             .and_then(|_| {
-                abi::check_identity(instantiation_token, "instantiationToken", "instantiationToken", &expected)
+                calls::check_identity(instantiation_token, "instantiationToken", "instantiationToken", &expected)
             })
             .and_then(|_| more());
         match checked {
-            Ok(()) => abi::new_instance::<M>(logger, expected, Version::Fmi3, interface),
+            Ok(()) => calls::new_instance::<M>(logger, expected, Version::Fmi3, interface),
             Err(message) => {
                 logger.status(fmi3Status::Error, &format!("{function}: {message}"));
                 std::ptr::null_mut()
@@ -142,7 +142,7 @@ pub unsafe fn instantiate_scheduled_execution<M: Model>(
     log_message: fmi3LogMessageCallback,
 ) -> fmi3Instance {
     let sink = Box::new(Sink(log_message, environment));
-    let logger = Logger::new(Some(sink), abi::text(name).unwrap_or(""), M::INFO.log_categories, logging_on);
+    let logger = Logger::new(Some(sink), calls::text(name).unwrap_or(""), M::INFO.log_categories, logging_on);
     logger.status(
         fmi3Status::Error,
         "fmi3InstantiateScheduledExecution: not supported: the FMU provides Model Exchange and Co-Simulation only",
@@ -151,7 +151,7 @@ pub unsafe fn instantiate_scheduled_execution<M: Model>(
 }
 
 pub unsafe fn free_instance<M: Model>(c: fmi3Instance) {
-    abi::free_instance::<M>(c, at("fmi3FreeInstance", allowed::FREE_INSTANCE))
+    calls::free_instance::<M>(c, at("fmi3FreeInstance", allowed::FREE_INSTANCE))
 }
 
 pub unsafe fn set_debug_logging<M: Model>(
@@ -160,7 +160,7 @@ pub unsafe fn set_debug_logging<M: Model>(
     n: usize,
     categories: *const fmi3String,
 ) -> fmi3Status {
-    abi::set_debug_logging::<M>(c, at("fmi3SetDebugLogging", allowed::SET_DEBUG_LOGGING), on, n, categories)
+    calls::set_debug_logging::<M>(c, at("fmi3SetDebugLogging", allowed::SET_DEBUG_LOGGING), on, n, categories)
 }
 
 /// fmi3EnterInitializationMode: the experiment (FMI 2.0's fmi2SetupExperiment) and the mode.
@@ -174,7 +174,7 @@ pub unsafe fn enter_initialization_mode<M: Model>(
 ) -> fmi3Status {
     let f = at("fmi3EnterInitializationMode", allowed::ENTER_INITIALIZATION_MODE);
     call::<M>(c, f, |inst| {
-        let status = abi::setup_experiment(
+        let status = calls::setup_experiment(
             inst,
             f.function,
             tolerance_defined.then_some(tolerance),
@@ -187,19 +187,19 @@ pub unsafe fn enter_initialization_mode<M: Model>(
 }
 
 pub unsafe fn exit_initialization_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
-    abi::exit_initialization_mode::<M>(c, at("fmi3ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE))
+    calls::exit_initialization_mode::<M>(c, at("fmi3ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE))
 }
 
 pub unsafe fn enter_event_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
-    abi::enter::<M>(c, at("fmi3EnterEventMode", allowed::ENTER_EVENT_MODE), State::EventMode)
+    calls::enter::<M>(c, at("fmi3EnterEventMode", allowed::ENTER_EVENT_MODE), Mode::EventMode)
 }
 
 pub unsafe fn terminate<M: Model>(c: fmi3Instance) -> fmi3Status {
-    abi::enter::<M>(c, at("fmi3Terminate", allowed::TERMINATE), State::Terminated)
+    calls::enter::<M>(c, at("fmi3Terminate", allowed::TERMINATE), Mode::Terminated)
 }
 
 pub unsafe fn reset<M: Model>(c: fmi3Instance) -> fmi3Status {
-    abi::reset::<M>(c, at("fmi3Reset", allowed::RESET))
+    calls::reset::<M>(c, at("fmi3Reset", allowed::RESET))
 }
 
 /// The variables are scalars: `nValues` must equal `nValueReferences`.
@@ -223,7 +223,7 @@ unsafe fn get<M: Model, T>(
     if let Err(e) = scalar_count(n, n_values) {
         return call::<M>(c, f, |_| Err(e));
     }
-    abi::get::<M, T>(c, f, vr, n, out, wanted, read)
+    calls::get::<M, T>(c, f, vr, n, out, wanted, read)
 }
 
 /// A setter whose `nValues` is checked first.
@@ -236,15 +236,15 @@ unsafe fn set<M: Model, T: Copy>(
     if let Err(e) = scalar_count(n, n_values) {
         return call::<M>(c, f, |_| Err(e));
     }
-    abi::set::<M, T>(c, f, vr, n, value, convert)
+    calls::set::<M, T>(c, f, vr, n, value, convert)
 }
 
 pub unsafe fn get_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut f64, nv: usize) -> fmi3Status {
-    get::<M, f64>(c, at("fmi3GetFloat64", allowed::GET), (vr, n, v, nv), BaseType::Real, abi::real)
+    get::<M, f64>(c, at("fmi3GetFloat64", allowed::GET), (vr, n, v, nv), BaseType::Real, calls::real)
 }
 
 pub unsafe fn get_int32<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut i32, nv: usize) -> fmi3Status {
-    get::<M, i32>(c, at("fmi3GetInt32", allowed::GET), (vr, n, v, nv), BaseType::Integer, abi::integer)
+    get::<M, i32>(c, at("fmi3GetInt32", allowed::GET), (vr, n, v, nv), BaseType::Integer, calls::integer)
 }
 
 pub unsafe fn get_boolean<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut bool, nv: usize) -> fmi3Status {
@@ -264,7 +264,7 @@ pub unsafe fn get_string<M: Model>(
     if let Err(e) = scalar_count(n, nv) {
         return call::<M>(c, f, |_| Err(e));
     }
-    abi::get_string::<M>(c, f, vr, n, v)
+    calls::get_string::<M>(c, f, vr, n, v)
 }
 
 pub unsafe fn set_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const f64, nv: usize) -> fmi3Status {
@@ -292,7 +292,7 @@ pub unsafe fn set_string<M: Model>(
     v: *const fmi3String,
     nv: usize,
 ) -> fmi3Status {
-    set::<M, fmi3String>(c, at("fmi3SetString", allowed::SET_DISCRETE), (vr, n, v, nv), |p| abi::string_value(p))
+    set::<M, fmi3String>(c, at("fmi3SetString", allowed::SET_DISCRETE), (vr, n, v, nv), |p| calls::string_value(p))
 }
 
 /// The get and set functions of the types no variable has (Float32, Int8 ... UInt64, Binary,
@@ -307,7 +307,7 @@ pub unsafe fn other_type<M: Model>(
 ) -> fmi3Status {
     let rule = if set { allowed::SET_DISCRETE } else { allowed::GET };
     call::<M>(c, at(function, rule), |inst: &mut Instance<M>| {
-        match slice(vr, n, abi::references::<M>(), "valueReferences")?.first() {
+        match slice(vr, n, calls::references::<M>(Version::Fmi3), "valueReferences")?.first() {
             Some(&r) => Err(inst.type_mismatch(r, ty)),
             None => Ok(fmi3Status::OK),
         }
@@ -316,19 +316,19 @@ pub unsafe fn other_type<M: Model>(
 
 /// Functions boomsim does not provide, in any state.
 pub fn unsupported<M: Model>(c: fmi3Instance, function: &'static str, why: &str) -> fmi3Status {
-    abi::unsupported::<M>(c, at(function, allowed::UNSUPPORTED), why)
+    calls::unsupported::<M>(c, at(function, allowed::UNSUPPORTED), why)
 }
 
 pub unsafe fn get_fmu_state<M: Model>(c: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status {
-    abi::get_fmu_state::<M>(c, at("fmi3GetFMUState", allowed::FMU_STATE), state)
+    calls::get_fmu_state::<M>(c, at("fmi3GetFMUState", allowed::FMU_STATE), state)
 }
 
 pub unsafe fn set_fmu_state<M: Model>(c: fmi3Instance, state: fmi3FMUState) -> fmi3Status {
-    abi::set_fmu_state::<M>(c, at("fmi3SetFMUState", allowed::FMU_STATE), state)
+    calls::set_fmu_state::<M>(c, at("fmi3SetFMUState", allowed::FMU_STATE), state)
 }
 
 pub unsafe fn free_fmu_state<M: Model>(c: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status {
-    abi::free_fmu_state::<M>(c, at("fmi3FreeFMUState", allowed::FMU_STATE), state)
+    calls::free_fmu_state::<M>(c, at("fmi3FreeFMUState", allowed::FMU_STATE), state)
 }
 
 pub unsafe fn serialized_fmu_state_size<M: Model>(
@@ -336,7 +336,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
     state: fmi3FMUState,
     size: *mut usize,
 ) -> fmi3Status {
-    abi::serialized_fmu_state_size::<M>(c, at("fmi3SerializedFMUStateSize", allowed::FMU_STATE), state, size)
+    calls::serialized_fmu_state_size::<M>(c, at("fmi3SerializedFMUStateSize", allowed::FMU_STATE), state, size)
 }
 
 pub unsafe fn serialize_fmu_state<M: Model>(
@@ -345,7 +345,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     bytes: *mut u8,
     size: usize,
 ) -> fmi3Status {
-    abi::serialize_fmu_state::<M>(c, at("fmi3SerializeFMUState", allowed::FMU_STATE), state, bytes, size)
+    calls::serialize_fmu_state::<M>(c, at("fmi3SerializeFMUState", allowed::FMU_STATE), state, bytes, size)
 }
 
 pub unsafe fn deserialize_fmu_state<M: Model>(
@@ -354,7 +354,7 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
     size: usize,
     state: *mut fmi3FMUState,
 ) -> fmi3Status {
-    abi::deserialize_fmu_state::<M>(c, at("fmi3DeserializeFMUState", allowed::FMU_STATE), bytes, size, state)
+    calls::deserialize_fmu_state::<M>(c, at("fmi3DeserializeFMUState", allowed::FMU_STATE), bytes, size, state)
 }
 
 /// The scalar counts of the derivative functions: `nSeed` and `nSensitivity` against the
@@ -385,7 +385,7 @@ pub unsafe fn get_directional_derivative<M: Model>(
     if let Err(e) = derivative_counts(n_seed, n_knowns, n_sensitivity, n_unknowns) {
         return call::<M>(c, f, |_| Err(e));
     }
-    abi::get_directional_derivative::<M>(c, f, (unknowns, n_unknowns), (knowns, n_knowns), seed, sensitivity)
+    calls::get_directional_derivative::<M>(c, f, (unknowns, n_unknowns), (knowns, n_knowns), seed, sensitivity)
 }
 
 /// fmi3GetAdjointDerivative: the seeds weight the unknowns, the sensitivities are per known
@@ -399,11 +399,11 @@ pub unsafe fn get_adjoint_derivative<M: Model>(
 ) -> fmi3Status {
     let f = at("fmi3GetAdjointDerivative", allowed::DERIVATIVES);
     if !M::DIRECTIONAL_DERIVATIVES {
-        return abi::unsupported::<M>(c, f, "providesAdjointDerivatives=\"false\"");
+        return calls::unsupported::<M>(c, f, "providesAdjointDerivatives=\"false\"");
     }
     call::<M>(c, f, |inst| {
         derivative_counts(n_seed, n_unknowns, n_sensitivity, n_knowns)?;
-        let limit = abi::references::<M>();
+        let limit = calls::references::<M>(Version::Fmi3);
         let unknowns = slice(unknowns, n_unknowns, limit, "unknowns")?;
         let knowns = slice(knowns, n_knowns, limit, "knowns")?;
         let seeds = slice(seed, n_seed, limit, "seed")?;
@@ -446,7 +446,7 @@ pub unsafe fn update_discrete_states<M: Model>(
 
 pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
     let f = at("fmi3EnterContinuousTimeMode", allowed::ENTER_CONTINUOUS_TIME_MODE);
-    abi::enter::<M>(c, f, State::ContinuousTimeMode)
+    calls::enter::<M>(c, f, Mode::ContinuousTimeMode)
 }
 
 pub unsafe fn completed_integrator_step<M: Model>(
@@ -455,33 +455,33 @@ pub unsafe fn completed_integrator_step<M: Model>(
     terminate: *mut bool,
 ) -> fmi3Status {
     let f = at("fmi3CompletedIntegratorStep", allowed::COMPLETED_INTEGRATOR_STEP);
-    abi::completed_integrator_step::<M, bool>(c, f, enter_event_mode, terminate)
+    calls::completed_integrator_step::<M, bool>(c, f, enter_event_mode, terminate)
 }
 
 pub unsafe fn set_time<M: Model>(c: fmi3Instance, time: f64) -> fmi3Status {
-    abi::set_time::<M>(c, at("fmi3SetTime", allowed::SET_TIME), time)
+    calls::set_time::<M>(c, at("fmi3SetTime", allowed::SET_TIME), time)
 }
 
 pub unsafe fn set_continuous_states<M: Model>(c: fmi3Instance, x: *const f64, nx: usize) -> fmi3Status {
-    abi::set_continuous_states::<M>(c, at("fmi3SetContinuousStates", allowed::SET_CONTINUOUS_STATES), x, nx)
+    calls::set_continuous_states::<M>(c, at("fmi3SetContinuousStates", allowed::SET_CONTINUOUS_STATES), x, nx)
 }
 
 pub unsafe fn get_continuous_states<M: Model>(c: fmi3Instance, x: *mut f64, nx: usize) -> fmi3Status {
-    abi::get_continuous_states::<M>(c, at("fmi3GetContinuousStates", allowed::GET_CONTINUOUS_STATES), x, nx)
+    calls::get_continuous_states::<M>(c, at("fmi3GetContinuousStates", allowed::GET_CONTINUOUS_STATES), x, nx)
 }
 
 pub unsafe fn get_continuous_state_derivatives<M: Model>(c: fmi3Instance, dx: *mut f64, nx: usize) -> fmi3Status {
     let f = at("fmi3GetContinuousStateDerivatives", allowed::GET_CONTINUOUS_STATE_DERIVATIVES);
-    abi::get_derivatives::<M>(c, f, dx, nx)
+    calls::get_derivatives::<M>(c, f, dx, nx)
 }
 
 pub unsafe fn get_event_indicators<M: Model>(c: fmi3Instance, z: *mut f64, ni: usize) -> fmi3Status {
-    abi::get_event_indicators::<M>(c, at("fmi3GetEventIndicators", allowed::GET_EVENT_INDICATORS), z, ni)
+    calls::get_event_indicators::<M>(c, at("fmi3GetEventIndicators", allowed::GET_EVENT_INDICATORS), z, ni)
 }
 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: fmi3Instance, x: *mut f64, nx: usize) -> fmi3Status {
     let f = at("fmi3GetNominalsOfContinuousStates", allowed::GET_NOMINALS);
-    abi::get_nominals_of_continuous_states::<M>(c, f, x, nx)
+    calls::get_nominals_of_continuous_states::<M>(c, f, x, nx)
 }
 
 pub unsafe fn get_number_of_event_indicators<M: Model>(c: fmi3Instance, n: *mut usize) -> fmi3Status {
@@ -500,12 +500,12 @@ pub unsafe fn get_number_of_continuous_states<M: Model>(c: fmi3Instance, n: *mut
 
 /// fmi3EnterStepMode: only from Event Mode, which these Co-Simulation instances never enter.
 pub unsafe fn enter_step_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
-    abi::enter::<M>(c, at("fmi3EnterStepMode", allowed::ENTER_STEP_MODE), State::StepComplete)
+    calls::enter::<M>(c, at("fmi3EnterStepMode", allowed::ENTER_STEP_MODE), Mode::StepComplete)
 }
 
 pub unsafe fn get_output_derivatives<M: Model>(c: fmi3Instance) -> fmi3Status {
     let f = at("fmi3GetOutputDerivatives", allowed::GET_OUTPUT_DERIVATIVES);
-    abi::unsupported::<M>(c, f, "maxOutputDerivativeOrder=\"0\"")
+    calls::unsupported::<M>(c, f, "maxOutputDerivativeOrder=\"0\"")
 }
 
 /// fmi3DoStep. The out-arguments are checked before the step: no event handling (no event
@@ -525,9 +525,9 @@ pub unsafe fn do_step<M: Model>(
         let term = terminate.as_mut().ok_or("terminateSimulation is NULL")?;
         let early = early_return.as_mut().ok_or("earlyReturn is NULL")?;
         let last = last_successful_time.as_mut().ok_or("lastSuccessfulTime is NULL")?;
-        let status = abi::do_step(inst, f.function, t, h);
+        let status = calls::do_step(inst, f.function, t, h);
         (*event, *early) = (false, false);
-        *term = inst.core.state == State::StepFailed;
+        *term = inst.core.mode == Mode::StepFailed;
         *last = inst.core.last_successful_time;
         status
     })

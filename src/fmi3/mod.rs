@@ -5,6 +5,6 @@
 
 pub mod api;
 mod export;
-pub mod state;
+pub mod machine;
 pub mod types;
 pub mod xml;

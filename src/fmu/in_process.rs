@@ -4,7 +4,7 @@
 
 use super::instance::{Instance, Step};
 use super::log::Logger;
-use super::state::Interface;
+use super::machine::Interface;
 use super::variables::BaseType;
 use super::{guid::guid, Model, Value};
 

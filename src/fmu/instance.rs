@@ -3,7 +3,7 @@
 
 use super::log::{num, Logger, Status};
 use super::model::{initial_unknown, Log, Model};
-use super::state::{Interface, State};
+use super::machine::{Interface, Mode};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
 use std::borrow::Cow;
@@ -52,7 +52,7 @@ pub struct Instance<M: Model> {
 /// Everything an FMU state captures: the instance less its name and logger.
 #[derive(Clone)]
 pub struct Core<M: Model> {
-    pub state: State,
+    pub mode: Mode,
     pub values: Values,
     /// First derivatives of Real inputs (fmi2SetRealInputDerivatives), per table row.
     pub input_derivatives: Vec<f64>,
@@ -74,7 +74,7 @@ impl<M: Model> Core<M> {
     /// The state right after fmi2Instantiate: start values, time 0.
     pub fn new() -> Self {
         Core {
-            state: State::Instantiated,
+            mode: Mode::Instantiated,
             values: Values::new(M::VARIABLES),
             input_derivatives: vec![0.0; M::VARIABLES.len()],
             model: None,
@@ -224,7 +224,7 @@ impl<M: Model> Instance<M> {
 
     /// fmi2EnterInitializationMode.
     pub fn enter_initialization_mode(&mut self) {
-        self.core.state = State::InitializationMode;
+        self.core.mode = Mode::InitializationMode;
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
     }
@@ -242,9 +242,9 @@ impl<M: Model> Instance<M> {
         c.outputs_current = true;
         c.derivatives_current = false;
         c.last_successful_time = c.time;
-        c.state = match self.interface {
-            Interface::CoSimulation => State::StepComplete,
-            Interface::ModelExchange => State::EventMode,
+        c.mode = match self.interface {
+            Interface::CoSimulation => Mode::StepComplete,
+            Interface::ModelExchange => Mode::EventMode,
         };
         Ok(())
     }
@@ -292,7 +292,7 @@ impl<M: Model> Instance<M> {
     fn with_model<R>(&self, f: impl FnOnce(&M, &Values) -> R) -> Result<R, String> {
         let c = &self.core;
         match &c.model {
-            Some(model) if c.state != State::InitializationMode => Ok(f(model, &c.values)),
+            Some(model) if c.mode != Mode::InitializationMode => Ok(f(model, &c.values)),
             _ => Ok(f(&M::initialize(&c.values)?, &c.values)),
         }
     }
@@ -345,7 +345,7 @@ impl<M: Model> Instance<M> {
     /// `Ok(Some(why))`: not finite at these states (status Discard).
     pub fn derivatives(&mut self, dx: &mut [f64]) -> Result<Warning, String> {
         Self::check_states(dx.len())?;
-        if self.core.state == State::InitializationMode {
+        if self.core.mode == Mode::InitializationMode {
             self.with_model(|m, values| m.derivatives(values, dx))?;
         } else {
             let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
@@ -374,7 +374,7 @@ impl<M: Model> Instance<M> {
         seeds: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
-        let init = self.core.state == State::InitializationMode;
+        let init = self.core.mode == Mode::InitializationMode;
         let me = self.interface == Interface::ModelExchange;
         for &vr in unknowns {
             let (i, v) = self.lookup(vr, BaseType::Real)?;
@@ -392,7 +392,7 @@ impl<M: Model> Instance<M> {
             let (_, v) = self.lookup(vr, BaseType::Real)?;
             let state = M::STATES.iter().any(|s| s.state == vr);
             let input = v.causality == Causality::Input;
-            let ok = if init { settable(v, false, State::InitializationMode).is_ok() } else { input || (me && state) };
+            let ok = if init { settable(v, false, Mode::InitializationMode).is_ok() } else { input || (me && state) };
             if !ok {
                 let what = match (init, me) {
                     (true, _) => "an input or a variable with initial=\"exact\"",
@@ -514,7 +514,7 @@ impl<M: Model> Instance<M> {
         if c.outputs_current {
             return Ok(());
         }
-        if c.state == State::InitializationMode {
+        if c.mode == Mode::InitializationMode {
             // Initial outputs follow from the values set so far.
             write_outputs(&M::initialize(&c.values)?, &mut c.values);
         } else if let Some(model) = &c.model {
@@ -619,9 +619,9 @@ impl<M: Model> Instance<M> {
         for (&vr, value) in vrs.iter().zip(new) {
             let (i, v) = self.lookup(vr, value.base_type())?;
             let state = M::STATES.iter().position(|s| s.state == vr);
-            settable(v, state.is_some(), self.core.state)?;
+            settable(v, state.is_some(), self.core.mode)?;
             in_range(v, &value)?;
-            if let (State::ContinuousTimeMode, Some(k), Value::Real(x)) = (self.core.state, state, &value) {
+            if let (Mode::ContinuousTimeMode, Some(k), Value::Real(x)) = (self.core.mode, state, &value) {
                 let x0 = states.get_or_insert_with(|| self.exposed_states());
                 x0[k] = *x;
             }
@@ -632,7 +632,7 @@ impl<M: Model> Instance<M> {
             // state, as fmi2SetContinuousStates would set it (checked by the model the same way).
             self.set_continuous_states(&x)?;
         }
-        let tunes = matches!(self.core.state, State::StepComplete | State::EventMode)
+        let tunes = matches!(self.core.mode, Mode::StepComplete | Mode::EventMode)
             && checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
         let before = tunes.then(|| self.core.values.clone());
         for (i, value) in checked {
@@ -645,7 +645,7 @@ impl<M: Model> Instance<M> {
                 return Err(e);
             }
         }
-        if let (State::StepComplete, Some(model)) = (self.core.state, self.core.model.as_mut()) {
+        if let (Mode::StepComplete, Some(model)) = (self.core.mode, self.core.model.as_mut()) {
             model.inputs_set(vrs);
         }
         self.core.outputs_current = false;
@@ -750,7 +750,7 @@ impl<M: Model> Instance<M> {
             // in state StepFailed.
             c.time = e.time;
             c.last_successful_time = e.time;
-            c.state = State::StepFailed;
+            c.mode = Mode::StepFailed;
             return Ok(Step::Discarded(why));
         }
         // Inputs with a derivative follow their ramp to the new communication point (only
@@ -772,7 +772,7 @@ impl<M: Model> Instance<M> {
         c.outputs_current = true;
         c.derivatives_current = false;
         if let Some(i) = c.values.take_non_finite() {
-            c.state = State::Error;
+            c.mode = Mode::Error;
             let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
             return Err(format!(
                 "{} = {} at t = {}: the model left its valid range",
@@ -846,27 +846,27 @@ pub fn bounded_slope(x: f64, d: f64, h: f64, (min, max): (f64, f64)) -> f64 {
 
 /// FMI 2.0 section 2.2.7 and the state tables (3.2.3, 4.2.4): which variables may be set in
 /// which state; `continuous_state`: `v` is a continuous-time state.
-fn settable(v: &Variable, continuous_state: bool, state: State) -> Result<(), String> {
+fn settable(v: &Variable, continuous_state: bool, state: Mode) -> Result<(), String> {
     let input = v.causality == Causality::Input;
     let ok = v.variability != Variability::Constant
         && match state {
-            State::Instantiated => v.initial != Initial::Calculated || input,
-            State::InitializationMode => v.initial == Initial::Exact || input,
-            State::StepComplete | State::EventMode => {
+            Mode::Instantiated => v.initial != Initial::Calculated || input,
+            Mode::InitializationMode => v.initial == Initial::Exact || input,
+            Mode::StepComplete | Mode::EventMode => {
                 input || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
             }
             // FMI 2.0 rule 5 (clarified in 2.0.1), FMI 3.0.2 3.2.1: continuous inputs and
             // continuous-time states.
-            State::ContinuousTimeMode => (input && v.variability == Variability::Continuous) || continuous_state,
+            Mode::ContinuousTimeMode => (input && v.variability == Variability::Continuous) || continuous_state,
             _ => false,
         };
     if ok {
         return Ok(());
     }
     let rule = match state {
-        State::StepComplete | State::EventMode => "after initialisation only inputs and tunable parameters may be set",
-        State::ContinuousTimeMode => "in Continuous-Time Mode only continuous inputs and continuous states may be set",
-        State::Instantiated | State::InitializationMode => "only parameters and inputs may be set",
+        Mode::StepComplete | Mode::EventMode => "after initialisation only inputs and tunable parameters may be set",
+        Mode::ContinuousTimeMode => "in Continuous-Time Mode only continuous inputs and continuous states may be set",
+        Mode::Instantiated | Mode::InitializationMode => "only parameters and inputs may be set",
         _ => "no variable may be set in this state",
     };
     Err(format!(

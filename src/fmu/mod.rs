@@ -4,16 +4,16 @@
 //! the bodies of the C functions both versions have, and the .fmu packer. The adapters
 //! [`crate::fmi2`] and [`crate::fmi3`] add only what their version names or types differently.
 
-pub mod abi;
+pub mod calls;
 pub mod chart;
-pub mod fmu_state;
+pub mod snapshot;
 pub mod guid;
 pub mod in_process;
 pub mod instance;
 pub mod log;
 pub mod model;
 pub mod pack;
-pub mod state;
+pub mod machine;
 pub mod structure;
 pub mod variables;
 pub mod version;

@@ -11,7 +11,7 @@
 
 use super::boom::Boom;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
-use super::states::{BOOM_DERIVATIVES, BOOM_STATES};
+use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
 use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION};
 use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
@@ -252,8 +252,8 @@ impl Model for BoomMechanics {
         port::directional_derivative_check(self.sys.coupling)?;
         let mut x = [0.0; BOOM_STATES.len()];
         self.continuous_states(&mut x);
-        let x = super::states::seeded_states(&BOOM_STATES, &x, knowns);
-        let f = super::states::seeded(knowns, vr::F, values.real(vr::F));
+        let x = super::exposed::seeded_states(&BOOM_STATES, &x, knowns);
+        let f = super::exposed::seeded(knowns, vr::F, values.real(vr::F));
         let dof = self.sys.boom.mechanics().dof();
         let (mut q, mut qd) = ([Dual64::from(0.0); MAX_SECTIONS], [Dual64::from(0.0); MAX_SECTIONS]);
         let (q, qd) = (&mut q[..dof], &mut qd[..dof]);
@@ -271,7 +271,7 @@ impl Model for BoomMechanics {
         let boom = self.sys.boom.output_rows(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y]);
         let derivatives = BOOM_STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d));
         let rows: Vec<(u32, Dual64)> = port.into_iter().chain(boom).chain(derivatives).collect();
-        super::states::pick_derivatives(&rows, unknowns, out)
+        super::exposed::pick_derivatives(&rows, unknowns, out)
     }
 
     /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).

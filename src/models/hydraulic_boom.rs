@@ -11,7 +11,7 @@
 pub use super::boom::Boom;
 use super::circuit::CIRCUIT_SCALE;
 use super::port::Ramp;
-use super::states::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
+use super::exposed::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
 use super::table::{
     out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_P4,
     START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
@@ -275,8 +275,8 @@ impl Model for HydraulicBoom {
     ) -> Result<(), String> {
         let mut x = [0.0; PLANT_STATES.len()];
         self.continuous_states(&mut x);
-        let x = super::states::seeded_states(&PLANT_STATES, &x, knowns);
-        let u_ref = super::states::seeded(knowns, vr::U_REF, values.real(vr::U_REF));
+        let x = super::exposed::seeded_states(&PLANT_STATES, &x, knowns);
+        let u_ref = super::exposed::seeded(knowns, vr::U_REF, values.real(vr::U_REF));
         let mut s = [Dual64::from(0.0); N_CIRCUIT + 2 * MAX_SECTIONS];
         let s = &mut s[..self.state.len()];
         s[..N_CIRCUIT].copy_from_slice(&x[..N_CIRCUIT]);
@@ -286,7 +286,7 @@ impl Model for HydraulicBoom {
         self.plant.me_rhs(u_ref, s, &mut dx);
         let derivatives = PLANT_STATES.iter().zip(dx).map(|(st, d)| (st.derivative, d));
         let rows: Vec<(u32, Dual64)> = self.plant.output_rows(u_ref, s).chain(derivatives).collect();
-        super::states::pick_derivatives(&rows, unknowns, out)
+        super::exposed::pick_derivatives(&rows, unknowns, out)
     }
 
     fn retune(&mut self, _values: &Values) -> Result<(), String> {

@@ -13,7 +13,7 @@
 
 use super::circuit::CIRCUIT_SCALE;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
-use super::states::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
+use super::exposed::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
 use super::table::{
     out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_P4, START_STROKE, U_REF_INPUT,
 };
@@ -293,16 +293,16 @@ impl Model for HydraulicCircuit {
         out: &mut [f64],
     ) -> Result<(), String> {
         port::directional_derivative_check(self.sys.coupling)?;
-        let seed = |r: u32, x: f64| super::states::seeded(knowns, r, x);
+        let seed = |r: u32, x: f64| super::exposed::seeded(knowns, r, x);
         let c =
-            super::states::seeded_states(&CIRCUIT_STATES, self.state[..N_CIRCUIT].try_into().expect("circuit"), knowns);
+            super::exposed::seeded_states(&CIRCUIT_STATES, self.state[..N_CIRCUIT].try_into().expect("circuit"), knowns);
         let [u_ref, x, v] = [vr::U_REF, vr::X, vr::V].map(|r| seed(r, values.real(r)));
         let e = self.sys.circuit.evaluate(&c, u_ref, x, v);
         let port = [(vr::C_H, e.force), (port::vr::F, e.force), (vr::PORT_X, x), (vr::PORT_V, v)];
         let derivatives = CIRCUIT_STATES.iter().zip(e.dx).map(|(s, d)| (s.derivative, d));
         let rows: Vec<(u32, Dual64)> =
             super::circuit::circuit_rows(&c, &e).into_iter().chain(port).chain(derivatives).collect();
-        super::states::pick_derivatives(&rows, unknowns, out)
+        super::exposed::pick_derivatives(&rows, unknowns, out)
     }
 
     /// The plain port's circuit at the stroke and velocity inputs.

@@ -8,7 +8,7 @@ pub mod hydraulic_boom;
 pub mod hydraulic_circuit;
 pub mod port;
 pub mod pressure_feedback_controller;
-pub mod states;
+pub mod exposed;
 pub mod stepping;
 pub mod table;
 pub mod vr;

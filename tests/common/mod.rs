@@ -157,7 +157,7 @@ fn crc32(data: &[u8]) -> u32 {
     !c
 }
 
-/// Byte offset of the payload of a serialised FMU state (the layout of src/fmi2/fmu_state.rs,
+/// Byte offset of the payload of a serialised FMU state (the layout of src/fmu/snapshot.rs,
 /// read independently: magic 8, format version 4, GUID length 4 + GUID, payload length 8).
 pub fn payload_offset(b: &[u8]) -> usize {
     let n = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
@@ -205,7 +205,7 @@ pub fn serialized<M: Model>(s: &Slave<M>) -> Vec<u8> {
 /// A silent in-process Co-Simulation instance of `M` in Initialization Mode with the values of
 /// `setup` set (the safe Rust API under the C ABI).
 pub fn in_initialization<M: Model>(setup: &[(u32, boomsim::fmi2::Value)]) -> boomsim::fmi2::instance::Instance<M> {
-    use boomsim::fmi2::{instance::Instance, log::Logger, state::Interface};
+    use boomsim::fmi2::{instance::Instance, log::Logger, machine::Interface};
     let log = Logger::new(None, "test", &[], false);
     let mut i = Instance::<M>::new(log, guid::<M>(), boomsim::fmu::Version::Fmi2, Interface::CoSimulation);
     i.setup_experiment(None, 0.0, None).unwrap();

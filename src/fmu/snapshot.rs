@@ -13,7 +13,7 @@
 use super::instance::{in_range, Core, TOLERANCE_RANGE};
 use super::log::num;
 use super::model::Model;
-use super::state::State;
+use super::machine::Mode;
 use super::variables::{Value, Values};
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
@@ -23,7 +23,7 @@ pub const FORMAT_VERSION: u32 = 4;
 /// Serialises a core into the checked byte format.
 pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
     let mut p = Vec::new();
-    p.push(state_code(core.state));
+    p.push(mode_code(core.mode));
     for x in [core.time, core.start_time, core.last_successful_time] {
         put_f64(&mut p, x);
     }
@@ -122,7 +122,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
     if len != body.len() - r.at {
         return Err(format!("payload length {len} does not match the {} bytes present", body.len() - r.at));
     }
-    let state = decode_state(r.take(1)?[0])?;
+    let state = decode_mode(r.take(1)?[0])?;
     let (time, start_time, last_successful_time) = (r.f64()?, r.f64()?, r.f64()?);
     let mut opt = || -> Result<Option<f64>, String> {
         let some = r.take(1)?[0] != 0;
@@ -154,8 +154,13 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         };
         values.put(i, v);
     }
+    // A model that left its valid range ended in the Error state (FMI 3.0: Terminated) with the
+    // non-finite values it computed, for debugging (FMI 2.0, 2.1.3); such a state reads back.
+    let broken = matches!(state, Mode::Error | Mode::Terminated);
     for (v, x) in M::VARIABLES.iter().zip(values.all()) {
-        in_range(v, x).map_err(|e| format!("the serialised FMU state holds {e}"))?;
+        if !(broken && matches!(x, Value::Real(r) if !r.is_finite())) {
+            in_range(v, x).map_err(|e| format!("the serialised FMU state holds {e}"))?;
+        }
     }
     check_times(time, start_time, last_successful_time, stop_time, tolerance)?;
     let input_derivatives = (0..count).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
@@ -173,13 +178,14 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
     if r.at != body.len() {
         return Err(format!("{} unexpected bytes after the state", body.len() - r.at));
     }
-    // A model exists exactly once initialisation has ended (a panic may leave Error without one).
-    let initialised = !matches!(state, State::Instantiated | State::InitializationMode);
-    if model.is_some() != initialised && state != State::Error {
+    // A model exists exactly once initialisation has ended; Error and Terminated may come before
+    // it (a panic, FMI 3.0: any fmi3Error) and so may lack one.
+    let initialised = !matches!(state, Mode::Instantiated | Mode::InitializationMode);
+    if model.is_some() != initialised && !broken {
         return Err(format!("state {state:?} {} a model", if initialised { "needs" } else { "cannot have" }));
     }
     Ok(Core {
-        state,
+        mode: state,
         values,
         input_derivatives,
         model,
@@ -223,11 +229,11 @@ fn put_u64(out: &mut Vec<u8>, x: u64) {
     out.extend_from_slice(&x.to_le_bytes());
 }
 
-fn state_code(s: State) -> u8 {
-    State::ALL.iter().position(|&x| x == s).unwrap_or(0) as u8
+fn mode_code(s: Mode) -> u8 {
+    Mode::ALL.iter().position(|&x| x == s).unwrap_or(0) as u8
 }
-fn decode_state(c: u8) -> Result<State, String> {
-    State::ALL.get(c as usize).copied().ok_or_else(|| format!("invalid state code {c}"))
+fn decode_mode(c: u8) -> Result<Mode, String> {
+    Mode::ALL.get(c as usize).copied().ok_or_else(|| format!("invalid state code {c}"))
 }
 
 /// A bounds-checked cursor.

@@ -1,12 +1,12 @@
 //! The FMI 3.0 state machines of Co-Simulation (FMI 3.0, section 4.2.4) and Model Exchange
 //! (section 3.2.4) as one table: per function, the interface it belongs to and the set of states
-//! in which it may be called. The states are those of [`crate::fmu::state`]: `StepComplete` is
+//! in which it may be called. The states are those of [`crate::fmu::machine`]: `StepComplete` is
 //! FMI 3.0's Step Mode, `StepFailed` its Step Discarded; `StepCanceled` is never entered. There
 //! are no structural parameters, clocks, or event mode in Co-Simulation (`hasEventMode="false"`),
 //! so Configuration, Reconfiguration, Clock Activation and Intermediate Update Mode are never
 //! entered either.
 
-pub use crate::fmu::state::*;
+pub use crate::fmu::machine::*;
 
 /// Per function: the interface and the states in which the call is legal.
 pub mod allowed {

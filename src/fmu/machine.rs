@@ -4,7 +4,7 @@
 
 /// The instance's state. An instance of one interface never enters the states of the other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum State {
+pub enum Mode {
     Instantiated,
     InitializationMode,
     /// Co-Simulation: after a step that succeeded (or initialisation).
@@ -19,7 +19,7 @@ pub enum State {
     Error,
 }
 
-impl State {
+impl Mode {
     /// The state's bit in a [`Mask`].
     pub const fn bit(self) -> Mask {
         1 << self as u16
@@ -28,23 +28,23 @@ impl State {
     /// The interface whose state this is; `None` for the states both share.
     pub const fn interface(self) -> Option<Interface> {
         match self {
-            State::StepComplete | State::StepFailed | State::StepCanceled => Some(Interface::CoSimulation),
-            State::EventMode | State::ContinuousTimeMode => Some(Interface::ModelExchange),
+            Mode::StepComplete | Mode::StepFailed | Mode::StepCanceled => Some(Interface::CoSimulation),
+            Mode::EventMode | Mode::ContinuousTimeMode => Some(Interface::ModelExchange),
             _ => None,
         }
     }
 
     /// Every state, for messages and the FMU state bytes.
-    pub const ALL: [State; 9] = [
-        State::Instantiated,
-        State::InitializationMode,
-        State::StepComplete,
-        State::StepFailed,
-        State::StepCanceled,
-        State::EventMode,
-        State::ContinuousTimeMode,
-        State::Terminated,
-        State::Error,
+    pub const ALL: [Mode; 9] = [
+        Mode::Instantiated,
+        Mode::InitializationMode,
+        Mode::StepComplete,
+        Mode::StepFailed,
+        Mode::StepCanceled,
+        Mode::EventMode,
+        Mode::ContinuousTimeMode,
+        Mode::Terminated,
+        Mode::Error,
     ];
 }
 
@@ -65,15 +65,15 @@ pub struct Rule {
     pub states: Mask,
 }
 
-pub const INST: Mask = State::Instantiated.bit();
-pub const INIT: Mask = State::InitializationMode.bit();
-pub const DONE: Mask = State::StepComplete.bit();
-pub const FAIL: Mask = State::StepFailed.bit();
-pub const CANC: Mask = State::StepCanceled.bit();
-pub const EVENT: Mask = State::EventMode.bit();
-pub const CONT: Mask = State::ContinuousTimeMode.bit();
-pub const TERM: Mask = State::Terminated.bit();
-pub const ERR: Mask = State::Error.bit();
+pub const INST: Mask = Mode::Instantiated.bit();
+pub const INIT: Mask = Mode::InitializationMode.bit();
+pub const DONE: Mask = Mode::StepComplete.bit();
+pub const FAIL: Mask = Mode::StepFailed.bit();
+pub const CANC: Mask = Mode::StepCanceled.bit();
+pub const EVENT: Mask = Mode::EventMode.bit();
+pub const CONT: Mask = Mode::ContinuousTimeMode.bit();
+pub const TERM: Mask = Mode::Terminated.bit();
+pub const ERR: Mask = Mode::Error.bit();
 
 pub const fn both(states: Mask) -> Rule {
     Rule { interface: None, states }
@@ -87,7 +87,7 @@ pub const fn me(states: Mask) -> Rule {
 
 /// The names of the states in a mask, for error messages.
 pub fn describe(mask: Mask) -> String {
-    let names: Vec<String> = State::ALL.iter().filter(|s| mask & s.bit() != 0).map(|s| format!("{s:?}")).collect();
+    let names: Vec<String> = Mode::ALL.iter().filter(|s| mask & s.bit() != 0).map(|s| format!("{s:?}")).collect();
     if names.is_empty() {
         "no state".to_owned()
     } else {

@@ -6,11 +6,11 @@
 //! failures through the logger with the instance name (ARCHITECTURE.md, principle 4).
 #![allow(clippy::missing_safety_doc)]
 
-use super::fmu_state;
+use super::snapshot;
 use super::instance::{Core, Instance, Step, Warning};
 use super::log::{Logger, Status, GENERIC_CATEGORIES, LOG_FMI_CALLS};
 use super::model::Model;
-use super::state::{describe, Interface, Rule, State};
+use super::machine::{describe, Interface, Rule, Mode};
 use super::variables::{BaseType, Value};
 use super::version::Version;
 use std::ffi::{CStr, CString};
@@ -58,7 +58,7 @@ pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) ->
                 inst.interface
             ));
         }
-        let state = inst.core.state;
+        let state = inst.core.mode;
         if f.rule.states & state.bit() == 0 {
             return Err(format!("illegal call in state {state:?}; it is allowed in: {}", describe(f.rule.states)));
         }
@@ -72,7 +72,7 @@ pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) ->
             Status::Error
         }
         Err(p) => {
-            inst.core.state = State::Error;
+            inst.core.mode = Mode::Error;
             let m = format!("{function}: internal error: {}{}", panic_text(p.as_ref()), after_error(inst));
             inst.log.status(Status::Error, &m);
             Status::Error
@@ -81,7 +81,7 @@ pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) ->
 }
 
 /// The state an error leaves, and what the message adds about it. FMI 3.0, 2.3.1: "If any
-/// function called in super state FMU State Settable returns fmi3Error, the FMU enters state
+/// function called in super state FMU Mode Settable returns fmi3Error, the FMU enters state
 /// Terminated". FMI 2.0 leaves the state after fmi2Error open (2.1.3: "it is possible to
 /// restore a previously retrieved FMU state"): a refused call changes nothing there, and only
 /// a broken model (a panic, a non-finite result) puts the instance in the Error state.
@@ -90,13 +90,13 @@ fn after_error<M: Model>(inst: &mut Instance<M>) -> String {
     let v = inst.version;
     let (reset, restore, free) =
         (v.function("fmi2Reset"), v.function("fmi2SetFMUstate"), v.function("fmi2FreeInstance"));
-    match (v, c.state) {
-        (Version::Fmi3, State::Terminated) => String::new(),
+    match (v, c.mode) {
+        (Version::Fmi3, Mode::Terminated) => String::new(),
         (Version::Fmi3, _) => {
-            c.state = State::Terminated;
+            c.mode = Mode::Terminated;
             format!("; the instance is now Terminated (FMI 3.0, 2.3.1; {reset}, {restore} or {free})")
         }
-        (Version::Fmi2, State::Error) => {
+        (Version::Fmi2, Mode::Error) => {
             format!("; the instance is now in the Error state ({reset}, {restore} or {free})")
         }
         (Version::Fmi2, _) => String::new(),
@@ -140,8 +140,11 @@ pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, limit: Limit, what: &str) ->
 }
 
 /// The limit of a list of value references: one per variable (FMI 3.0: and `time`).
-pub fn references<M: Model>() -> Limit<'static> {
-    (M::VARIABLES.len() + 1, "one per variable of the model")
+pub fn references<M: Model>(version: Version) -> Limit<'static> {
+    match version {
+        Version::Fmi2 => (M::VARIABLES.len(), "one per variable of the model"),
+        Version::Fmi3 => (M::VARIABLES.len() + 1, "one per variable of the model and time"),
+    }
 }
 
 /// The limit of an array of continuous states: the model's number.
@@ -234,9 +237,9 @@ pub unsafe fn exit_initialization_mode<M: Model>(c: Handle, f: Call) -> Status {
 }
 
 /// Moves to `state` (terminate, enter event mode, enter continuous-time mode).
-pub unsafe fn enter<M: Model>(c: Handle, f: Call, state: State) -> Status {
+pub unsafe fn enter<M: Model>(c: Handle, f: Call, state: Mode) -> Status {
     call::<M>(c, f, |inst| {
-        inst.core.state = state;
+        inst.core.mode = state;
         Ok(Status::OK)
     })
 }
@@ -259,8 +262,8 @@ pub unsafe fn get<M: Model, T>(
     read: impl Fn(&Value) -> T,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let vrs = slice(vr, n, references::<M>(), "vr")?;
-        let out = slice_mut(out, n, references::<M>(), "value")?;
+        let vrs = slice(vr, n, references::<M>(inst.version), "vr")?;
+        let out = slice_mut(out, n, references::<M>(inst.version), "value")?;
         inst.get(vrs, out, wanted, read)?;
         Ok(Status::OK)
     })
@@ -286,8 +289,8 @@ pub fn integer(v: &Value) -> i32 {
 
 pub unsafe fn get_string<M: Model>(c: Handle, f: Call, vr: *const u32, n: usize, value: *mut *const c_char) -> Status {
     call::<M>(c, f, |inst| {
-        let vrs = slice(vr, n, references::<M>(), "vr")?;
-        let out = slice_mut(value, n, references::<M>(), "value")?;
+        let vrs = slice(vr, n, references::<M>(inst.version), "vr")?;
+        let out = slice_mut(value, n, references::<M>(inst.version), "value")?;
         let mut texts = vec![CString::default(); n];
         inst.get(vrs, &mut texts, BaseType::String, |v| match v {
             Value::String(s) => CString::new(s.replace('\0', " ")).unwrap_or_default(),
@@ -310,9 +313,9 @@ pub unsafe fn set<M: Model, T: Copy>(
     convert: impl Fn(T) -> Result<Value, String>,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let vrs = slice(vr, n, references::<M>(), "vr")?;
+        let vrs = slice(vr, n, references::<M>(inst.version), "vr")?;
         let values =
-            slice(value, n, references::<M>(), "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
+            slice(value, n, references::<M>(inst.version), "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
         inst.set(vrs, values)?;
         Ok(Status::OK)
     })
@@ -386,7 +389,7 @@ pub unsafe fn free_fmu_state<M: Model>(c: Handle, f: Call, state: *mut FmuState)
 pub unsafe fn serialized_fmu_state_size<M: Model>(c: Handle, f: Call, state: FmuState, size: *mut usize) -> Status {
     call::<M>(c, f, |inst| {
         let out = size.as_mut().ok_or("size is NULL")?;
-        *out = fmu_state::serialize(own_fmu_state(inst, state)?, &inst.guid).len();
+        *out = snapshot::serialize(own_fmu_state(inst, state)?, &inst.guid).len();
         Ok(Status::OK)
     })
 }
@@ -399,7 +402,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     size: usize,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let data = fmu_state::serialize(own_fmu_state(inst, state)?, &inst.guid);
+        let data = snapshot::serialize(own_fmu_state(inst, state)?, &inst.guid);
         if data.len() != size {
             return Err(format!(
                 "size = {size} bytes, but the state needs {} ({})",
@@ -421,21 +424,21 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
 ) -> Status {
     call::<M>(c, f, |inst| {
         // The bytes are read as far as the header first: `size` must be the length it announces.
-        let head = fmu_state::head_len(&inst.guid);
+        let head = snapshot::head_len(&inst.guid);
         let limit = (size.min(head), "the state's header");
         let prefix = slice(bytes, size.min(head), limit, "serializedState")?;
-        let data = match fmu_state::announced_len(prefix) {
+        let data = match snapshot::announced_len(prefix) {
             Some(n) if n != size => return Err(format!("size = {size} bytes, but the state's header announces {n}")),
             Some(_) => slice(bytes, size, (size, "the length the header announces"), "serializedState")?,
             // Not a header of this format: the prefix tells why.
             None => prefix,
         };
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
-        let core = fmu_state::deserialize::<M>(data, &inst.guid)?;
-        if let Some(other) = core.state.interface().filter(|&i| i != inst.interface) {
+        let core = snapshot::deserialize::<M>(data, &inst.guid)?;
+        if let Some(other) = core.mode.interface().filter(|&i| i != inst.interface) {
             return Err(format!(
                 "the state was saved by a {other:?} instance (state {:?}); this instance is {:?}",
-                core.state, inst.interface
+                core.mode, inst.interface
             ));
         }
         *out = new_fmu_state(inst, core);
@@ -462,7 +465,7 @@ pub unsafe fn get_directional_derivative<M: Model>(
     }
     call::<M>(c, f, |inst| {
         let name = |fmi2| inst.version.argument(fmi2);
-        let limit = references::<M>();
+        let limit = references::<M>(inst.version);
         let unknowns = slice(unknown, n_unknown, limit, name("vUnknown_ref"))?;
         let knowns = slice(known, n_known, limit, name("vKnown_ref"))?;
         let seeds = slice(dv_known, n_known, limit, name("dvKnown"))?;

@@ -1,8 +1,8 @@
 //! The FMI 2.0 state machines of Co-Simulation (FMI 2.0.4, section 4.2.4) and Model Exchange
 //! (section 3.2.3) as one table: per function, the interface it belongs to and the set of states
-//! in which it may be called (the states themselves are shared with FMI 3.0: [`crate::fmu::state`]).
+//! in which it may be called (the states themselves are shared with FMI 3.0: [`crate::fmu::machine`]).
 
-pub use crate::fmu::state::*;
+pub use crate::fmu::machine::*;
 
 /// Per function: the interface and the states in which the call is legal.
 pub mod allowed {
