@@ -265,6 +265,7 @@ impl<'a> Session<'a> {
             (Op::Instantiate(spec), Output::Instance(c)) => {
                 if !self.opened {
                     self.me = spec.fmu_type == MODEL_EXCHANGE;
+                    self.report.me = self.me;
                 }
                 self.instantiated(c)?
             }

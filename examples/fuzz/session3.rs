@@ -369,6 +369,7 @@ impl<'a> Session3<'a> {
             self.opened = true;
             self.c = c;
             self.me = spec.interface == Interface3::ModelExchange;
+            self.report.me = self.me;
             (self.logger, self.all_logged) = (spec.logger, spec.logging_on);
             Ok(())
         } else if c.is_null() {
