@@ -11,7 +11,7 @@ use std::os::raw::c_int;
 use std::path::Path;
 
 /// A variable's base type (FMI 3.0: Float64, Int32, Boolean, String).
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Type {
     Real,
     Integer,

@@ -7,6 +7,8 @@
 //!   fmi2GetEventIndicators and fmi2GetDerivatives (Model Exchange), and
 //!   fmi2GetDirectionalDerivative;
 //!   fmi2GetRealStatus(fmi2LastSuccessfulTime) is the end of the last step the fuzzer saw succeed;
+//! - a call that `machine2` says must fail returns fmi2Error, with a log message when the
+//!   instance has a logger;
 //! - fmi2GetTypesPlatform is "default" and fmi2GetVersion "2.0";
 //! - the logger gets the componentEnvironment given to fmi2Instantiate, a valid status,
 //!   non-NULL strings and the format "%s" (checked in `callbacks`);
@@ -18,7 +20,8 @@
 
 use crate::callbacks::LOG;
 use crate::fmi2::{
-    CallbackFunctions, Component, EventInfo, Fmi2, Library, Status, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK, WARNING,
+    CallbackFunctions, Component, EventInfo, Fmi2, Library, Status, ERROR, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK,
+    WARNING,
 };
 use crate::fmu_states::{FmuStates, StateCall, StateOutput};
 use crate::model_description::Description;
@@ -64,6 +67,8 @@ pub struct Session<'a> {
     opened: bool,
     /// The main instance is a Model Exchange one.
     pub me: bool,
+    /// The main instance has a logger.
+    logger: bool,
     /// The continuous states fmi2GetContinuousStates last returned (Model Exchange).
     pub x: Vec<f64>,
     /// Callback structures of the instances, alive until the end of the sequence; boxed, since
@@ -86,6 +91,7 @@ impl<'a> Session<'a> {
             second: null_mut(),
             opened: false,
             me: false,
+            logger: false,
             x: Vec::new(),
             callbacks: Vec::new(),
             view: View::fresh(),
@@ -103,8 +109,10 @@ impl<'a> Session<'a> {
         };
         match &op {
             Op::State(call) => self.report.begin(format_args!("{}{on}", call.describe(false))),
+            Op::Oversized(o) => self.report.begin(format_args!("{}{on}", o.describe(false))),
             op => self.report.begin(format_args!("fmi2{op:?}{on}")),
         }
+        let errors = LOG.with(|sink| sink.borrow().errors);
         // SAFETY: every pointer passed is NULL or points to as many elements as announced,
         // alive for the call (see `invoke`); the instance is one of the session's or NULL.
         let (status, output) = unsafe { self.invoke(c, &op) };
@@ -115,6 +123,10 @@ impl<'a> Session<'a> {
         if let Some(violation) = LOG.with(|sink| sink.borrow_mut().violation.take()) {
             return Err(violation);
         }
+        if target == Target::Main && !c.is_null() {
+            let logged = LOG.with(|sink| sink.borrow().errors) > errors;
+            self.check_refusal(&op, status, logged)?;
+        }
         let ok = matches!(status, Some(OK | WARNING));
         match (target, output) {
             (Target::Main, output) => self.observe(op, status, ok, output),
@@ -124,6 +136,21 @@ impl<'a> Session<'a> {
                 Ok(())
             }
             _ => Ok(()),
+        }
+    }
+
+    /// `machine2`'s part of the oracle on a call to the main instance: a forbidden call returns
+    /// fmi2Error (`logged`: with a log message of that status).
+    fn check_refusal(&self, op: &Op, status: Option<Status>, logged: bool) -> Result<(), String> {
+        let Some(why) = crate::machine2::forbidden(op, &self.view, self.me, self.model) else { return Ok(()) };
+        let function = match op {
+            Op::Oversized(o) => o.function(false),
+            op => format!("fmi2{op:?}").split([' ', '(']).next().unwrap_or_default().to_owned(),
+        };
+        match status {
+            Some(ERROR) if self.logger && !logged => Err(format!("{function} returned fmi2Error without a log message ({why})")),
+            Some(ERROR) | None => Ok(()),
+            Some(s) => Err(format!("{function} returned {}, but the call must fail: {why}", crate::report::outcome(i64::from(s), false))),
         }
     }
 
@@ -235,6 +262,7 @@ impl<'a> Session<'a> {
             Op::GetNominalsOfContinuousStates { n, null } => {
                 real_output(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
             }
+            Op::Oversized(o) => status(o.invoke2(f, c, self.model)),
         }
     }
 
@@ -266,6 +294,7 @@ impl<'a> Session<'a> {
                 if !self.opened {
                     self.me = spec.fmu_type == MODEL_EXCHANGE;
                     self.report.me = self.me;
+                    self.logger = spec.callbacks.is_some_and(|c| c.logger);
                 }
                 self.instantiated(c)?
             }
@@ -280,7 +309,7 @@ impl<'a> Session<'a> {
             }
             (Op::SetupExperiment { start, stop_defined, stop, .. }, _) if ok => {
                 let v = &mut self.view;
-                (v.time, v.stop, v.set_up) = (start, (stop_defined != 0).then_some(stop), true);
+                (v.time, v.start, v.stop, v.set_up) = (start, start, (stop_defined != 0).then_some(stop), true);
             }
             (Op::EnterInitializationMode, _) if ok => self.view.phase = Phase::Initialization,
             (Op::ExitInitializationMode, _) if ok => {

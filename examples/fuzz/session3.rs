@@ -13,7 +13,10 @@
 //!   too), fmi3Boolean outputs 0 or 1, strings non-NULL, the numbers of continuous states and
 //!   event indicators those of the XML; fmi3DoStep without early return or event handling and
 //!   with lastSuccessfulTime = currentCommunicationPoint + communicationStepSize (Discard: in
-//!   [currentCommunicationPoint, + communicationStepSize]);
+//!   [currentCommunicationPoint, + communicationStepSize]); a Discard leaves the instance as it
+//!   was (Step Mode, the same time) and a retry with a smaller step from that time is no error;
+//! - after any fmi3Error of the main instance, it is in Terminated (FMI 3.0 2.3.1), where
+//!   `machine3` allows only what Terminated allows;
 //! - fmi3GetVersion is "3.0"; the logger gets the instanceEnvironment given at instantiation, a
 //!   valid status and non-NULL strings (checked in `callbacks`);
 //! - the FMU state checks of `fmu_states`.
@@ -75,6 +78,8 @@ pub struct Session3<'a> {
     pub view: View,
     pub states: FmuStates,
     simulated: f64,
+    /// The step size of the fmi3DoStep that returned fmi3Discard just before (at `view.time`).
+    pub discarded: Option<f64>,
     /// The main instance has a logMessage; discards are delivered (logStatusDiscard, logAll).
     logger: bool,
     discards_logged: bool,
@@ -95,6 +100,7 @@ impl<'a> Session3<'a> {
             view: View::fresh(),
             states: FmuStates { fmi3: true, ..FmuStates::default() },
             simulated: 0.0,
+            discarded: None,
             logger: false,
             discards_logged: true,
             all_logged: false,
@@ -133,22 +139,29 @@ impl<'a> Session3<'a> {
         if target == Target::Null {
             return if ok { Err("returned fmi3OK or fmi3Warning for a NULL instance".into()) } else { Ok(()) };
         }
-        if target == Target::Main && !c.is_null() && op.takes_instance() {
+        let live = target == Target::Main && !c.is_null() && op.takes_instance();
+        if live {
             self.check_status(&op, status, (errors, discards))?;
         }
-        match (target, output) {
-            (Target::Main, output) => self.observe(op, status, ok, output, errors),
-            (Target::Second, Output::Stateful(StateOutput::State(p))) if ok && !p.is_null() => {
-                self.states.foreign.push(p);
-                Ok(())
-            }
-            _ => Ok(()),
+        if !matches!(op, Op3::DoStep { .. }) {
+            self.discarded = None;
         }
+        match (target, output) {
+            (Target::Main, output) => self.observe(op, status, ok, output, errors)?,
+            (Target::Second, Output::Stateful(StateOutput::State(p))) if ok && !p.is_null() => self.states.foreign.push(p),
+            _ => {}
+        }
+        if live && status == Some(ERROR) {
+            // FMI 3.0 2.3.1: "If any function called in super state FMU State Settable returns
+            // fmi3Error, the FMU enters state Terminated" (issue 25 item 5).
+            self.view.phase = Phase::Terminated;
+        }
+        Ok(())
     }
 
     /// The state machine's and the logger's part of the oracle on a call to the main instance.
     fn check_status(&self, op: &Op3, status: Option<Status>, (errors, discards): (u64, u64)) -> Result<(), String> {
-        if let (Some(why), Some(s)) = (forbidden(op, self.view.phase, self.me, self.model), status) {
+        if let (Some(why), Some(s)) = (forbidden(op, &self.view, self.me, self.model), status) {
             if s != ERROR {
                 let call = op.describe();
                 let function = call.split([' ', '(']).next().unwrap_or_default();
@@ -160,8 +173,19 @@ impl<'a> Session3<'a> {
             Some(DISCARD) if self.logger && (self.discards_logged || self.all_logged) && discards == 0 => {
                 Err("returned fmi3Discard without a log message".into())
             }
+            Some(ERROR) if self.is_retry(op) => Err(format!(
+                "{} returned fmi3Error for a retry with a smaller step after fmi3Discard, which leaves the instance in Step Mode at the step's start (FMI 3.0 4.2.1)",
+                op.describe()
+            )),
             _ => Ok(()),
         }
+    }
+
+    /// Whether `op` retries a discarded step: from the same time with a smaller step, in a view
+    /// that is certain.
+    fn is_retry(&self, op: &Op3) -> bool {
+        let Op3::DoStep { t, h, .. } = *op else { return false };
+        self.discarded.is_some_and(|h0| self.view.phase == Phase::StepComplete && t == self.view.time && h > 0.0 && h < h0)
     }
 
     /// Passes the arguments of `op` through the C ABI; output buffers are temporaries of the call.
@@ -262,6 +286,7 @@ impl<'a> Session3<'a> {
             }
             Op3::GetNumberOfContinuousStates { null } => count(*null, |p| f.fmi3GetNumberOfContinuousStates(c, p)),
             Op3::GetNumberOfEventIndicators { null } => count(*null, |p| f.fmi3GetNumberOfEventIndicators(c, p)),
+            Op3::Oversized(o) => status(o.invoke3(f, c, self.model)),
         }
     }
 
@@ -309,8 +334,8 @@ impl<'a> Session3<'a> {
             (Op3::SetDebugLogging { logging_on, categories }, _) => self.debug_logging(logging_on, &categories),
             (Op3::EnterInitializationMode(e), _) => {
                 let v = &mut self.view;
-                (v.time, v.stop, v.set_up, v.phase) =
-                    (e.start, e.stop_defined.then_some(e.stop), true, Phase::Initialization);
+                (v.time, v.start, v.stop, v.set_up, v.phase) =
+                    (e.start, e.start, e.stop_defined.then_some(e.stop), true, Phase::Initialization);
             }
             (Op3::ExitInitializationMode, _) => {
                 self.view.phase = if self.me { Phase::EventMode } else { Phase::StepComplete }
@@ -419,9 +444,12 @@ impl<'a> Session3<'a> {
             }
             _ => {}
         }
+        let before = self.view;
         self.simulated += self.view.stepped(t, h, status);
         if status == Some(DISCARD) {
-            self.view.time = last;
+            // FMI 3.0 2.2.4, 4.2.1 (issue 25 item 6): the instance stays as before the call,
+            // in Step Mode at t, so that a smaller step can be retried.
+            (self.view, self.discarded) = (before, Some(h));
         }
         Ok(())
     }

@@ -4,7 +4,8 @@
 //! points that do not match, input derivatives of any order and size, freed FMU states and states
 //! of a second instance, serialized states with a flipped bit, truncated, extended, random, or
 //! edited with the CRC recomputed, unknown log categories, NULL and non-UTF-8 strings; Model
-//! Exchange calls with NULL or wrongly sized arrays, special states and times.
+//! Exchange calls with NULL or wrongly sized arrays, special states and times; counts far larger
+//! than the arrays (`oversized`).
 
 use crate::callbacks::Callbacks;
 use crate::fmi2::{CO_SIMULATION, MODEL_EXCHANGE};
@@ -12,6 +13,7 @@ use crate::fmu_states::{FmuState, FmuStates, StateCall};
 use crate::view::View;
 use crate::model_description::{Description, Type, Variable, TYPES};
 use crate::ops::{Arr, Blob, Instantiation, Op, Slot, Text};
+use crate::oversized::Oversized;
 use crate::planner::Experiment;
 use crate::rng::Rng;
 use crate::session::Session;
@@ -44,7 +46,8 @@ pub const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m",
 pub fn wild(rng: &mut Rng, s: &Session) -> Op {
     let m = s.model;
     let real = Type::Real;
-    match rng.below(38) {
+    match rng.below(40) {
+        38..=39 => Op::Oversized(Oversized::draw(rng, m, false)),
         0 => Op::GetTypesPlatform,
         1 => Op::GetVersion,
         2 => Op::SetDebugLogging { logging_on: wild_boolean(rng), categories: categories(rng, m) },

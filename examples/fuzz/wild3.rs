@@ -3,11 +3,13 @@
 //! states, damaged serialized states, any step) through the FMI 3.0 functions, plus nValues that
 //! differ from the number of value references, fmi3Boolean bytes other than 0 and 1, the types
 //! no variable has, the functions the FMUs do not provide, any function in any state, and
-//! instantiations with a wrong token, name, eventModeUsed or intermediate variables.
+//! instantiations with a wrong token, name, eventModeUsed or intermediate variables; counts far
+//! larger than the arrays (`oversized`).
 
 use crate::model_description::{Description, Type, Variable, TYPES};
 use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3, OTHER_TYPES, REFUSED};
+use crate::oversized::Oversized;
 use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::wild::{
@@ -19,7 +21,8 @@ use crate::wild::{
 pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
     let m = s.model;
     let real = Type::Real;
-    match rng.below(32) {
+    match rng.below(34) {
+        32..=33 => Op3::Oversized(Oversized::draw(rng, m, true)),
         0 => Op3::GetVersion,
         1 => Op3::SetDebugLogging { logging_on: rng.chance(0.5), categories: categories(rng, m) },
         2 => Op3::Instantiate(instantiation3(rng, m)),
