@@ -64,14 +64,17 @@ mod ops3;
 mod oversized;
 mod planner;
 mod planner3;
+mod probes;
 mod refused;
 mod report;
+mod required;
 mod rng;
 mod sequence;
 mod sequence3;
 mod session;
 mod session3;
 mod view;
+mod watch;
 mod wild;
 mod wild3;
 

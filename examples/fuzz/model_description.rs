@@ -173,6 +173,8 @@ pub struct Description {
     /// indicators (FMI 3.0: the `EventIndicator` elements; FMI 2.0, which does not name them:
     /// the order of the variables, the same as FMI 3.0's).
     pub event_locals: Vec<u32>,
+    /// The spool reference input (`valve.u_ref`), in the models with event locals.
+    pub spool_reference: Option<u32>,
     pub max_vr: u32,
     index: HashMap<u32, usize>,
 }
@@ -287,6 +289,7 @@ impl Description {
                 .collect(),
             state_vrs,
             derivatives,
+            spool_reference: variables.iter().find(|v| v.name == "valve.u_ref" && v.ty == Type::Real).map(|v| v.vr),
             event_locals: event_vrs,
             max_vr: variables.iter().map(|v| v.vr).max().unwrap_or(0),
             index: variables.iter().enumerate().map(|(i, v)| (v.vr, i)).collect(),

@@ -8,7 +8,8 @@
 //!   fmi2GetDirectionalDerivative;
 //!   fmi2GetRealStatus(fmi2LastSuccessfulTime) is the end of the last step the fuzzer saw succeed;
 //! - a call that `machine2` says must fail returns fmi2Error, with a log message when the
-//!   instance has a logger;
+//!   instance has a logger; one that `required` says must succeed returns fmi2OK or fmi2Warning;
+//!   the expectations of the planner's probes (`watch`) hold;
 //! - fmi2GetTypesPlatform is "default" and fmi2GetVersion "2.0";
 //! - the logger gets the componentEnvironment given to fmi2Instantiate, a valid status,
 //!   non-NULL strings and the format "%s" (checked in `callbacks`);
@@ -27,7 +28,9 @@ use crate::fmu_states::{FmuStates, StateCall, StateOutput};
 use crate::model_description::Description;
 use crate::ops::{Arr, Instantiation, Op, Slot, Text};
 use crate::report::Report;
+use crate::required::{self, Derivative};
 use crate::view::{Phase, View};
+use crate::watch::{Seen, Watch};
 use std::ffi::CStr;
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};
@@ -77,6 +80,7 @@ pub struct Session<'a> {
     callbacks: Vec<Box<CallbackFunctions>>,
     pub view: View,
     pub states: FmuStates,
+    watch: Watch,
     /// Simulated time so far (an upper bound).
     simulated: f64,
 }
@@ -96,6 +100,7 @@ impl<'a> Session<'a> {
             callbacks: Vec::new(),
             view: View::fresh(),
             states: FmuStates::default(),
+            watch: Watch::default(),
             simulated: 0.0,
         }
     }
@@ -128,6 +133,10 @@ impl<'a> Session<'a> {
             self.check_refusal(&op, status, logged)?;
         }
         let ok = matches!(status, Some(OK | WARNING));
+        if target == Target::Main && !c.is_null() {
+            self.check_required(&op, status, ok)?;
+            self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
+        }
         match (target, output) {
             (Target::Main, output) => self.observe(op, status, ok, output),
             (Target::Null, _) if ok => Err("returned fmi2OK or fmi2Warning for a NULL instance".into()),
@@ -143,14 +152,34 @@ impl<'a> Session<'a> {
     /// fmi2Error (`logged`: with a log message of that status).
     fn check_refusal(&self, op: &Op, status: Option<Status>, logged: bool) -> Result<(), String> {
         let Some(why) = crate::machine2::forbidden(op, &self.view, self.me, self.model) else { return Ok(()) };
-        let function = match op {
-            Op::Oversized(o) => o.function(false),
-            op => format!("fmi2{op:?}").split([' ', '(']).next().unwrap_or_default().to_owned(),
-        };
+        let function = function(op);
         match status {
             Some(ERROR) if self.logger && !logged => Err(format!("{function} returned fmi2Error without a log message ({why})")),
             Some(ERROR) | None => Ok(()),
             Some(s) => Err(format!("{function} returned {}, but the call must fail: {why}", crate::report::outcome(i64::from(s), false))),
+        }
+    }
+
+    /// `required`'s part of the oracle on a call to the main instance: the call must succeed.
+    fn check_required(&self, op: &Op, status: Option<Status>, ok: bool) -> Result<(), String> {
+        let (m, view, me) = (self.model, &self.view, self.me);
+        let why = match op {
+            Op::GetDirectionalDerivative { unknowns, knowns, dv_known, null_dv_unknown } => {
+                let call = Derivative { unknowns, knowns, seeds: dv_known, adjoint: false, outputs_right: !null_dv_unknown };
+                required::derivative(&call, view, me, m)
+            }
+            Op::SetReal { vr, values } => required::state_set(vr, values, view, me, m),
+            Op::GetDerivatives { n, null } | Op::GetNominalsOfContinuousStates { n, null } => {
+                required::initialization_getter(*n, *null, view, me, m)
+            }
+            Op::State(call) => required::state_call(call, &self.states),
+            _ => None,
+        };
+        match (why, status) {
+            (Some(why), Some(s)) if !ok => {
+                Err(format!("{} returned {}, but the call must succeed: {why}", function(op), crate::report::outcome(i64::from(s), false)))
+            }
+            _ => Ok(()),
         }
     }
 
@@ -383,6 +412,27 @@ impl<'a> Session<'a> {
     /// Simulated seconds left for the sequence.
     pub fn budget(&self) -> f64 {
         SIMULATION_BUDGET - self.simulated
+    }
+}
+
+/// The function an op calls, for messages.
+fn function(op: &Op) -> String {
+    match op {
+        Op::Oversized(o) => o.function(false),
+        Op::State(call) => call.name(false).to_owned(),
+        op => format!("fmi2{op:?}").split([' ', '(']).next().unwrap_or_default().to_owned(),
+    }
+}
+
+/// What the watch sees of a call that succeeded.
+fn seen<'a>(op: &'a Op, output: &'a Output) -> Seen<'a> {
+    match (op, output) {
+        (Op::GetReal { vr: Arr::Items(vr), null_values: false }, Output::Reals(v)) => Seen::Read(vr, v),
+        (Op::SetReal { vr: Arr::Items(vr), values: Arr::Items(v) }, _) => Seen::Set(vr, v),
+        (Op::DoStep { .. }, _) => Seen::Stepped,
+        (Op::GetEventIndicators { null: false, .. }, Output::Reals(v)) => Seen::EventIndicators(v),
+        (Op::GetContinuousStates { null: false, .. }, Output::Reals(v)) => Seen::ContinuousStates(v),
+        _ => Seen::Other,
     }
 }
 

@@ -3,7 +3,8 @@
 //! - every function returns a valid fmi3Status (0..=4), and never fmi3OK or fmi3Warning for a
 //!   NULL instance;
 //! - a call that `machine3` says the standard forbids in the instance's state (or whose
-//!   arguments cannot be right) returns fmi3Error;
+//!   arguments cannot be right) returns fmi3Error; one that `required` says must succeed returns
+//!   fmi3OK or fmi3Warning; the expectations of the planner's probes (`watch`) hold;
 //! - every fmi3Error and fmi3Discard of an instance with a logger comes with a logMessage call of
 //!   that status during the call (discards only while logStatusDiscard or logAll is on), and so
 //!   does an instantiation that returns NULL;
@@ -31,8 +32,10 @@ use crate::model_description::Description;
 use crate::ops::{Arr, Slot, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
 use crate::report::Report;
+use crate::required::{self, Derivative};
 use crate::session::{out, Target};
 use crate::view::{Phase, View};
+use crate::watch::{Seen, Watch};
 use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
@@ -77,6 +80,7 @@ pub struct Session3<'a> {
     pub x: Vec<f64>,
     pub view: View,
     pub states: FmuStates,
+    watch: Watch,
     simulated: f64,
     /// The step size of the fmi3DoStep that returned fmi3Discard just before (at `view.time`).
     pub discarded: Option<f64>,
@@ -99,6 +103,7 @@ impl<'a> Session3<'a> {
             x: Vec::new(),
             view: View::fresh(),
             states: FmuStates { fmi3: true, ..FmuStates::default() },
+            watch: Watch::default(),
             simulated: 0.0,
             discarded: None,
             logger: false,
@@ -142,6 +147,8 @@ impl<'a> Session3<'a> {
         let live = target == Target::Main && !c.is_null() && op.takes_instance();
         if live {
             self.check_status(&op, status, (errors, discards))?;
+            self.check_required(&op, status, ok)?;
+            self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
         }
         if !matches!(op, Op3::DoStep { .. }) {
             self.discarded = None;
@@ -177,6 +184,26 @@ impl<'a> Session3<'a> {
                 "{} returned fmi3Error for a retry with a smaller step after fmi3Discard, which leaves the instance in Step Mode at the step's start (FMI 3.0 4.2.1)",
                 op.describe()
             )),
+            _ => Ok(()),
+        }
+    }
+
+    /// `required`'s part of the oracle on a call to the main instance: the call must succeed.
+    fn check_required(&self, op: &Op3, status: Option<Status>, ok: bool) -> Result<(), String> {
+        let (m, view, me) = (self.model, &self.view, self.me);
+        let why = match op {
+            Op3::Derivative { adjoint, unknowns, knowns, seed, n_sensitivity, null_sensitivity } => {
+                let sensitivities = if *adjoint { knowns.len() } else { unknowns.len() };
+                let outputs_right = !null_sensitivity && *n_sensitivity == sensitivities;
+                let call = Derivative { unknowns, knowns, seeds: seed, adjoint: *adjoint, outputs_right };
+                required::derivative(&call, view, me, m).filter(|_| !adjoint || m.adjoint)
+            }
+            Op3::SetFloat64 { vr, values } => required::state_set(vr, values, view, me, m),
+            Op3::State(call) => required::state_call(call, &self.states),
+            _ => None,
+        };
+        match (why, status) {
+            (Some(why), Some(s)) if !ok => Err(format!("{} returned {}, but the call must succeed: {why}", op.describe(), name(s))),
             _ => Ok(()),
         }
     }
@@ -452,6 +479,18 @@ impl<'a> Session3<'a> {
             (self.view, self.discarded) = (before, Some(h));
         }
         Ok(())
+    }
+}
+
+/// What the watch sees of a call that succeeded.
+fn seen<'a>(op: &'a Op3, output: &'a Output) -> Seen<'a> {
+    match (op, output) {
+        (Op3::GetFloat64 { vr: Arr::Items(vr), null_values: false, .. }, Output::Reals(v)) if v.len() == vr.len() => Seen::Read(vr, v),
+        (Op3::SetFloat64 { vr: Arr::Items(vr), values: Arr::Items(v) }, _) => Seen::Set(vr, v),
+        (Op3::DoStep { .. }, _) => Seen::Stepped,
+        (Op3::GetEventIndicators { null: false, .. }, Output::Reals(v)) => Seen::EventIndicators(v),
+        (Op3::GetContinuousStates { null: false, .. }, Output::Reals(v)) => Seen::ContinuousStates(v),
+        _ => Seen::Other,
     }
 }
 

@@ -44,6 +44,11 @@ impl View {
         View { phase: Phase::Unknown, time: f64::NAN, stop: None, start: f64::NAN, set_up: true, certain: false }
     }
 
+    /// Whether the phase and time are known for certain (not from edited bytes).
+    pub fn certain(&self) -> bool {
+        self.certain && !matches!(self.phase, Phase::Unknown | Phase::Broken)
+    }
+
     /// Why fmi2SetTime/fmi3SetTime(t) of a Model Exchange instance must fail, if it must: it is
     /// allowed in Continuous-Time Mode only (FMI 2.0 3.2.3's table, whose note 8 on Event Mode is
     /// for FMUs without continuous states; FMI 3.0 3.2.4: Event Mode does not list it), and a
