@@ -460,11 +460,14 @@ def run_native(scenario: dict, boom: str = "rigid", step: float | None = None, s
     plant_f = FmuFile.get("HydraulicBoom")
     switch = boom_switch(plant_f, boom)
     scenario, ctrl_params = with_params(scenario, plant_f, params)
-    t_end, step, _, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
+    t_end, step, n, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
+    table = scenario["reference"]
+    # The reference at the communication points as `run` computes them (t = k step, then t + step).
+    u_ref = [reference(table, 0.0)] + [reference(table, k * step + step) for k in range(n)]
     request = {"stop_time": t_end, "step": step, "record_every": record_every, "interpolate": interpolate,
                "feedback_start": fb_start, "enable": bool(scenario["controller"]["enable"]),
-               "reference": scenario["reference"].tolist(), "plant": plant_start(scenario, switch),
-               "controller": controller_start(scenario, ctrl_params)}
+               "u_ref": u_ref, "outputs": PLANT_OUT, "cbv_open": CBV_OPEN,
+               "plant": plant_start(scenario, switch), "controller": controller_start(scenario, ctrl_params)}
     if not BOOMSIM.exists():
         raise UsageError(f"{BOOMSIM} is missing: run `cargo build --release`")
     try:

@@ -32,11 +32,9 @@ from __future__ import annotations
 import argparse
 import hashlib
 import itertools
-import functools
 import json
 import os
 import pathlib
-import subprocess
 import sys
 import time
 import tomllib
@@ -44,13 +42,15 @@ import tomllib
 import numpy as np
 
 import cosim
+import linear
 import metrics as metrics_mod
+import sweep_summary
 from cosim import UsageError
 
 DISTS = {"uniform": ("low", "high"), "normal": ("mean", "sd")}
 #: Filter factors relative to the linear analysis at the point's operating point and the
 #: controller parameter each sets: K_f = n_K C1 mu_c mu_p (thesis eq. 6.6), omega_f = n_omega
-#: omega_n (eq. 6.7), from `boomsim analyze` (`operating_point`).
+#: omega_n (eq. 6.7), from `boomsim analyze` (`linear.operating_point`).
 FACTORS = {"n_K": "K_f", "n_omega": "omega_f"}
 #: Sweepable settings of the co-simulation itself, passed to the runner by keyword.
 SETTINGS = {"step": "communication step [s]; the stop time must be a multiple of it"}
@@ -137,46 +137,11 @@ def point_id(sweep: dict, values: dict) -> dict:
 # --------------------------------------------------------------------------- filter factors
 
 
-def operating_point(sweep: dict, values: dict) -> dict:
-    """The `boomsim analyze` options of a point's operating point: stroke start.x [mm], the
-    CBV's pilot ratio and set pressure [bar], the rigid boom's payload [kg], bulk modulus [MPa]
-    and the steady lowering flow Q4 = valve.q_rated |u_ref| [l/min] of the final reference (the
-    pressure-compensated spool). Each from the point, else the scenario, else the FMU's start
-    value."""
-    sc = sweep["scenario"]
-    plant = cosim.FmuFile.get("HydraulicBoom")
-
-    def value(name: str) -> float:
-        if name in values:
-            return float(values[name])
-        if name in sc["plant"]:
-            return float(sc["plant"][name])
-        return float(sc["start_stroke"]) if name == "start.x" else float(plant.vars[name].start)
-
-    return {"xc": value("start.x") * 1e3, "mu-p": value("cbv.mu_p"), "p-set": value("cbv.p_set") / 1e5,
-            "payload": value("payload.m"), "beta": value("fluid.beta") / 1e6,
-            "q4": value("valve.q_rated") * abs(float(sc["reference"][-1, 1])) * 6e4}
-
-
-@functools.cache
-def analyze(op: tuple, n_k: tuple = (1.0,), n_omega: tuple = (1.0,)) -> dict:
-    """`boomsim analyze --json` at the operating point `op` (the items of `operating_point`)
-    for the filters n_k x n_omega."""
-    exe = cosim.BOOMSIM
-    if not exe.exists():
-        raise UsageError(f"{exe} is missing: run `cargo build --release` (n_K and n_omega need `boomsim analyze`)")
-    args = [f"--{k}={v!r}" for k, v in op] + ["--n-k", ",".join(map(repr, n_k)), "--n-omega", ",".join(map(repr, n_omega))]
-    r = subprocess.run([str(exe), "analyze", "--json", *args], capture_output=True, text=True)
-    if r.returncode:
-        raise UsageError(f"no linear analysis at {', '.join(f'{k} = {v:g}' for k, v in op)}: {r.stderr.strip()}")
-    return json.loads(r.stdout)
-
-
 def with_filter(sweep: dict, point: dict) -> dict:
     """The point with K_f and omega_f of its filter factors n_K and n_omega (FACTORS)."""
     if not sweep["derived"]:
         return point
-    unit = analyze(tuple(operating_point(sweep, point).items()))["filters"][0]  # n_K = n_omega = 1
+    unit = linear.analyze(tuple(linear.operating_point(sweep, point).items()))["filters"][0]  # n_K = n_omega = 1
     return {**point, **{p: point[f] * unit[p] for f, p in FACTORS.items() if f in point}}
 
 
@@ -313,8 +278,6 @@ def main(argv=None):
     todo = [p for p in sweep["points"] if p["id"] not in have]
     print(f"sweep: {len(sweep['points'])} points, {len(have)} already done, {len(todo)} to run", file=sys.stderr)
     execute(sweep, todo, out, args)
-    import sweep_summary
-
     sweep_summary.write(sweep, read_rows(sweep, out), out)
     print(f"sweep: wrote {out / 'summary.md'}", file=sys.stderr)
 

@@ -25,6 +25,7 @@ import pathlib
 
 import numpy as np
 
+import linear
 from metrics import DEFINITIONS
 
 #: The maps' metrics, when the sweep has them.
@@ -113,13 +114,11 @@ def recommend(xs: list[float], ys: list[float], region: np.ndarray, t_settle: np
 def linear_stability(sweep: dict, grid: Grid, panel: tuple, xs, ys) -> list[tuple[dict, np.ndarray]]:
     """(operating point, [y, x] stable) of the linear analysis for every distinct operating
     point of the panel's points (several when e.g. the stroke varies within the panel)."""
-    import sweep as sweep_mod
-
-    ops = {tuple(sweep_mod.operating_point(sweep, r).items())
+    ops = {tuple(linear.operating_point(sweep, r).items())
            for (pn, _, _), rs in grid.cells.items() if pn == panel for r in rs}
     result = []
     for op in sorted(ops):
-        j = sweep_mod.analyze(op, tuple(float(x) for x in xs), tuple(float(y) for y in ys))
+        j = linear.analyze(op, tuple(float(x) for x in xs), tuple(float(y) for y in ys))
         stable = np.array([f["stable"] for f in j["filters"]], dtype=bool).reshape(len(xs), len(ys)).T
         result.append((dict(op), stable))
     return result

@@ -1,14 +1,19 @@
 //! `boomsim cosim`: the co-simulation of `scripts/cosim.py`'s `run` (HydraulicBoom and
 //! PressureFeedbackController, FMI 2.0 Co-Simulation, Gauss-Seidel, p4 interpolated in the
 //! controller) with the FMI layer called in-process instead of through fmpy: the native runner of
-//! the sweeps. The same calls with the same arguments in the same order from the end of
-//! initialisation on (the start values are set in Initialization Mode, where their order does not
-//! matter), so the recorded rows are the Python runner's bit for bit (tests/python/test_sweep.py).
+//! the sweeps. The Python runner is the reference; this loop makes the same calls with the same
+//! arguments in the same order from the end of initialisation on (the start values are set in
+//! Initialization Mode, where their order does not matter), so the recorded rows are the Python
+//! runner's bit for bit (tests/python/test_sweep.py). What the scenario means (the operator's
+//! reference, the recorded outputs, when the CBV counts as open) comes with the request, from
+//! `cosim.py`, so it is defined once.
 //!
-//! Input (stdin, JSON): `stop_time`, `step`, `record_every`, `interpolate`, `feedback_start`
-//! ("t0" or "cbv_open"), `enable`, `reference` ([[t, u_ref], ...]), `plant` and `controller`
-//! (start values by variable name, set in Initialization Mode). Output (stdout): one JSON line
-//! `{"rows", "columns", "rhs", "feedback_on_at"}`, then the rows as little-endian f64.
+//! Input (stdin, JSON): `stop_time`, `step`, `record_every`, `interpolate`, `feedback_start` ("t0" or
+//! "cbv_open"), `enable`, `u_ref` (the operator's reference at the n + 1 communication points),
+//! `outputs` (the plant's recorded variables, `p4` and `cbv.u_cbv` among them), `cbv_open` (the
+//! opening above which the CBV counts as open), `plant` and `controller` (start values by variable
+//! name, set in Initialization Mode). Output (stdout): one JSON line `{"rows", "columns", "rhs",
+//! "feedback_on_at"}`, then the rows as little-endian f64.
 
 use crate::fmu::in_process::{InProcess, Slave};
 use crate::fmu::variables::BaseType;
@@ -17,25 +22,6 @@ use crate::models::pressure_feedback_controller::vr as pfc;
 use crate::models::{HydraulicBoom, PressureFeedbackController};
 use serde_json::{json, Map, Value as Json};
 use std::io::Write;
-
-/// The plant's recorded outputs, in the order of `cosim.PLANT_OUT`.
-const PLANT_OUT: [&str; 10] = ["p1", "p2", "p3", "p4", "valve.u", "cbv.u_cbv", "cylinder.x", "cylinder.v", "Q3", "Q4"];
-/// The CBV counts as open above this opening (`metrics.CBV_OPEN`).
-const CBV_OPEN: f64 = 1e-6;
-
-/// The operator's reference: piecewise linear through the rows, right-continuous at repeated
-/// times, held outside (`cosim.reference`, the same operations in the same order).
-fn reference(table: &[(f64, f64)], t: f64) -> f64 {
-    let i = table.partition_point(|&(ti, _)| ti <= t);
-    if i == 0 {
-        return table[0].1;
-    }
-    if i >= table.len() {
-        return table[table.len() - 1].1;
-    }
-    let ((t0, u0), (t1, u1)) = (table[i - 1], table[i]);
-    u0 + (u1 - u0) * (t - t0) / (t1 - t0)
-}
 
 /// The start values by name as (value reference, value) of `M`'s variables.
 fn start_values<M: Model>(values: &Map<String, Json>) -> Result<Vec<(u32, Value)>, String> {
@@ -76,18 +62,18 @@ pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
     let interpolate = field("interpolate")?.as_bool().ok_or("\"interpolate\" must be true or false")?;
     let enable = field("enable")?.as_bool().ok_or("\"enable\" must be true or false")?;
     let cbv_open = field("feedback_start")? == "cbv_open";
-    let table: Vec<(f64, f64)> = field("reference")?
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|r| Some((r.get(0)?.as_f64()?, r.get(1)?.as_f64()?)))
-        .collect();
+    let open_above = num("cbv_open")?;
+    let list = |k: &str| field(k)?.as_array().ok_or_else(|| format!("\"{k}\" must be a list"));
+    let u_refs: Vec<f64> =
+        list("u_ref")?.iter().map(|u| u.as_f64().ok_or("\"u_ref\" must hold numbers")).collect::<Result<_, _>>()?;
+    let recorded: Vec<&str> =
+        list("outputs")?.iter().map(|o| o.as_str().ok_or("\"outputs\" must hold names")).collect::<Result<_, _>>()?;
     let map = |k: &str| field(k)?.as_object().cloned().ok_or_else(|| format!("\"{k}\" must be an object"));
     let (plant_start, ctrl_start) = (map("plant")?, map("controller")?);
-    if table.is_empty() || !(h > 0.0 && t_end > 0.0 && record_every > 0) {
-        return Err("the request needs a reference, step > 0, stop_time > 0 and record_every > 0".into());
+    if u_refs.len() < 2 || !(h > 0.0 && record_every > 0) {
+        return Err("the request needs u_ref at two points or more, step > 0 and record_every > 0".into());
     }
-    let n = (t_end / h).round() as usize;
+    let n = u_refs.len() - 1;
 
     let plant_vr = |name: &str| variable::<HydraulicBoom>(name).map(|v| v.vr);
     let (vr_p4, vr_u, vr_rhs) = (plant_vr("p4")?, plant_vr("valve.u_ref")?, plant_vr("solver.rhs_evals")?);
@@ -97,28 +83,26 @@ pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
     let mut p4 = plant.get(vr_p4)?;
     let ctrl_start = start_values::<PressureFeedbackController>(&ctrl_start)?;
     // (Re-)initialises the controller at t0 from rest at the present p4 (`init_controller`).
-    let controller = |t0: f64, feedback: bool, p4: f64| -> Result<InProcess<PressureFeedbackController>, String> {
-        let own = [
-            (pfc::ENABLE, Value::Boolean(feedback)),
-            (pfc::P, Value::Real(p4)),
-            (pfc::U_REF, Value::Real(reference(&table, t0))),
-        ];
-        let mut c = instance::<PressureFeedbackController>(t0, t_end, &[&ctrl_start[..], &own].concat())?;
-        c.exit_initialization_mode()?;
-        Ok(c)
-    };
+    let controller =
+        |t0: f64, u_ref: f64, feedback: bool, p4: f64| -> Result<InProcess<PressureFeedbackController>, String> {
+            let own =
+                [(pfc::ENABLE, Value::Boolean(feedback)), (pfc::P, Value::Real(p4)), (pfc::U_REF, Value::Real(u_ref))];
+            let mut c = instance::<PressureFeedbackController>(t0, t_end, &[&ctrl_start[..], &own].concat())?;
+            c.exit_initialization_mode()?;
+            Ok(c)
+        };
     let mut on = enable && !cbv_open;
-    let mut ctrl = controller(0.0, on, p4)?;
+    let mut ctrl = controller(0.0, u_refs[0], on, p4)?;
     let mut feedback_on_at = if on { Some(0.0) } else { None };
 
-    let out_p: Vec<u32> = PLANT_OUT.iter().map(|name| plant_vr(name)).collect::<Result<_, _>>()?;
-    let at = |name: &str| PLANT_OUT.iter().position(|&n| n == name).expect("a recorded output");
-    let (i_p4, i_cbv) = (at("p4"), at("cbv.u_cbv"));
+    let out_p: Vec<u32> = recorded.iter().map(|name| plant_vr(name)).collect::<Result<_, _>>()?;
+    let at = |name: &str| recorded.iter().position(|&n| n == name).ok_or(format!("\"outputs\" must name {name}"));
+    let (i_p4, i_cbv) = (at("p4")?, at("cbv.u_cbv")?);
     let outputs =
         |plant: &mut InProcess<HydraulicBoom>| out_p.iter().map(|&r| plant.get(r)).collect::<Result<Vec<_>, _>>();
-    let mut rows = Vec::with_capacity((n / record_every + 1) * (4 + PLANT_OUT.len()));
+    let mut rows = Vec::with_capacity((n / record_every + 1) * (4 + recorded.len()));
     let mut y = outputs(&mut plant)?;
-    let mut u_ref = reference(&table, 0.0);
+    let mut u_ref = u_refs[0];
     for k in 0..=n {
         let t = k as f64 * h;
         let (u, u_comp) = (ctrl.get(pfc::U)?, ctrl.get(pfc::U_COMP)?);
@@ -138,17 +122,17 @@ pub fn run(request: &Json) -> Result<(Json, Vec<f64>), String> {
         }
         step(&mut ctrl, ctrl_id, t, h)?;
         p4 = p4_next;
-        u_ref = reference(&table, t + h);
-        if enable && !on && y[i_cbv] > CBV_OPEN {
+        u_ref = u_refs[k + 1];
+        if enable && !on && y[i_cbv] > open_above {
             on = true;
             feedback_on_at = Some(t + h);
-            ctrl = controller(t + h, true, p4)?;
+            ctrl = controller(t + h, u_ref, true, p4)?;
         }
         ctrl.set(pfc::P, p4)?;
         ctrl.set(pfc::U_REF, u_ref)?;
     }
     let rhs = plant.get(vr_rhs)?;
-    let columns = 4 + PLANT_OUT.len();
+    let columns = 4 + recorded.len();
     let header =
         json!({"rows": rows.len() / columns, "columns": columns, "rhs": rhs, "feedback_on_at": feedback_on_at});
     Ok((header, rows))

@@ -173,15 +173,66 @@ fn directional_derivative_arguments_are_checked() {
     assert!(out[0] < 0.0, "friction opposes the velocity: {}", out[0]);
     assert_eq!(call(x_v, vr::X, 1.0, &mut out), fmi2Status::Error);
     assert!(
-        s.last_error().contains("\"valve.x_v\"") && s.last_error().contains("is not an output"),
+        s.last_error().contains("\"valve.x_v\"") && s.last_error().contains("is not an output or a derivative"),
         "{}",
         s.last_error()
     );
     assert_eq!(call(vr::F, p3, 1.0, &mut out), fmi2Status::Error, "a state is no known in Co-Simulation");
     assert!(s.last_error().contains("known \"p3\""), "{}", s.last_error());
-    assert_eq!(call(der_p3, vr::X, 1.0, &mut out), fmi2Status::Error, "a derivative is no unknown in CS");
+    // FMI 2.0, 2.1.9, Step Mode: "If <ModelStructure><Derivatives> is present, also the
+    // variables listed here as state derivatives" are unknowns. Against a central difference of
+    // the der() variable itself (the f64 right-hand side, not the dual numbers) over the stroke
+    // input; 1e-5 relative: the difference's truncation error at a 1e-7 m step.
+    assert_eq!(call(der_p3, vr::X, 1.0, &mut out), fmi2Status::OK, "{}", s.last_error());
+    let x = s.real(vr::X);
+    let h = 1e-7;
+    let der_at = |x: f64| {
+        assert_eq!(s.set_real(vr::X, x), fmi2Status::OK);
+        s.real(der_p3)
+    };
+    let central = (der_at(x + h) - der_at(x - h)) / (2.0 * h);
+    assert_eq!(s.set_real(vr::X, x), fmi2Status::OK);
+    assert!((out[0] - central).abs() <= 1e-5 * central.abs(), "d der(p3)/dx: {} vs {central}", out[0]);
     assert_eq!(call(vr::F, vr::X, f64::NAN, &mut out), fmi2Status::Error);
     assert!(s.last_error().contains("dvKnown of \"cylinder.x\" = NaN"), "{}", s.last_error());
     let param = HydraulicCircuit::VARIABLES.iter().find(|v| v.causality == Causality::Parameter).unwrap().vr;
     assert_eq!(call(vr::F, param, 1.0, &mut out), fmi2Status::Error);
+}
+
+/// FMI 2.0 tables (3.2.3, 4.2.4: fmi2GetDirectionalDerivative in Initialization Mode) and 2.1.9
+/// (there the unknowns are the InitialUnknowns, the knowns what Initialization Mode sets: a
+/// parameter too), in Co-Simulation and Model Exchange. The rigid boom starts at rest, held by
+/// the closed CBV: the piston carries the load and the rod side's start.p4 (eq. 2.72 at rest),
+/// p3 A_p = F + p4 A_r, so dp3/d(start.p4) = A_r / A_p = 1 - (d_rod / d_piston)^2, from the
+/// FMU's own bore and rod. 1e-6 relative: the central difference's error (~1e-10) and the
+/// equilibrium solve's tolerance, far below the ratio's 0.5.
+#[test]
+fn initialization_mode_derivatives_follow_the_start_equilibrium() {
+    let (start_p4, d_piston, d_rod) = (32, 120, 121);
+    for fmu_type in [FMI2_COSIMULATION, FMI2_MODEL_EXCHANGE] {
+        let s = common::Slave::<HydraulicBoom>::try_new("init", &boomsim::fmi2::guid::guid::<HydraulicBoom>(), fmu_type)
+            .unwrap();
+        unsafe {
+            assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), fmi2Status::OK);
+            assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c), fmi2Status::OK);
+        }
+        assert_eq!(s.set_boolean(vr::FLEXIBLE, false), fmi2Status::OK);
+        let ratio = 1.0 - (s.real(d_rod) / s.real(d_piston)).powi(2);
+        let mut out = [f64::NAN];
+        let status =
+            unsafe { api::get_directional_derivative::<HydraulicBoom>(s.c, &vr::P3, 1, &start_p4, 1, &1.0, out.as_mut_ptr()) };
+        assert_eq!(status, fmi2Status::OK, "{}", s.last_error());
+        assert!((out[0] - ratio).abs() <= 1e-6 * ratio, "type {fmu_type}: dp3/dp4 = {} vs A_r/A_p = {ratio}", out[0]);
+        // A local (an event indicator's variable) is no InitialUnknown.
+        let status =
+            unsafe { api::get_directional_derivative::<HydraulicBoom>(s.c, &vr::EVENT_U_REF, 1, &start_p4, 1, &1.0, out.as_mut_ptr()) };
+        assert_eq!(status, fmi2Status::Error);
+        assert!(s.last_error().contains("is not an InitialUnknown"), "{}", s.last_error());
+        // Counts past the arrays are refused before they are read.
+        let status = unsafe {
+            api::get_directional_derivative::<HydraulicBoom>(s.c, &vr::P3, usize::MAX, &start_p4, 1, &1.0, out.as_mut_ptr())
+        };
+        assert_eq!(status, fmi2Status::Error);
+        assert!(s.last_error().contains("vUnknown_ref: 18446744073709551615 elements announced"), "{}", s.last_error());
+    }
 }

@@ -245,7 +245,8 @@ fn cases() -> Vec<Case> {
             cs: "",
             me: "C",
         },
-        Case { name: "fmi3SetTime", call: |i| unsafe { api::set_time::<Pfc>(i.c, 0.0) }, cs: "", me: "EC" },
+        // 3.2.1: Continuous-Time Mode only (Event Mode, 2.3.5, does not list it).
+        Case { name: "fmi3SetTime", call: |i| unsafe { api::set_time::<Pfc>(i.c, 0.0) }, cs: "", me: "C" },
         Case {
             name: "fmi3SetContinuousStates",
             call: |i| unsafe { api::set_continuous_states::<Pfc>(i.c, &30e5, 1) },
@@ -326,12 +327,12 @@ fn every_function_in_every_state_follows_the_fmi3_state_machine() {
                     let m = i.last_error();
                     let why = ["illegal call in state", "function, but this instance", "not supported"];
                     assert!(m.starts_with(case.name) && why.iter().any(|w| m.contains(w)), "{at}: {m:?}");
-                    // A refused call changes nothing: getting the number of states stays legal (ME).
-                    if me {
-                        let mut n = 0;
-                        assert_eq!(unsafe { api::get_number_of_continuous_states::<Pfc>(i.c, &mut n) }, OK);
-                        assert_eq!(n, Pfc::STATES.len());
-                    }
+                    // FMI 3.0, 2.3.1: "If any function called in super state FMU State Settable
+                    // returns fmi3Error, the FMU enters state Terminated": setting an input (legal
+                    // in every other state) is refused now, and fmi3Reset is legal there.
+                    assert_eq!(i.set(vr::P, 30e5), ERR, "{at}: Terminated after the error");
+                    assert!(i.last_error().contains("illegal call in state Terminated"), "{at}: {}", i.last_error());
+                    assert_eq!(unsafe { api::reset::<Pfc>(i.c) }, OK, "{at}");
                 }
                 checked += 1;
             }
@@ -382,20 +383,38 @@ fn a_null_logger_is_tolerated() {
     assert!(!c.is_null());
     unsafe {
         assert_eq!(api::do_step::<Pfc>(c, 0.0, 1e-3, true, (&mut false, &mut false, &mut false), &mut 0.0), ERR);
+        // FMI 3.0, 2.3.1: the error left the instance Terminated; fmi3Reset starts it anew.
+        assert_eq!(api::enter_initialization_mode::<Pfc>(c, false, 0.0, 0.0, false, 0.0), ERR);
+        assert_eq!(api::reset::<Pfc>(c), OK);
         assert_eq!(api::enter_initialization_mode::<Pfc>(c, false, 0.0, 0.0, false, 0.0), OK);
         assert_eq!(api::set_float64::<Pfc>(c, &vr::P, 1, &f64::NAN, 1), ERR);
-        assert_eq!(api::exit_initialization_mode::<Pfc>(c), OK);
+        assert_eq!(api::exit_initialization_mode::<Pfc>(c), ERR, "Terminated after the error");
         api::free_instance::<Pfc>(c);
     }
 }
 
-/// Each wrong argument: fmi3Error, a message naming the variable, value or pointer, and an
-/// instance that continues unchanged (the next step gives the outputs of an untouched twin).
+/// Each wrong argument: fmi3Error, a message naming the variable, value or pointer, and the
+/// instance Terminated (FMI 3.0, 2.3.1: "If any function called in super state FMU State
+/// Settable returns fmi3Error, the FMU enters state Terminated"; a step is refused), from where
+/// fmi3SetFMUState restores it (2.2.4: "it is possible to restore a previously retrieved FMU
+/// state"): the next steps give the outputs of an untouched twin.
 #[test]
 fn misuse_answers_with_error_and_a_message_and_changes_nothing() {
     let setup = [(vr::P, 40e5), (vr::U_REF, -0.1)];
     let (i, twin) = (Inst::<Pfc>::initialized(false, &setup), Inst::<Pfc>::initialized(false, &setup));
+    let mut saved = null_mut();
+    assert_eq!(unsafe { api::get_fmu_state::<Pfc>(i.c, &mut saved) }, OK);
     let wrong: &[(&str, &dyn Fn() -> fmi3Status, &[&str])] = &[
+        (
+            "count past the arrays",
+            &|| unsafe { api::set_float64::<Pfc>(i.c, &vr::P, usize::MAX, &1e5, usize::MAX) },
+            &["vr: 18446744073709551615 elements announced, but at most"],
+        ),
+        (
+            "get count past the arrays",
+            &|| unsafe { api::get_float64::<Pfc>(i.c, &vr::U, usize::MAX, &mut 0.0, usize::MAX) },
+            &["18446744073709551615 elements announced"],
+        ),
         ("NaN", &|| i.set(vr::P, f64::NAN), &["p = NaN is not a finite number", "valid range [-101325, 1e8] Pa"]),
         ("out of range", &|| i.set(vr::U_REF, 2.0), &["u_ref = 2 is outside its valid range [-1, 1]"]),
         ("not settable", &|| i.set(vr::U, 0.5), &["cannot set \"u\"", "causality=output"]),
@@ -449,7 +468,11 @@ fn misuse_answers_with_error_and_a_message_and_changes_nothing() {
         assert_eq!(call(), ERR, "{what}");
         let m = i.last_error();
         assert!(says.iter().all(|s| m.contains(s)), "{what}: {m:?}");
+        assert!(m.contains("the instance is now Terminated (FMI 3.0, 2.3.1"), "{what}: {m:?}");
+        assert_eq!(i.step(0.0, 1e-3), ERR, "{what}: Terminated");
+        assert_eq!(unsafe { api::set_fmu_state::<Pfc>(i.c, saved) }, OK, "{what}: restored");
     }
+    assert_eq!(unsafe { api::free_fmu_state::<Pfc>(i.c, &mut saved) }, OK);
     for k in 0..3 {
         let t = k as f64 * 1e-3;
         assert_eq!((i.set(vr::P, 41e5), twin.set(vr::P, 41e5)), (OK, OK));
@@ -677,4 +700,65 @@ fn event_indicators_are_the_declared_variables_in_their_order() {
     let mut count = 1;
     unsafe { assert_eq!(api::get_number_of_event_indicators::<Pfc>(i.c, &mut count), OK) };
     assert_eq!(count, 0);
+}
+
+/// FMI 3.0, 2.2.4 (fmi3Discard: "the FMU is in the same state as before the call ... the
+/// computation may continue") and 4.2.1 (fmi3DoStep may return it "if the FMU is in the same
+/// state as before the call"): a step of 1e6 s that the plant's integrator cannot finish is
+/// discarded and the instance stays at its time in Step Mode, so a smaller step continues from
+/// there and gives what an untouched twin gives.
+#[test]
+fn a_discarded_step_leaves_the_instance_as_it_was() {
+    use boomsim::models::vr as plant;
+    let setup = [(plant::U_REF, -0.3)];
+    let open_ended = || {
+        let s = Inst::<HydraulicBoom>::new(false);
+        unsafe {
+            assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(s.c, false, 0.0, 0.0, false, 0.0), OK);
+            assert_eq!(s.set(setup[0].0, setup[0].1), OK);
+            assert_eq!(api::exit_initialization_mode::<HydraulicBoom>(s.c), OK);
+        }
+        s
+    };
+    let (i, twin) = (open_ended(), open_ended());
+    assert_eq!(i.step(0.0, 1e6), fmi3Status::Discard);
+    let said = i.messages.lock().unwrap().last().map(|m| (m.0, m.2.clone())).expect("a message");
+    assert!(said.0 == fmi3Status::Discard && said.1.contains("the instance is back at t = 0"), "{said:?}");
+    assert_eq!(i.get(boomsim::fmu::instance::INDEPENDENT_VR), 0.0);
+    for k in 0..5 {
+        let t = k as f64 * 1e-3;
+        assert_eq!((i.step(t, 1e-3), twin.step(t, 1e-3)), (OK, OK), "{}", i.last_error());
+        assert_eq!(i.get(plant::P3).to_bits(), twin.get(plant::P3).to_bits());
+    }
+}
+
+/// FMI 3.0, 2.3.3: fmi3GetDirectionalDerivative and fmi3GetAdjointDerivative are among
+/// Initialization Mode's calls. At the rigid boom's start equilibrium (p3 A_p = F + p4 A_r, eq.
+/// 2.72 at rest) dp3/d(start.p4) = A_r / A_p = 1 - (d_rod / d_piston)^2 from the FMU's own
+/// bore and rod, both ways; 1e-6 relative: the central difference's error and the equilibrium
+/// solve's tolerance.
+#[test]
+fn derivatives_in_initialization_mode() {
+    use boomsim::models::vr as plant;
+    let (start_p4, d_piston, d_rod): (u32, u32, u32) = (32, 120, 121);
+    for me in [false, true] {
+        let i = Inst::<HydraulicBoom>::new(me);
+        unsafe {
+            assert_eq!(api::enter_initialization_mode::<HydraulicBoom>(i.c, false, 0.0, 0.0, false, 0.0), OK);
+            assert_eq!(api::set_boolean::<HydraulicBoom>(i.c, &plant::FLEXIBLE, 1, &0, 1), OK);
+        }
+        let ratio = 1.0 - (i.get(d_rod) / i.get(d_piston)).powi(2);
+        let (mut forward, mut adjoint) = (f64::NAN, f64::NAN);
+        unsafe {
+            let p3 = (&plant::P3 as *const u32, 1);
+            let known = (&start_p4 as *const u32, 1);
+            let dd = api::get_directional_derivative::<HydraulicBoom>(i.c, p3, known, (&1.0, 1), (&mut forward, 1));
+            assert_eq!(dd, OK, "{}", i.last_error());
+            let ad = api::get_adjoint_derivative::<HydraulicBoom>(i.c, p3, known, (&1.0, 1), (&mut adjoint, 1));
+            assert_eq!(ad, OK, "{}", i.last_error());
+        }
+        for d in [forward, adjoint] {
+            assert!((d - ratio).abs() <= 1e-6 * ratio, "ME {me}: {d} vs A_r/A_p = {ratio}");
+        }
+    }
 }

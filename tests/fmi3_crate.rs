@@ -52,7 +52,7 @@ fn controller_runs_in_the_fmi_crate_as_fmi3_and_matches_the_analytic_step_respon
     }
     let (mut e, mut te, mut ea, mut l) = (false, false, false, 0.0);
     assert!(s.do_step(0.2, -h, true, &mut e, &mut te, &mut ea, &mut l).is_err(), "negative step refused");
-    s.terminate().unwrap();
+    assert!(s.terminate().is_err(), "FMI 3.0, 2.3.1: the error left the instance Terminated");
 }
 
 /// The plant lowering the load (valve.u_ref = -0.3 for 0.3 s, flexible boom) in Co-Simulation:

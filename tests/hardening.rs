@@ -103,13 +103,16 @@ fn input_slopes_stop_at_the_declared_range() {
     assert_eq!(c.real(pfc::P), 1e8);
     assert!(c.real(pfc::U).is_finite() && c.real(pfc::U_COMP).is_finite());
 
-    // HydraulicCircuit's stroke follows the integral of its velocity: no slope of its own.
+    // HydraulicCircuit's stroke takes a slope like every continuous input (FMI 2.0
+    // canInterpolateInputs has no per-input exception) and stops at its bound the same way.
     let h = plant::<HydraulicCircuit>(1e-6, true, &[]);
-    assert_eq!(h.set_slope(vr::X, f64::MAX), ERR);
-    assert!(h.last_error().contains("\"cylinder.x\" has no derivative"), "{}", h.last_error());
+    assert_eq!(h.set_slope(vr::X, f64::MAX), OK, "{}", h.last_error());
     assert_eq!(h.set_slope(vr::V, f64::MAX), OK);
     assert_eq!(h.step(0.0, H), WARN);
     assert_eq!(h.real(vr::V), 10.0, "cylinder.v stops at its maximum 10 m/s");
+    let x = HydraulicCircuit::VARIABLES.iter().find(|v| v.vr == vr::X).unwrap();
+    let boomsim::fmi2::Kind::Real { max: x_max, .. } = x.kind else { panic!("cylinder.x is a Real") };
+    assert_eq!(h.real(vr::X), x_max, "cylinder.x stops at its declared maximum");
     assert!(all_reals(&h).iter().all(|x| x.is_finite()));
 }
 
@@ -248,4 +251,38 @@ fn plants_interpolate_the_spool_reference() {
     }
     check::<HydraulicBoom>();
     check::<HydraulicCircuit>();
+}
+
+/// The event indicators' variables are what the model computes now (issue 25 item 7), after
+/// steps as before them: at valve.u_ref = -0.1 after 300 steps of 1 ms, event.spool_reference
+/// = u_ref, event.dead_band_upper = x_v - x_db and event.dead_band_lower = x_v + x_db (their
+/// definitions, eq. 2.44-2.45), from the FMU's own spool position and dead band.
+#[test]
+fn event_indicator_variables_follow_the_steps() {
+    let s = plant::<HydraulicBoom>(1e-6, true, &[(vr::U_REF, -0.1)]);
+    for k in 0..300 {
+        assert_eq!(s.step(k as f64 * H, H), OK);
+    }
+    let (x_v, x_db) = (s.real(vr::X_V), s.real(index_of::<HydraulicBoom>("valve.x_db").1));
+    assert!(x_v < -x_db, "the spool is open for lowering: x_v = {x_v}");
+    assert_eq!(s.real(vr::EVENT_U_REF), -0.1);
+    assert_eq!(s.real(vr::EVENT_DEAD_BAND_UPPER), x_v - x_db);
+    assert_eq!(s.real(vr::EVENT_DEAD_BAND_LOWER), x_v + x_db);
+}
+
+/// A state the FMU wrote always reads back (issue 25 item 8): an interpolated input carried to
+/// the bound of its range by a reduced slope ends exactly on it (not a rounding error outside,
+/// which fmi2DeSerializeFMUstate would refuse as out of range), and the serialised state is
+/// taken back.
+#[test]
+fn an_input_stopped_at_its_bound_serialises() {
+    let c = Slave::<Pfc>::initialized("p", &[(pfc::P, 40e5)]);
+    assert_eq!(c.set_slope(pfc::P, -1e12), OK);
+    assert_eq!(c.step(0.0, 0.3), WARN);
+    assert_eq!(c.real(pfc::P), -101325.0, "p stops at its declared minimum");
+    let bytes = common::serialized(&c);
+    let mut st = null_mut();
+    let status = unsafe { api::deserialize_fmu_state::<Pfc>(c.c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut st) };
+    assert_eq!(status, OK, "{}", c.last_error());
+    assert_eq!(unsafe { api::free_fmu_state::<Pfc>(c.c, &mut st) }, OK);
 }

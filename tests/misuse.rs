@@ -166,6 +166,15 @@ const ROWS: &[Row] = &[
     Row { at: At::Terminated, what: "setReal of an input after terminate", call: |s| set_real(s, vr::P, 1e5), status: ERR, says: &["fmi2SetReal", "Terminated"] },
     Row { at: At::Terminated, what: "terminate twice", call: |s| unsafe { api::terminate::<Pfc>(s.c) }, status: ERR, says: &["fmi2Terminate", "Terminated"] },
     Row { at: At::Terminated, what: "setRealInputDerivatives after terminate", call: |s| derivative(s, vr::P, 1, 1.0), status: ERR, says: &["fmi2SetRealInputDerivatives", "Terminated"] },
+    // Counts larger than the arrays (one element each here): refused before an array is read,
+    // naming the count and its limit (the standard makes a wrong count the importer's error;
+    // the FMU's promise is never to crash on one).
+    Row { at: At::Stepping, what: "setReal nvr = SIZE_MAX", call: |s| unsafe { api::set_real::<Pfc>(s.c, &vr::P, usize::MAX, &1e5) }, status: ERR, says: &["fmi2SetReal", "vr: 18446744073709551615 elements announced, but at most"] },
+    Row { at: At::Stepping, what: "getReal nvr = SIZE_MAX", call: |s| unsafe { api::get_real::<Pfc>(s.c, &vr::U, usize::MAX, &mut 0.0) }, status: ERR, says: &["fmi2GetReal", "18446744073709551615 elements announced"] },
+    Row { at: At::Stepping, what: "getString nvr = SIZE_MAX", call: |s| unsafe { api::get_string::<Pfc>(s.c, &vr::U, usize::MAX, &mut null()) }, status: ERR, says: &["fmi2GetString", "18446744073709551615 elements announced"] },
+    Row { at: At::Stepping, what: "setRealInputDerivatives nvr = SIZE_MAX", call: |s| unsafe { api::set_real_input_derivatives::<Pfc>(s.c, &vr::P, usize::MAX, &1, &1.0) }, status: ERR, says: &["fmi2SetRealInputDerivatives", "18446744073709551615 elements announced"] },
+    Row { at: At::Stepping, what: "setDebugLogging nCategories = SIZE_MAX", call: |s| unsafe { api::set_debug_logging::<Pfc>(s.c, 1, usize::MAX, &c"logAll".as_ptr()) }, status: ERR, says: &["fmi2SetDebugLogging", "categories: 18446744073709551615 elements announced"] },
+    Row { at: At::Stepping, what: "deSerializeFMUstate size = SIZE_MAX", call: |s| { let b = common::serialized(s); let mut st = null_mut(); unsafe { api::deserialize_fmu_state::<Pfc>(s.c, b.as_ptr() as *const fmi2Byte, usize::MAX, &mut st) } }, status: ERR, says: &["fmi2DeSerializeFMUstate", "size = 18446744073709551615 bytes, but the state's header announces"] },
     // fmi2SetupExperiment arguments.
     Row { at: At::Instantiated, what: "tolerance NaN", call: |s| setup(s, f64::NAN, 0.0, STOP), status: ERR, says: &["tolerance = NaN"] },
     Row { at: At::Instantiated, what: "tolerance 0", call: |s| setup(s, 0.0, 0.0, STOP), status: ERR, says: &["tolerance = 0"] },

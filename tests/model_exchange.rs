@@ -65,8 +65,10 @@ fn at(st: St) -> Slave<Pfc> {
 
 type Call = fn(fmi2Component) -> fmi2Status;
 
-/// The ten ME functions and the states the standard's table (FMI 2.0.4, section 3.2.3) allows
-/// them in, written from the standard independently of `src/fmi2/state.rs`.
+/// The ten ME functions and the states the standard's table (FMI 2.0.5, section 3.2.3, with
+/// the 2.0.1 to 2.0.3 errata) allows them in, written from the standard independently of
+/// `src/fmi2/state.rs`: fmi2SetTime in Event Mode only for a pure discrete-time FMU (note 8);
+/// fmi2GetDerivatives and fmi2GetNominalsOfContinuousStates in Initialization Mode too.
 #[rustfmt::skip]
 fn me_functions() -> Vec<(&'static str, Call, &'static [St])> {
     use St::*;
@@ -78,15 +80,16 @@ fn me_functions() -> Vec<(&'static str, Call, &'static [St])> {
             let (mut e, mut t) = (0 as c_int, 0 as c_int);
             api::completed_integrator_step::<Pfc>(c, 1, &mut e, &mut t)
         }, &[ContinuousTimeMode]),
-        ("fmi2SetTime", |c| unsafe { api::set_time::<Pfc>(c, 0.5) }, &[EventMode, ContinuousTimeMode]),
+        ("fmi2SetTime", |c| unsafe { api::set_time::<Pfc>(c, 0.5) }, &[ContinuousTimeMode]),
         ("fmi2SetContinuousStates", |c| unsafe { api::set_continuous_states::<Pfc>(c, &1e5, 1) }, &[ContinuousTimeMode]),
-        ("fmi2GetDerivatives", |c| unsafe { api::get_derivatives::<Pfc>(c, &mut 0.0, 1) }, &[EventMode, ContinuousTimeMode, Terminated]),
+        ("fmi2GetDerivatives", |c| unsafe { api::get_derivatives::<Pfc>(c, &mut 0.0, 1) },
+            &[InitializationMode, EventMode, ContinuousTimeMode, Terminated]),
         ("fmi2GetEventIndicators", |c| unsafe { api::get_event_indicators::<Pfc>(c, std::ptr::null_mut(), 0) },
             &[InitializationMode, EventMode, ContinuousTimeMode, Terminated]),
         ("fmi2GetContinuousStates", |c| unsafe { api::get_continuous_states::<Pfc>(c, &mut 0.0, 1) },
             &[InitializationMode, EventMode, ContinuousTimeMode, Terminated]),
         ("fmi2GetNominalsOfContinuousStates", |c| unsafe { api::get_nominals_of_continuous_states::<Pfc>(c, &mut 0.0, 1) },
-            &[Instantiated, EventMode, ContinuousTimeMode, Terminated]),
+            &[Instantiated, InitializationMode, EventMode, ContinuousTimeMode, Terminated]),
     ]
 }
 
@@ -144,7 +147,10 @@ fn wrong_state_vectors_are_refused() {
         assert_eq!(api::get_nominals_of_continuous_states::<Pfc>(s.c, null, 1), ERR);
         assert_eq!(api::completed_integrator_step::<Pfc>(s.c, 1, std::ptr::null_mut(), std::ptr::null_mut()), ERR);
         assert_eq!(api::set_time::<Pfc>(s.c, f64::NAN), ERR);
-        assert!(s.last_error().contains("time = NaN must be finite"), "{}", s.last_error());
+        assert!(s.last_error().contains("time = NaN is outside its valid range [0, inf)"), "{}", s.last_error());
+        // FMI 3.0, 3.2.1 (fmi3SetTime): not before the start time; FMI 2.0 alike (no state exists there).
+        assert_eq!(api::set_time::<Pfc>(s.c, -1e-3), ERR);
+        assert!(s.last_error().contains("time = -0.001 is outside its valid range [0, inf)"), "{}", s.last_error());
         assert_eq!(api::enter_event_mode::<Pfc>(s.c), OK);
         assert_eq!(api::new_discrete_states::<Pfc>(s.c, std::ptr::null_mut()), ERR);
         assert_eq!(api::enter_continuous_time_mode::<Pfc>(s.c), OK, "still usable");
@@ -343,4 +349,29 @@ fn event_indicators_mark_the_dead_band() {
         assert_eq!(api::get_event_indicators::<HydraulicBoom>(s.c, z.as_mut_ptr(), 2), ERR);
         assert!(s.last_error().contains("ni = 2, but HydraulicBoom has 3 event indicators"), "{}", s.last_error());
     }
+}
+
+/// FMI 2.0, 3.2.3 rule 5 (clarified in 2.0.1): in Continuous-Time Mode fmi2SetReal may set a
+/// continuous-time state by its value reference; it is the state then, as fmi2SetContinuousStates
+/// would set it. And a state the FMU wrote always reads back: fmi2SetTime back before the last
+/// completed integrator step (3.2.1 allows going back) still serialises into bytes that
+/// fmi2DeSerializeFMUstate takes.
+#[test]
+fn a_state_set_by_its_reference_is_the_state_and_serialises() {
+    let s = at(St::ContinuousTimeMode);
+    assert_eq!(s.set_real(pfc::P_LP, 7e5), OK, "{}", s.last_error());
+    let mut x = [0.0];
+    assert_eq!(unsafe { api::get_continuous_states::<Pfc>(s.c, x.as_mut_ptr(), 1) }, OK);
+    assert_eq!(x[0], 7e5);
+    assert_eq!(s.real(pfc::P_LP), 7e5);
+    assert_eq!(s.set_real(pfc::P_LP, f64::NAN), ERR, "refused as fmi2SetContinuousStates refuses it");
+    assert_eq!(unsafe { api::set_time::<Pfc>(s.c, 0.5) }, OK);
+    let (mut enter, mut terminate) = (0 as c_int, 0 as c_int);
+    assert_eq!(unsafe { api::completed_integrator_step::<Pfc>(s.c, 1, &mut enter, &mut terminate) }, OK);
+    assert_eq!(unsafe { api::set_time::<Pfc>(s.c, 0.25) }, OK);
+    let bytes = common::serialized(&s);
+    let mut st = std::ptr::null_mut();
+    let status = unsafe { api::deserialize_fmu_state::<Pfc>(s.c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut st) };
+    assert_eq!(status, OK, "{}", s.last_error());
+    assert_eq!(unsafe { api::free_fmu_state::<Pfc>(s.c, &mut st) }, OK);
 }

@@ -151,3 +151,20 @@ fn fmu_state_keeps_the_extrapolation() {
     assert_eq!(run(&s), reference);
     assert_eq!(unsafe { api::free_fmu_state::<Pfc>(s.c, &mut state) }, OK);
 }
+
+/// Robustness (issue 25 item 10): a denormal step (5e-324 s, the smallest f64) puts two samples
+/// of p closer in time than a division resolves; the extrapolated slope through them would be
+/// infinite. It is held instead, so the next steps stay finite with fmi2OK and u_comp keeps the
+/// high-pass law: a pressure held at P0 since the start gives u_comp = 0.
+#[test]
+fn a_denormal_step_leaves_the_extrapolation_finite() {
+    let s = controller(true);
+    let tiny = f64::from_bits(1);
+    assert_eq!(s.step(0.0, tiny), OK);
+    assert_eq!(s.set_real(vr::P, P0 + 1e5), OK);
+    assert_eq!(s.step(tiny, H), OK, "{}", s.last_error());
+    assert!(s.real(vr::U_COMP).is_finite() && s.real(vr::U).is_finite());
+    assert_eq!(s.set_real(vr::P, P0), OK);
+    assert_eq!(s.step(tiny + H, H), OK, "{}", s.last_error());
+    assert!(s.real(vr::U_COMP).is_finite());
+}

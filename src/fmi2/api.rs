@@ -236,7 +236,10 @@ pub unsafe fn set_real_input_derivatives<M: Model>(
     value: *const f64,
 ) -> fmi2Status {
     call::<M>(c, at("fmi2SetRealInputDerivatives", allowed::SET_INPUT_DERIVATIVES), |inst| {
-        inst.set_input_derivatives(slice(vr, n, "vr")?, slice(order, n, "order")?, slice(value, n, "value")?)?;
+        let limit = abi::references::<M>();
+        let (vr, order, value) =
+            (slice(vr, n, limit, "vr")?, slice(order, n, limit, "order")?, slice(value, n, limit, "value")?);
+        inst.set_input_derivatives(vr, order, value)?;
         Ok(fmi2Status::OK)
     })
 }

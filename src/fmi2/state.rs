@@ -16,7 +16,8 @@ pub mod allowed {
     pub const TERMINATE: Rule = both(DONE | FAIL | CANC | EVENT | CONT);
     pub const RESET: Rule = both(ANY);
     pub const GET: Rule = both(INIT | DONE | FAIL | CANC | EVENT | CONT | TERM | ERR);
-    /// fmi2SetReal; in Continuous-Time Mode only continuous inputs (checked per variable).
+    /// fmi2SetReal; in Continuous-Time Mode only continuous inputs and continuous states
+    /// (rule 5, clarified in 2.0.1; checked per variable).
     pub const SET_REAL: Rule = both(INST | INIT | DONE | EVENT | CONT);
     /// fmi2SetInteger, fmi2SetBoolean, fmi2SetString: discrete, so not in Continuous-Time Mode.
     pub const SET_DISCRETE: Rule = both(INST | INIT | DONE | EVENT);
@@ -32,10 +33,13 @@ pub mod allowed {
     pub const NEW_DISCRETE_STATES: Rule = me(EVENT);
     pub const ENTER_CONTINUOUS_TIME_MODE: Rule = me(EVENT);
     pub const COMPLETED_INTEGRATOR_STEP: Rule = me(CONT);
-    pub const SET_TIME: Rule = me(EVENT | CONT);
+    /// Table note 8: in Event Mode only for a pure discrete-time FMU, which these are not.
+    pub const SET_TIME: Rule = me(CONT);
     pub const SET_CONTINUOUS_STATES: Rule = me(CONT);
-    pub const GET_DERIVATIVES: Rule = me(EVENT | CONT | TERM | ERR);
+    /// Initialization Mode since the 2.0.1 errata (3.2.3: "fmi2GetDerivatives may be called in
+    /// initializationMode").
+    pub const GET_DERIVATIVES: Rule = me(INIT | EVENT | CONT | TERM | ERR);
     pub const GET_EVENT_INDICATORS: Rule = me(INIT | EVENT | CONT | TERM | ERR);
     pub const GET_CONTINUOUS_STATES: Rule = me(INIT | EVENT | CONT | TERM | ERR);
-    pub const GET_NOMINALS: Rule = me(INST | EVENT | CONT | TERM | ERR);
+    pub const GET_NOMINALS: Rule = me(INST | INIT | EVENT | CONT | TERM | ERR);
 }

@@ -306,9 +306,11 @@ pub unsafe fn other_type<M: Model>(
     ty: &str,
 ) -> fmi3Status {
     let rule = if set { allowed::SET_DISCRETE } else { allowed::GET };
-    call::<M>(c, at(function, rule), |inst: &mut Instance<M>| match slice(vr, n, "valueReferences")?.first() {
-        Some(&r) => Err(inst.type_mismatch(r, ty)),
-        None => Ok(fmi3Status::OK),
+    call::<M>(c, at(function, rule), |inst: &mut Instance<M>| {
+        match slice(vr, n, abi::references::<M>(), "valueReferences")?.first() {
+            Some(&r) => Err(inst.type_mismatch(r, ty)),
+            None => Ok(fmi3Status::OK),
+        }
     })
 }
 
@@ -401,10 +403,11 @@ pub unsafe fn get_adjoint_derivative<M: Model>(
     }
     call::<M>(c, f, |inst| {
         derivative_counts(n_seed, n_unknowns, n_sensitivity, n_knowns)?;
-        let unknowns = slice(unknowns, n_unknowns, "unknowns")?;
-        let knowns = slice(knowns, n_knowns, "knowns")?;
-        let seeds = slice(seed, n_seed, "seed")?;
-        let out = slice_mut(sensitivity, n_sensitivity, "sensitivity")?;
+        let limit = abi::references::<M>();
+        let unknowns = slice(unknowns, n_unknowns, limit, "unknowns")?;
+        let knowns = slice(knowns, n_knowns, limit, "knowns")?;
+        let seeds = slice(seed, n_seed, limit, "seed")?;
+        let out = slice_mut(sensitivity, n_sensitivity, limit, "sensitivity")?;
         inst.adjoint_derivative(unknowns, knowns, seeds, out)?;
         Ok(fmi3Status::OK)
     })

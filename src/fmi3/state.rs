@@ -21,7 +21,8 @@ pub mod allowed {
     pub const TERMINATE: Rule = both(DONE | FAIL | EVENT | CONT);
     pub const RESET: Rule = both(ANY);
     pub const GET: Rule = both(INIT | DONE | FAIL | EVENT | CONT | TERM | ERR);
-    /// fmi3SetFloat64; in Continuous-Time Mode only continuous inputs (checked per variable).
+    /// fmi3SetFloat64; in Continuous-Time Mode only continuous inputs and continuous-time states
+    /// (3.2.1, as of FMI 3.0.2; checked per variable).
     pub const SET_FLOAT64: Rule = both(INST | INIT | DONE | EVENT | CONT);
     /// fmi3SetInt32, fmi3SetBoolean, fmi3SetString (and the other types): not in Continuous-Time Mode.
     pub const SET_DISCRETE: Rule = both(INST | INIT | DONE | EVENT);
@@ -34,7 +35,8 @@ pub mod allowed {
     pub const UPDATE_DISCRETE_STATES: Rule = me(EVENT);
     pub const ENTER_CONTINUOUS_TIME_MODE: Rule = me(EVENT);
     pub const COMPLETED_INTEGRATOR_STEP: Rule = me(CONT);
-    pub const SET_TIME: Rule = me(EVENT | CONT);
+    /// Continuous-Time Mode only (3.2.1; Event Mode, 2.3.5, does not list it).
+    pub const SET_TIME: Rule = me(CONT);
     pub const SET_CONTINUOUS_STATES: Rule = me(CONT);
     pub const GET_CONTINUOUS_STATE_DERIVATIVES: Rule = me(INIT | EVENT | CONT | TERM | ERR);
     pub const GET_EVENT_INDICATORS: Rule = me(INIT | EVENT | CONT | TERM | ERR);

@@ -8,7 +8,7 @@
 
 use super::fmu_state;
 use super::instance::{Core, Instance, Step, Warning};
-use super::log::{Logger, Status, LOG_FMI_CALLS};
+use super::log::{Logger, Status, GENERIC_CATEGORIES, LOG_FMI_CALLS};
 use super::model::Model;
 use super::state::{describe, Interface, Rule, State};
 use super::variables::{BaseType, Value};
@@ -67,21 +67,39 @@ pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) ->
     match result {
         Ok(Ok(status)) => status,
         Ok(Err(message)) => {
-            inst.log.status(Status::Error, &format!("{function}: {message}"));
+            let m = format!("{function}: {message}{}", after_error(inst));
+            inst.log.status(Status::Error, &m);
             Status::Error
         }
         Err(p) => {
             inst.core.state = State::Error;
-            let v = inst.version;
-            let m = format!(
-                "{function}: internal error: {}; the instance is now in the Error state ({} or {})",
-                panic_text(p.as_ref()),
-                v.function("fmi2Reset"),
-                v.function("fmi2FreeInstance")
-            );
+            let m = format!("{function}: internal error: {}{}", panic_text(p.as_ref()), after_error(inst));
             inst.log.status(Status::Error, &m);
             Status::Error
         }
+    }
+}
+
+/// The state an error leaves, and what the message adds about it. FMI 3.0, 2.3.1: "If any
+/// function called in super state FMU State Settable returns fmi3Error, the FMU enters state
+/// Terminated". FMI 2.0 leaves the state after fmi2Error open (2.1.3: "it is possible to
+/// restore a previously retrieved FMU state"): a refused call changes nothing there, and only
+/// a broken model (a panic, a non-finite result) puts the instance in the Error state.
+fn after_error<M: Model>(inst: &mut Instance<M>) -> String {
+    let c = &mut inst.core;
+    let v = inst.version;
+    let (reset, restore, free) =
+        (v.function("fmi2Reset"), v.function("fmi2SetFMUstate"), v.function("fmi2FreeInstance"));
+    match (v, c.state) {
+        (Version::Fmi3, State::Terminated) => String::new(),
+        (Version::Fmi3, _) => {
+            c.state = State::Terminated;
+            format!("; the instance is now Terminated (FMI 3.0, 2.3.1; {reset}, {restore} or {free})")
+        }
+        (Version::Fmi2, State::Error) => {
+            format!("; the instance is now in the Error state ({reset}, {restore} or {free})")
+        }
+        (Version::Fmi2, _) => String::new(),
     }
 }
 
@@ -96,9 +114,17 @@ pub fn warn<M: Model>(inst: &Instance<M>, function: &str, warning: Warning) -> S
     }
 }
 
-/// A slice from a C array; NULL is an error unless `n` is 0.
-pub unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T], String> {
-    if n == 0 {
+/// The most elements an array of a call may announce, and what bounds it (for the message).
+/// FMI makes a count larger than its array the importer's error, but a count the model cannot use
+/// is refused before the array is touched, so that it cannot make the FMU read or write past it.
+pub type Limit<'a> = (usize, &'a str);
+
+/// A slice from a C array of `n` elements; NULL is an error unless `n` is 0, and so is `n`
+/// above the limit.
+pub unsafe fn slice<'a, T>(p: *const T, n: usize, (max, of): Limit, what: &str) -> Result<&'a [T], String> {
+    if n > max {
+        Err(format!("{what}: {n} elements announced, but at most {max} are valid ({of})"))
+    } else if n == 0 {
         Ok(&[])
     } else if p.is_null() {
         Err(format!("{what} is NULL but {n} elements were announced"))
@@ -107,15 +133,20 @@ pub unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T],
     }
 }
 
-/// A mutable slice from a C array; NULL is an error unless `n` is 0.
-pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mut [T], String> {
-    if n == 0 {
-        Ok(&mut [])
-    } else if p.is_null() {
-        Err(format!("{what} is NULL but {n} elements were announced"))
-    } else {
-        Ok(std::slice::from_raw_parts_mut(p, n))
-    }
+/// A mutable slice from a C array of `n` elements, checked as [`slice`].
+pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, limit: Limit, what: &str) -> Result<&'a mut [T], String> {
+    slice(p as *const T, n, limit, what)?;
+    Ok(if n == 0 { &mut [] } else { std::slice::from_raw_parts_mut(p, n) })
+}
+
+/// The limit of a list of value references: one per variable (FMI 3.0: and `time`).
+pub fn references<M: Model>() -> Limit<'static> {
+    (M::VARIABLES.len() + 1, "one per variable of the model")
+}
+
+/// The limit of an array of continuous states: the model's number.
+pub fn states<M: Model>() -> Limit<'static> {
+    (M::STATES.len(), "the model's continuous states")
 }
 
 /// A C string as UTF-8, if it is one.
@@ -166,7 +197,8 @@ pub unsafe fn set_debug_logging<M: Model>(
     categories: *const *const c_char,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let names = slice(categories, n, "categories")?
+        let limit = (M::INFO.log_categories.len() + GENERIC_CATEGORIES.len(), "the model's log categories");
+        let names = slice(categories, n, limit, "categories")?
             .iter()
             .map(|&p| text(p).ok_or_else(|| "a category name is NULL or not UTF-8".to_string()))
             .collect::<Result<Vec<_>, _>>()?;
@@ -227,8 +259,8 @@ pub unsafe fn get<M: Model, T>(
     read: impl Fn(&Value) -> T,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let vrs = slice(vr, n, "vr")?;
-        let out = slice_mut(out, n, "value")?;
+        let vrs = slice(vr, n, references::<M>(), "vr")?;
+        let out = slice_mut(out, n, references::<M>(), "value")?;
         inst.get(vrs, out, wanted, read)?;
         Ok(Status::OK)
     })
@@ -254,8 +286,8 @@ pub fn integer(v: &Value) -> i32 {
 
 pub unsafe fn get_string<M: Model>(c: Handle, f: Call, vr: *const u32, n: usize, value: *mut *const c_char) -> Status {
     call::<M>(c, f, |inst| {
-        let vrs = slice(vr, n, "vr")?;
-        let out = slice_mut(value, n, "value")?;
+        let vrs = slice(vr, n, references::<M>(), "vr")?;
+        let out = slice_mut(value, n, references::<M>(), "value")?;
         let mut texts = vec![CString::default(); n];
         inst.get(vrs, &mut texts, BaseType::String, |v| match v {
             Value::String(s) => CString::new(s.replace('\0', " ")).unwrap_or_default(),
@@ -278,8 +310,9 @@ pub unsafe fn set<M: Model, T: Copy>(
     convert: impl Fn(T) -> Result<Value, String>,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let vrs = slice(vr, n, "vr")?;
-        let values = slice(value, n, "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
+        let vrs = slice(vr, n, references::<M>(), "vr")?;
+        let values =
+            slice(value, n, references::<M>(), "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
         inst.set(vrs, values)?;
         Ok(Status::OK)
     })
@@ -374,7 +407,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
                 inst.version.function("fmi2SerializedFMUstateSize")
             ));
         }
-        slice_mut(bytes, size, "serializedState")?.copy_from_slice(&data);
+        slice_mut(bytes, size, (data.len(), "the state's size"), "serializedState")?.copy_from_slice(&data);
         Ok(Status::OK)
     })
 }
@@ -387,7 +420,16 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
     state: *mut FmuState,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let data = slice(bytes, size, "serializedState")?;
+        // The bytes are read as far as the header first: `size` must be the length it announces.
+        let head = fmu_state::head_len(&inst.guid);
+        let limit = (size.min(head), "the state's header");
+        let prefix = slice(bytes, size.min(head), limit, "serializedState")?;
+        let data = match fmu_state::announced_len(prefix) {
+            Some(n) if n != size => return Err(format!("size = {size} bytes, but the state's header announces {n}")),
+            Some(_) => slice(bytes, size, (size, "the length the header announces"), "serializedState")?,
+            // Not a header of this format: the prefix tells why.
+            None => prefix,
+        };
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
         let core = fmu_state::deserialize::<M>(data, &inst.guid)?;
         if let Some(other) = core.state.interface().filter(|&i| i != inst.interface) {
@@ -420,10 +462,11 @@ pub unsafe fn get_directional_derivative<M: Model>(
     }
     call::<M>(c, f, |inst| {
         let name = |fmi2| inst.version.argument(fmi2);
-        let unknowns = slice(unknown, n_unknown, name("vUnknown_ref"))?;
-        let knowns = slice(known, n_known, name("vKnown_ref"))?;
-        let seeds = slice(dv_known, n_known, name("dvKnown"))?;
-        let out = slice_mut(dv_unknown, n_unknown, name("dvUnknown"))?;
+        let limit = references::<M>();
+        let unknowns = slice(unknown, n_unknown, limit, name("vUnknown_ref"))?;
+        let knowns = slice(known, n_known, limit, name("vKnown_ref"))?;
+        let seeds = slice(dv_known, n_known, limit, name("dvKnown"))?;
+        let out = slice_mut(dv_unknown, n_unknown, limit, name("dvUnknown"))?;
         inst.directional_derivative(unknowns, knowns, seeds, out)?;
         Ok(Status::OK)
     })
@@ -466,14 +509,16 @@ pub unsafe fn set_time<M: Model>(c: Handle, f: Call, time: f64) -> Status {
 
 pub unsafe fn set_continuous_states<M: Model>(c: Handle, f: Call, x: *const f64, nx: usize) -> Status {
     call::<M>(c, f, |inst| {
-        inst.set_continuous_states(slice(x, nx, "x")?)?;
+        Instance::<M>::check_states(nx)?;
+        inst.set_continuous_states(slice(x, nx, states::<M>(), "x")?)?;
         Ok(Status::OK)
     })
 }
 
 pub unsafe fn get_continuous_states<M: Model>(c: Handle, f: Call, x: *mut f64, nx: usize) -> Status {
     call::<M>(c, f, |inst| {
-        inst.continuous_states(slice_mut(x, nx, "x")?)?;
+        Instance::<M>::check_states(nx)?;
+        inst.continuous_states(slice_mut(x, nx, states::<M>(), "x")?)?;
         Ok(Status::OK)
     })
 }
@@ -481,26 +526,31 @@ pub unsafe fn get_continuous_states<M: Model>(c: Handle, f: Call, x: *mut f64, n
 /// The state derivatives; Discard (FMI 2.0, 2.1.3: retry with a smaller step) where the states
 /// are outside the model's domain.
 pub unsafe fn get_derivatives<M: Model>(c: Handle, f: Call, dx: *mut f64, nx: usize) -> Status {
-    call::<M>(c, f, |inst| match inst.derivatives(slice_mut(dx, nx, "derivatives")?)? {
-        None => Ok(Status::OK),
-        Some(why) => {
-            inst.log.status(Status::Discard, &format!("{}: {why}", f.function));
-            Ok(Status::Discard)
+    call::<M>(c, f, |inst| {
+        Instance::<M>::check_states(nx)?;
+        match inst.derivatives(slice_mut(dx, nx, states::<M>(), "derivatives")?)? {
+            None => Ok(Status::OK),
+            Some(why) => {
+                inst.log.status(Status::Discard, &format!("{}: {why}", f.function));
+                Ok(Status::Discard)
+            }
         }
     })
 }
 
 pub unsafe fn get_event_indicators<M: Model>(c: Handle, f: Call, z: *mut f64, ni: usize) -> Status {
     call::<M>(c, f, |inst| {
-        inst.event_indicators(slice_mut(z, ni, "eventIndicators")?)?;
+        let limit = (M::EVENT_INDICATORS.len(), "the model's event indicators");
+        Instance::<M>::check_count("ni", ni, limit.0, "event indicators")?;
+        inst.event_indicators(slice_mut(z, ni, limit, "eventIndicators")?)?;
         Ok(Status::OK)
     })
 }
 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: Handle, f: Call, x: *mut f64, nx: usize) -> Status {
     call::<M>(c, f, |_| {
-        let out = slice_mut(x, nx, "x_nominal")?;
         Instance::<M>::check_states(nx)?;
+        let out = slice_mut(x, nx, states::<M>(), "x_nominal")?;
         out.iter_mut().zip(M::STATES).for_each(|(o, s)| *o = s.nominal);
         Ok(Status::OK)
     })

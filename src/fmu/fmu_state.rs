@@ -76,6 +76,25 @@ pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
     out
 }
 
+/// The length of the header of a state of the FMU with `guid`: magic, format version, GUID,
+/// payload length.
+pub fn head_len(guid: &str) -> usize {
+    MAGIC.len() + 4 + 4 + guid.len() + 8
+}
+
+/// The whole length a header announces (header, payload, checksum), if the bytes begin with
+/// a header of this format; what follows is not read.
+pub fn announced_len(head: &[u8]) -> Option<usize> {
+    let at = |from: usize, n: usize| head.get(from..from + n);
+    if at(0, MAGIC.len())? != MAGIC {
+        return None;
+    }
+    let guid_len = u32::from_le_bytes(at(MAGIC.len() + 4, 4)?.try_into().ok()?) as usize;
+    let payload_at = MAGIC.len() + 8 + guid_len;
+    let payload = u64::from_le_bytes(at(payload_at, 8)?.try_into().ok()?) as usize;
+    (payload_at + 8).checked_add(payload)?.checked_add(4)
+}
+
 /// Parses bytes written by [`serialize`] for this model and GUID.
 pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String> {
     if bytes.len() < MAGIC.len() + 4 + 4 + 8 + 4 {
@@ -175,12 +194,12 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
 }
 
 /// The instance clock and experiment of a restored state: what fmi2SetupExperiment would accept
-/// and the clock between start and stop.
+/// and the clocks at or after the start (Model Exchange may set the time back before the last
+/// completed integrator step: fmi2SetTime).
 fn check_times(time: f64, start: f64, last: f64, stop: Option<f64>, tolerance: Option<f64>) -> Result<(), String> {
     let (lo, hi) = TOLERANCE_RANGE;
     let ok = [time, start, last].iter().all(|t| t.is_finite())
         && time >= start
-        && last <= time
         && last >= start
         && stop.is_none_or(|s| s.is_finite() && s >= start)
         && tolerance.is_none_or(|t| (lo..=hi).contains(&t));

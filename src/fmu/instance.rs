@@ -2,7 +2,7 @@
 //! [`super::api`] wraps these methods in the C ABI.
 
 use super::log::{num, Logger, Status};
-use super::model::{Log, Model};
+use super::model::{initial_unknown, Log, Model};
 use super::state::{Interface, State};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
@@ -108,6 +108,22 @@ fn write_outputs<M: Model>(model: &M, values: &mut Values) {
     for (&r, &z) in M::EVENT_INDICATORS.iter().zip(z.iter()) {
         values.set_real(r, z);
     }
+}
+
+/// The values of `unknowns` (InitialUnknowns) that a model built from `values` starts with.
+fn initial_values<M: Model>(values: &Values, unknowns: &[u32]) -> Result<Vec<f64>, String> {
+    let model = M::initialize(values)?;
+    let mut v = values.clone();
+    write_outputs(&model, &mut v);
+    let mut x = vec![0.0; M::STATES.len()];
+    model.continuous_states(&mut x);
+    let mut dx = vec![0.0; M::STATES.len()];
+    model.derivatives(values, &mut dx);
+    for ((s, x), d) in M::STATES.iter().zip(x).zip(dx) {
+        v.set_real(s.state, x);
+        v.set_real(s.derivative, d);
+    }
+    Ok(unknowns.iter().map(|&r| v.real(r)).collect())
 }
 
 /// A model-facing [`Log`] that writes through the instance logger.
@@ -221,7 +237,7 @@ impl<M: Model> Instance<M> {
             M::model_exchange_check(&c.values)?;
         }
         let model = M::initialize(&c.values)?;
-        model.outputs(&mut c.values);
+        write_outputs(&model, &mut c.values);
         c.model = Some(model);
         c.outputs_current = true;
         c.derivatives_current = false;
@@ -243,8 +259,14 @@ impl<M: Model> Instance<M> {
     /// and interpolate back, and the models are autonomous (time enters only through the
     /// inputs), so their equations hold at any time.
     pub fn set_time(&mut self, t: f64) -> Result<(), String> {
-        if !t.is_finite() {
-            return Err(format!("time = {} must be finite", num(t)));
+        if !(t >= self.core.start_time && t.is_finite()) {
+            // FMI 3.0, 3.2.1 (fmi3SetTime): time "must be larger or equal to startTime"; FMI 2.0
+            // alike: the model has no states before its start.
+            return Err(format!(
+                "time = {} is outside its valid range [{}, inf) (the start time)",
+                num(t),
+                num(self.core.start_time)
+            ));
         }
         self.core.time = t;
         self.core.outputs_current = false;
@@ -258,7 +280,7 @@ impl<M: Model> Instance<M> {
     }
 
     /// An array length the importer announces (`what` = `n`) against the model's `expected` `of`.
-    fn check_count(what: &str, n: usize, expected: usize, of: &str) -> Result<(), String> {
+    pub(crate) fn check_count(what: &str, n: usize, expected: usize, of: &str) -> Result<(), String> {
         if n == expected {
             return Ok(());
         }
@@ -290,6 +312,15 @@ impl<M: Model> Instance<M> {
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
         Ok(())
+    }
+
+    /// The continuous states of the model built at initialisation.
+    fn exposed_states(&self) -> Vec<f64> {
+        let mut x = vec![0.0; M::STATES.len()];
+        if let Some(m) = &self.core.model {
+            m.continuous_states(&mut x);
+        }
+        x
     }
 
     /// fmi2GetContinuousStates (in Initialization Mode: those the values set so far give).
@@ -330,9 +361,12 @@ impl<M: Model> Instance<M> {
         }))
     }
 
-    /// fmi2GetDirectionalDerivative: the unknowns must be outputs or (Model Exchange) `der()`
-    /// variables, the knowns Real inputs or (Model Exchange) continuous states, FMI 2.0, 2.1.9;
-    /// after initialisation.
+    /// fmi2GetDirectionalDerivative (FMI 2.0, 2.1.9; FMI 3.0, 2.3.11), by mode: in
+    /// Initialization Mode the unknowns are the Real InitialUnknowns and the knowns the Real
+    /// variables that may be set there (inputs, `initial="exact"` parameters and start values);
+    /// after it the unknowns are the outputs and the `der()` variables of `<Derivatives>` (Step
+    /// Mode too: "if <Derivatives> is present, also the variables listed here"), the knowns the
+    /// Real inputs and, in Model Exchange, the continuous states.
     pub fn directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -340,19 +374,31 @@ impl<M: Model> Instance<M> {
         seeds: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
+        let init = self.core.state == State::InitializationMode;
         let me = self.interface == Interface::ModelExchange;
-        let what = if me { "an output or a derivative" } else { "an output" };
         for &vr in unknowns {
             let (i, v) = self.lookup(vr, BaseType::Real)?;
-            if !(v.causality == Causality::Output || (me && self.derivative_rows[i])) {
+            let ok = if init {
+                initial_unknown::<M>(v)
+            } else {
+                v.causality == Causality::Output || self.derivative_rows[i]
+            };
+            if !ok {
+                let what = if init { "an InitialUnknown" } else { "an output or a derivative" };
                 return Err(format!("unknown \"{}\" (vr {vr}) is not {what} of ModelStructure", v.name));
             }
         }
-        let what = if me { "an input or a continuous state" } else { "an input" };
         for (&vr, &dv) in knowns.iter().zip(seeds) {
             let (_, v) = self.lookup(vr, BaseType::Real)?;
             let state = M::STATES.iter().any(|s| s.state == vr);
-            if !(v.causality == Causality::Input || (me && state)) {
+            let input = v.causality == Causality::Input;
+            let ok = if init { settable(v, false, State::InitializationMode).is_ok() } else { input || (me && state) };
+            if !ok {
+                let what = match (init, me) {
+                    (true, _) => "an input or a variable with initial=\"exact\"",
+                    (false, true) => "an input or a continuous state",
+                    (false, false) => "an input",
+                };
                 return Err(format!("known \"{}\" (vr {vr}) is not {what}", v.name));
             }
             if !dv.is_finite() {
@@ -364,17 +410,73 @@ impl<M: Model> Instance<M> {
                 ));
             }
         }
-        if matches!(self.core.state, State::InitializationMode) {
-            return Err("directional derivatives are provided after initialisation".into());
+        if init {
+            self.initial_derivative(unknowns, knowns, seeds, out)?;
+        } else {
+            let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
+            let knowns: Vec<(u32, f64)> = knowns.iter().copied().zip(seeds.iter().copied()).collect();
+            model.directional_derivative(&self.core.values, &knowns, unknowns, out)?;
         }
-        let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
-        let knowns: Vec<(u32, f64)> = knowns.iter().copied().zip(seeds.iter().copied()).collect();
-        model.directional_derivative(&self.core.values, &knowns, unknowns, out)?;
         if let Some(k) = out.iter().position(|x| !x.is_finite()) {
             return Err(format!(
                 "the derivative of \"{}\" is not finite at these states",
                 self.name(unknowns[k]).unwrap_or("?")
             ));
+        }
+        Ok(())
+    }
+
+    /// The directional derivative in Initialization Mode, where the start state is computed
+    /// from the parameters by [`Model::initialize`] (not a function of dual numbers): a central
+    /// difference along the seed (FMI 2.0, 2.1.9: "may compute the directional derivatives by
+    /// numerical differentiation"). The step moves each known by about 6e-6 of its magnitude
+    /// (cube root of the unit round-off: truncation and round-off errors balance at ~1e-10
+    /// relative), where a known at or near 0 counts with a thousandth of its range; one-sided
+    /// (error ~6e-6 relative) where a known sits at a bound of its range.
+    fn initial_derivative(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seeds: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let values = &self.core.values;
+        let magnitude = |r: u32| -> Result<f64, String> {
+            let (_, v) = self.lookup(r, BaseType::Real)?;
+            let width = match v.kind {
+                Kind::Real { min, max, .. } if (max - min).is_finite() => 1e-3 * (max - min),
+                _ => 1.0,
+            };
+            Ok(values.real(r).abs().max(width))
+        };
+        let mut scale: f64 = 0.0;
+        for (&r, d) in knowns.iter().zip(seeds).filter(|(_, d)| **d != 0.0) {
+            scale = scale.max(d.abs() / magnitude(r)?);
+        }
+        if scale == 0.0 {
+            out.fill(0.0);
+            return Ok(());
+        }
+        let h = f64::EPSILON.cbrt() / scale;
+        let at = |step: f64| -> Result<Vec<f64>, String> {
+            let mut v = values.clone();
+            for (&r, d) in knowns.iter().zip(seeds) {
+                let (i, var) = self.lookup(r, BaseType::Real)?;
+                let x = Value::Real(v.real(r) + step * d);
+                in_range(var, &x)?;
+                v.put(i, x);
+            }
+            initial_values::<M>(&v, unknowns)
+        };
+        let (plus, minus) = (at(h), at(-h));
+        let (hi, lo, span) = match (plus, minus) {
+            (Ok(p), Ok(m)) => (p, m, 2.0 * h),
+            (Ok(p), Err(_)) => (p, initial_values::<M>(values, unknowns)?, h),
+            (Err(_), Ok(m)) => (initial_values::<M>(values, unknowns)?, m, h),
+            (Err(e), Err(_)) => return Err(format!("no start state near these values: {e}")),
+        };
+        for ((o, a), b) in out.iter_mut().zip(hi).zip(lo) {
+            *o = (a - b) / span;
         }
         Ok(())
     }
@@ -513,11 +615,22 @@ impl<M: Model> Instance<M> {
     /// any is stored.
     pub fn set(&mut self, vrs: &[u32], new: Vec<Value>) -> Result<(), String> {
         let mut checked = Vec::with_capacity(vrs.len());
+        let mut states: Option<Vec<f64>> = None;
         for (&vr, value) in vrs.iter().zip(new) {
             let (i, v) = self.lookup(vr, value.base_type())?;
-            settable(v, self.core.state)?;
+            let state = M::STATES.iter().position(|s| s.state == vr);
+            settable(v, state.is_some(), self.core.state)?;
             in_range(v, &value)?;
+            if let (State::ContinuousTimeMode, Some(k), Value::Real(x)) = (self.core.state, state, &value) {
+                let x0 = states.get_or_insert_with(|| self.exposed_states());
+                x0[k] = *x;
+            }
             checked.push((i, value));
+        }
+        if let Some(x) = states {
+            // FMI 2.0, 3.2.3 rule 5: a continuous-time state set by its value reference is a new
+            // state, as fmi2SetContinuousStates would set it (checked by the model the same way).
+            self.set_continuous_states(&x)?;
         }
         let tunes = matches!(self.core.state, State::StepComplete | State::EventMode)
             && checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
@@ -618,43 +731,54 @@ impl<M: Model> Instance<M> {
         }
         let inputs = M::INFO.interpolated_inputs;
         let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
+        // FMI 3.0, 2.2.4: after fmi3Discard "the FMU is in the same state as before the call".
+        let before = (self.version == Version::Fmi3).then(|| model.clone());
         let result = model.do_step(&c.values, &slopes, start, end - start, tolerance, &mut ModelLog(&self.log));
         c.outputs_current = false;
         c.derivatives_current = false;
         if let Err(e) = result {
+            let why =
+                format!("step from t = {} with h = {} stopped at t = {}: {}", num(t), num(h), num(e.time), e.message);
+            if let Some(before) = before {
+                *model = before;
+                return Ok(Step::Discarded(format!(
+                    "{why}; the instance is back at t = {} (retry with a smaller step)",
+                    num(start)
+                )));
+            }
+            // FMI 2.0, 4.2.3: Discard leaves the slave at the last good time (fmi2LastSuccessfulTime),
+            // in state StepFailed.
             c.time = e.time;
             c.last_successful_time = e.time;
             c.state = State::StepFailed;
-            let why =
-                format!("step from t = {} with h = {} stopped at t = {}: {}", num(t), num(h), num(e.time), e.message);
             return Ok(Step::Discarded(why));
         }
         // Inputs with a derivative follow their ramp to the new communication point (only
         // interpolated inputs accept derivatives).
         for &r in inputs {
             let Some(i) = c.values.position(r) else { continue };
-            if let (Value::Real(x), true) = (c.values.at(i), slopes[i] != 0.0) {
-                c.values.put(i, Value::Real(x + slopes[i] * (end - start)));
+            if let (Value::Real(x), Kind::Real { min, max, .. }, true) =
+                (c.values.at(i), M::VARIABLES[i].kind, slopes[i] != 0.0)
+            {
+                // A slope bounded to reach a bound ends there, not a rounding error outside.
+                c.values.put(i, Value::Real((x + slopes[i] * (end - start)).clamp(min, max)));
             }
         }
         c.time = end;
         c.last_successful_time = end;
         // Every Real the importer can read is finite after a good step, or the step is an error.
         c.values.take_non_finite();
-        model.outputs(&mut c.values);
+        write_outputs(model, &mut c.values);
         c.outputs_current = true;
         c.derivatives_current = false;
         if let Some(i) = c.values.take_non_finite() {
             c.state = State::Error;
             let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
             return Err(format!(
-                "{} = {} at t = {}: the model left its valid range; the instance is now in the Error state ({}, {} or {})",
+                "{} = {} at t = {}: the model left its valid range",
                 M::VARIABLES[i].name,
                 num(x),
-                num(end),
-                self.version.function("fmi2Reset"),
-                self.version.function("fmi2SetFMUstate"),
-                self.version.function("fmi2FreeInstance")
+                num(end)
             ));
         }
         Ok(Step::Done(warning))
@@ -703,19 +827,26 @@ pub fn bounded_slopes<'a>(values: &Values, slopes: &'a [f64], inputs: &[u32], h:
 
 /// The slope of a ramp from `x` over `h` that stays in `[min, max]`: `d` if `x + d h` is inside,
 /// else the slope reaching the nearer bound at the end of the step.
+/// A step too short to divide by (a denormal `h`) leaves the input where it is.
 pub fn bounded_slope(x: f64, d: f64, h: f64, (min, max): (f64, f64)) -> f64 {
     let end = x + d * h;
-    if end > max {
+    let slope = if end > max {
         (max - x) / h
     } else if end < min {
         (min - x) / h
     } else {
         d
+    };
+    if slope.is_finite() {
+        slope
+    } else {
+        0.0
     }
 }
 
-/// FMI 2.0 section 2.2.7: which variables may be set in which state.
-fn settable(v: &Variable, state: State) -> Result<(), String> {
+/// FMI 2.0 section 2.2.7 and the state tables (3.2.3, 4.2.4): which variables may be set in
+/// which state; `continuous_state`: `v` is a continuous-time state.
+fn settable(v: &Variable, continuous_state: bool, state: State) -> Result<(), String> {
     let input = v.causality == Causality::Input;
     let ok = v.variability != Variability::Constant
         && match state {
@@ -724,7 +855,9 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
             State::StepComplete | State::EventMode => {
                 input || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
             }
-            State::ContinuousTimeMode => input && v.variability == Variability::Continuous,
+            // FMI 2.0 rule 5 (clarified in 2.0.1), FMI 3.0.2 3.2.1: continuous inputs and
+            // continuous-time states.
+            State::ContinuousTimeMode => (input && v.variability == Variability::Continuous) || continuous_state,
             _ => false,
         };
     if ok {
@@ -732,7 +865,7 @@ fn settable(v: &Variable, state: State) -> Result<(), String> {
     }
     let rule = match state {
         State::StepComplete | State::EventMode => "after initialisation only inputs and tunable parameters may be set",
-        State::ContinuousTimeMode => "in Continuous-Time Mode only continuous inputs may be set",
+        State::ContinuousTimeMode => "in Continuous-Time Mode only continuous inputs and continuous states may be set",
         State::Instantiated | State::InitializationMode => "only parameters and inputs may be set",
         _ => "no variable may be set in this state",
     };

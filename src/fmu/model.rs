@@ -2,7 +2,7 @@
 //! Model Exchange (its continuous states, their derivatives, its outputs) and as Co-Simulation
 //! (a step of its own, with the internal solver).
 
-use super::variables::{Value, Values, Variable};
+use super::variables::{Causality, Initial, Value, Values, Variable};
 
 /// Static facts about a model, written to modelDescription.xml.
 #[derive(Debug, Clone, Copy)]
@@ -164,4 +164,16 @@ pub trait Model: Clone + Send + Sized + 'static {
 
     /// Restores a model saved by [`Model::save`] under the given variable values.
     fn load(values: &Values, state: &[f64]) -> Result<Self, String>;
+}
+
+/// FMI 2.0, 2.2.8 (FMI 3.0, 2.4.8 alike): whether `v` is an InitialUnknown of model `M`: an
+/// output with initial approx or calculated, a calculated parameter, a continuous state with
+/// initial approx or calculated, or a `der()` variable.
+pub fn initial_unknown<M: Model>(v: &Variable) -> bool {
+    let state = M::STATES.iter().any(|s| s.state == v.vr && v.initial != Initial::Exact);
+    let derivative = M::STATES.iter().any(|s| s.derivative == v.vr);
+    derivative
+        || state
+        || (v.causality == Causality::Output && v.initial != Initial::Exact)
+        || v.causality == Causality::CalculatedParameter
 }

@@ -109,12 +109,22 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
     let categories: Vec<&str> = GENERIC_CATEGORIES.iter().chain(i.log_categories).map(|c| c.0).collect();
     let platforms: Vec<&str> = platforms.iter().map(|p| p.folder(version)).collect();
     let states: Vec<&str> = M::STATES.iter().map(|s| name(&s.state)).collect();
-    let (fmi, identity, interpolation) = match version {
-        Version::Fmi2 => ("FMI 2.0", ("GUID", guid::<M>()), "Inputs linear over a step (fmi2SetRealInputDerivatives)"),
+    let (fmi, identity, interpolation, after_error) = match version {
+        Version::Fmi2 => (
+            "FMI 2.0",
+            ("GUID", guid::<M>()),
+            "Inputs linear over a step (fmi2SetRealInputDerivatives)",
+            "A refused call changes nothing and the instance goes on (FMI 2.0 leaves the state after fmi2Error open); \
+             a model that leaves its valid range puts it in the Error state (fmi2Reset, fmi2SetFMUstate). \
+             fmi2Discard of fmi2DoStep stops at the last good time (fmi2LastSuccessfulTime).",
+        ),
         Version::Fmi3 => (
             "FMI 3.0",
             ("Instantiation token", token::<M>()),
             "Inputs linear over a step (FMI 2.0's fmi2SetRealInputDerivatives; FMI 3.0 holds inputs over a step)",
+            "Terminated after any fmi3Error (FMI 3.0, 2.3.1): getters, FMU states, fmi3Reset; fmi3SetFMUState of a \
+             state saved before resumes. fmi3Discard of fmi3DoStep leaves the instance as before the step (2.2.4): \
+             retry with a smaller step.",
         ),
     };
     let states_label =
@@ -138,6 +148,7 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
         ),
         (interpolation, if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") }),
         ("Log categories", categories.join(", ")),
+        ("After an error", after_error.to_owned()),
         ("Variables", M::VARIABLES.len().to_string()),
     ];
     let rows: String =

@@ -4,7 +4,7 @@
 //! indices, FMI 3.0 as value references).
 
 use super::log::{num, GENERIC_CATEGORIES};
-use super::model::Model;
+use super::model::{initial_unknown, Model};
 use super::structure::Structure;
 use super::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
 use crate::units::{self, BASE_NAMES};
@@ -202,16 +202,15 @@ pub fn initial_unknowns<M: Model>(structure: &Structure) -> Vec<(u32, Vec<u32>)>
     M::VARIABLES
         .iter()
         .filter_map(|v| {
+            if !initial_unknown::<M>(v) {
+                return None;
+            }
             let state = M::STATES.iter().any(|s| s.state == v.vr && v.initial != Initial::Exact);
             let derivative = M::STATES.iter().any(|s| s.derivative == v.vr);
             let deps = if derivative || (state && v.causality != Causality::Output) {
                 structure.initial.get(&v.vr).into_iter().flatten().copied().chain(parameters()).collect()
-            } else if (v.causality == Causality::Output && v.initial != Initial::Exact)
-                || v.causality == Causality::CalculatedParameter
-            {
-                initial_dependencies::<M>(v)
             } else {
-                return None;
+                initial_dependencies::<M>(v)
             };
             Some((v.vr, deps))
         })

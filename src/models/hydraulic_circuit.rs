@@ -5,7 +5,11 @@
 //! States: the circuit's six (p1..p4, spool position, load-holding opening); with the TLM port
 //! also the rod's stroke and velocity. Plain port: the stroke follows the velocity input within a
 //! step, x(t) = x_k + integral of v, v(t) = v_k + v' (t - t_k) (v' from
-//! fmi2SetRealInputDerivatives, 0 holds v), so chamber volumes and piston flows agree.
+//! fmi2SetRealInputDerivatives, 0 holds v), so chamber volumes and piston flows agree. The
+//! stroke input takes a derivative too (FMI 2.0 `canInterpolateInputs` is for every continuous
+//! input): like every interpolated input, x then continues along it to the next communication
+//! point, but within a step the circuit uses the integral of v, whose slope is the velocity the
+//! master sends with x.
 
 use super::circuit::CIRCUIT_SCALE;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
@@ -239,7 +243,7 @@ impl Model for HydraulicCircuit {
         identifier: "HydraulicCircuit",
         description: "Pressure-compensated valve, counterbalance valve and cylinder with a mechanical port (plain or TLM) for external mechanics (thesis Fig. 2.8)",
         // cylinder.x follows the integral of cylinder.v within a step: it has no slope of its own.
-        interpolated_inputs: &[vr::U_REF, vr::V, vr::C_M],
+        interpolated_inputs: &[vr::U_REF, vr::X, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
         ..super::stepping::PLANT_INFO
     };

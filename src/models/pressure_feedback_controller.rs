@@ -194,7 +194,9 @@ impl PressureFeedbackController {
         } else if !self.fresh {
             self.p
         } else if self.sampled && t > self.p.t0 {
-            Ramp { slope: (given.y0 - self.p.y0) / (t - self.p.t0), ..given }
+            // Two samples closer than a division resolves (a denormal step) give no slope: held.
+            let slope = (given.y0 - self.p.y0) / (t - self.p.t0);
+            Ramp { slope: if slope.is_finite() { slope } else { 0.0 }, ..given }
         } else {
             given
         };

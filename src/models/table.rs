@@ -284,7 +284,7 @@ impl<const N: usize> TableBuilder<N> {
             );
             (self.len, k) = (self.len + 1, k + 1);
         }
-        self.vars(&super::states::SECTION_RATES)
+        self.vars(&SECTION_RATES)
     }
 
     /// The finished table; fails to compile unless every row is filled.
@@ -296,3 +296,41 @@ impl<const N: usize> TableBuilder<N> {
 
 /// Number of boom parameters, flexible-beam parameters and section angles and rates (table rows).
 pub(crate) const N_BOOM_ROWS: usize = BOOM_SPECS.len() + BEAM_SPECS.len() + 2 * MAX_SECTIONS;
+
+/// The section rates, outputs and Model Exchange states (structured names, 1-based).
+pub(crate) const SECTION_RATES: [Variable; MAX_SECTIONS] = [
+    out("boom.section[1].omega", vr::SECTION_RATES, "rad/s", "deg/s", RATE),
+    out("boom.section[2].omega", vr::SECTION_RATES + 1, "rad/s", "deg/s", RATE),
+    out("boom.section[3].omega", vr::SECTION_RATES + 2, "rad/s", "deg/s", RATE),
+    out("boom.section[4].omega", vr::SECTION_RATES + 3, "rad/s", "deg/s", RATE),
+    out("boom.section[5].omega", vr::SECTION_RATES + 4, "rad/s", "deg/s", RATE),
+    out("boom.section[6].omega", vr::SECTION_RATES + 5, "rad/s", "deg/s", RATE),
+    out("boom.section[7].omega", vr::SECTION_RATES + 6, "rad/s", "deg/s", RATE),
+    out("boom.section[8].omega", vr::SECTION_RATES + 7, "rad/s", "deg/s", RATE),
+    out("boom.section[9].omega", vr::SECTION_RATES + 8, "rad/s", "deg/s", RATE),
+    out("boom.section[10].omega", vr::SECTION_RATES + 9, "rad/s", "deg/s", RATE),
+    out("boom.section[11].omega", vr::SECTION_RATES + 10, "rad/s", "deg/s", RATE),
+    out("boom.section[12].omega", vr::SECTION_RATES + 11, "rad/s", "deg/s", RATE),
+    out("boom.section[13].omega", vr::SECTION_RATES + 12, "rad/s", "deg/s", RATE),
+    out("boom.section[14].omega", vr::SECTION_RATES + 13, "rad/s", "deg/s", RATE),
+    out("boom.section[15].omega", vr::SECTION_RATES + 14, "rad/s", "deg/s", RATE),
+    out("boom.section[16].omega", vr::SECTION_RATES + 15, "rad/s", "deg/s", RATE),
+    out("boom.section[17].omega", vr::SECTION_RATES + 16, "rad/s", "deg/s", RATE),
+    out("boom.section[18].omega", vr::SECTION_RATES + 17, "rad/s", "deg/s", RATE),
+    out("boom.section[19].omega", vr::SECTION_RATES + 18, "rad/s", "deg/s", RATE),
+    out("boom.section[20].omega", vr::SECTION_RATES + 19, "rad/s", "deg/s", RATE),
+    out("boom.section[21].omega", vr::SECTION_RATES + 20, "rad/s", "deg/s", RATE),
+    out("boom.section[22].omega", vr::SECTION_RATES + 21, "rad/s", "deg/s", RATE),
+    out("boom.section[23].omega", vr::SECTION_RATES + 22, "rad/s", "deg/s", RATE),
+    out("boom.section[24].omega", vr::SECTION_RATES + 23, "rad/s", "deg/s", RATE),
+    out("boom.section[25].omega", vr::SECTION_RATES + 24, "rad/s", "deg/s", RATE),
+    out("boom.section[26].omega", vr::SECTION_RATES + 25, "rad/s", "deg/s", RATE),
+    out("boom.section[27].omega", vr::SECTION_RATES + 26, "rad/s", "deg/s", RATE),
+    out("boom.section[28].omega", vr::SECTION_RATES + 27, "rad/s", "deg/s", RATE),
+    out("boom.section[29].omega", vr::SECTION_RATES + 28, "rad/s", "deg/s", RATE),
+    out("boom.section[30].omega", vr::SECTION_RATES + 29, "rad/s", "deg/s", RATE),
+    out("boom.section[31].omega", vr::SECTION_RATES + 30, "rad/s", "deg/s", RATE),
+    out("boom.section[32].omega", vr::SECTION_RATES + 31, "rad/s", "deg/s", RATE),
+];
+
+const RATE: &str = "Absolute angular velocity of the arm section; beyond the last section, the last one's";
