@@ -140,6 +140,9 @@ pub struct Description {
     pub fmi3: bool,
     /// `providesAdjointDerivatives` of the CoSimulation element (FMI 3.0).
     pub adjoint: bool,
+    /// `providesDirectionalDerivative` (FMI 3.0: `providesDirectionalDerivatives`) of the
+    /// CoSimulation element.
+    pub directional: bool,
     pub categories: Vec<String>,
     pub variables: Vec<Variable>,
     /// Value references per type, in the order of `TYPES`.
@@ -188,7 +191,7 @@ impl Description {
     fn parse(xml: &str) -> Result<Self, String> {
         let mut reader = quick_xml::Reader::from_str(xml);
         let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
-        let (mut states, mut event_indicators, mut fmi3, mut adjoint) = (0, 0, false, false);
+        let (mut states, mut event_indicators, mut fmi3, mut adjoint, mut directional) = (0, 0, false, false, false);
         let mut scalar: Option<Attributes> = None;
         // ModelStructure: (the section, the index or value reference) of every Unknown element.
         let (mut section, mut structure) = (String::new(), Vec::<(String, u32)>::new());
@@ -209,6 +212,8 @@ impl Description {
                         "CoSimulation" => {
                             identifier = a.get("modelIdentifier").cloned();
                             adjoint = a.get("providesAdjointDerivatives").is_some_and(|v| v == "true");
+                            let key = if fmi3 { "providesDirectionalDerivatives" } else { "providesDirectionalDerivative" };
+                            directional = a.get(key).is_some_and(|v| v == "true");
                         }
                         "Category" => categories.extend(a.get("name").cloned()),
                         "ScalarVariable" => scalar = Some(a),
@@ -297,6 +302,7 @@ impl Description {
             guid: guid.ok_or("no guid or instantiationToken")?,
             fmi3,
             adjoint,
+            directional,
             flexible,
             states,
             event_indicators,

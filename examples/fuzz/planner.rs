@@ -26,11 +26,13 @@ pub struct Planner {
     /// Set once initialisation failed or the instance broke: plans keep the parameters' start values.
     tame: bool,
     round_trip: RoundTrip,
+    /// A state-by-reference probe waits for the states just read.
+    by_reference: bool,
 }
 
 impl Planner {
     pub fn new(rng: &mut Rng) -> Self {
-        Planner { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false, round_trip: RoundTrip::default() }
+        Planner { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false, round_trip: RoundTrip::default(), by_reference: false }
     }
 
     pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
@@ -200,9 +202,16 @@ impl Planner {
             return if rng.chance(0.7) { Op::Terminate } else { Op::Reset };
         }
         let phase = Phase::ContinuousTime;
+        let pending = std::mem::take(&mut self.by_reference) && s.x_fresh;
         let probe = match rng.below(100) {
+            _ if pending => probes::state_by_reference(rng, m, &s.x),
             0..=2 => probes::event_locals(m),
-            3..=5 => probes::state_by_reference(rng, m, &s.x),
+            3..=5 if s.x_fresh => probes::state_by_reference(rng, m, &s.x),
+            3..=5 => {
+                // The states first: the probe starts from them.
+                self.by_reference = true;
+                vec![Probe::GetContinuousStates]
+            }
             6..=7 => {
                 self.round_trip.start();
                 probes::time_back(rng, &s.view, self.h)
@@ -266,6 +275,7 @@ fn probe_op(p: Probe, m: &Description) -> Op {
         Probe::GetContinuousStates => Op::GetContinuousStates { n: m.states, null: false },
         Probe::GetEventIndicators => Op::GetEventIndicators { n: m.event_indicators, null: false },
         Probe::SetTime(t) => Op::SetTime { t },
+        Probe::SetContinuousStates(x) => Op::SetContinuousStates { x: Arr::Items(x) },
     }
 }
 

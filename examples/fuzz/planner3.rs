@@ -24,11 +24,13 @@ pub struct Planner3 {
     /// Set once initialisation failed or the instance broke: plans keep the start values.
     tame: bool,
     round_trip: RoundTrip,
+    /// A state-by-reference probe waits for the states just read.
+    by_reference: bool,
 }
 
 impl Planner3 {
     pub fn new(rng: &mut Rng) -> Self {
-        Planner3 { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false, round_trip: RoundTrip::default() }
+        Planner3 { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false, round_trip: RoundTrip::default(), by_reference: false }
     }
 
     pub fn next(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
@@ -162,9 +164,16 @@ impl Planner3 {
         if !(s.view.time < 1.0) {
             return if rng.chance(0.7) { Op3::Terminate } else { Op3::Reset };
         }
+        let pending = std::mem::take(&mut self.by_reference) && s.x_fresh;
         let probe = match rng.below(100) {
+            _ if pending => probes::state_by_reference(rng, m, &s.x),
             0..=2 => probes::event_locals(m),
-            3..=5 => probes::state_by_reference(rng, m, &s.x),
+            3..=5 if s.x_fresh => probes::state_by_reference(rng, m, &s.x),
+            3..=5 => {
+                // The states first: the probe starts from them.
+                self.by_reference = true;
+                vec![Probe::GetContinuousStates]
+            }
             6..=7 => {
                 self.round_trip.start();
                 probes::time_back(rng, &s.view, self.h)
@@ -237,6 +246,7 @@ fn probe_op(p: Probe, m: &Description) -> Op3 {
         Probe::GetContinuousStates => Op3::GetContinuousStates { n: m.states, null: false },
         Probe::GetEventIndicators => Op3::GetEventIndicators { n: m.event_indicators, null: false },
         Probe::SetTime(t) => Op3::SetTime { t },
+        Probe::SetContinuousStates(x) => Op3::SetContinuousStates { x: Arr::Items(x) },
     }
 }
 

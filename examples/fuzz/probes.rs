@@ -23,6 +23,7 @@ pub enum Probe {
     Set(Vec<u32>, Vec<f64>),
     DoStep { t: f64, h: f64 },
     GetContinuousStates,
+    SetContinuousStates(Vec<f64>),
     GetEventIndicators,
     SetTime(f64),
 }
@@ -50,15 +51,21 @@ pub fn event_locals(m: &Description) -> Vec<Probe> {
     vec![Probe::Read(m.event_locals.clone()), Probe::GetEventIndicators]
 }
 
-/// Model Exchange, Continuous-Time Mode: a state near `x` (the last states read) set by its
-/// value reference, then the states read.
+/// Model Exchange, Continuous-Time Mode: a state near `x` (the states, just read) set by its
+/// value reference, the states read, the same states set with SetContinuousStates, read again.
 pub fn state_by_reference(rng: &mut Rng, m: &Description, x: &[f64]) -> Vec<Probe> {
     if x.len() != m.state_vrs.len() || x.is_empty() {
         return Vec::new();
     }
     let i = rng.below(x.len());
-    let value = x[i] + (1e-6 + 1e-4 * x[i].abs()) * rng.uniform(-1.0, 1.0);
-    vec![Probe::Set(vec![m.state_vrs[i]], vec![value]), Probe::GetContinuousStates]
+    let mut whole = x.to_vec();
+    whole[i] = x[i] + (1e-6 + 1e-4 * x[i].abs()) * rng.uniform(-1.0, 1.0);
+    vec![
+        Probe::Set(vec![m.state_vrs[i]], vec![whole[i]]),
+        Probe::GetContinuousStates,
+        Probe::SetContinuousStates(whole),
+        Probe::GetContinuousStates,
+    ]
 }
 
 /// Model Exchange: the time set back by up to `h`, not before the startTime (the round trip

@@ -74,6 +74,8 @@ pub struct Session<'a> {
     logger: bool,
     /// The continuous states fmi2GetContinuousStates last returned (Model Exchange).
     pub x: Vec<f64>,
+    /// `x` was read by the last call to the main instance.
+    pub x_fresh: bool,
     /// Callback structures of the instances, alive until the end of the sequence; boxed, since
     /// an FMU may keep the pointer and a Vec moves its elements.
     #[allow(clippy::vec_box)]
@@ -97,6 +99,7 @@ impl<'a> Session<'a> {
             me: false,
             logger: false,
             x: Vec::new(),
+            x_fresh: false,
             callbacks: Vec::new(),
             view: View::fresh(),
             states: FmuStates::default(),
@@ -136,6 +139,7 @@ impl<'a> Session<'a> {
         if target == Target::Main && !c.is_null() {
             self.check_required(&op, status, ok)?;
             self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
+            self.x_fresh = false;
         }
         match (target, output) {
             (Target::Main, output) => self.observe(op, status, ok, output),
@@ -336,6 +340,11 @@ impl<'a> Session<'a> {
                 self.second = null_mut();
                 self.states.foreign.clear();
             }
+            (Op::SetReal { vr, .. } | Op::SetInteger { vr, .. } | Op::SetBoolean { vr, .. } | Op::SetString { vr, .. }, _)
+                if ok && required::tunes(&vr, self.model) =>
+            {
+                self.view.tuned = true
+            }
             (Op::SetupExperiment { start, stop_defined, stop, .. }, _) if ok => {
                 let v = &mut self.view;
                 (v.time, v.start, v.stop, v.set_up) = (start, start, (stop_defined != 0).then_some(stop), true);
@@ -354,7 +363,7 @@ impl<'a> Session<'a> {
             (Op::GetEventIndicators { .. }, Output::Reals(v)) if ok => finite(&v, "fmi2GetEventIndicators")?,
             (Op::GetContinuousStates { .. }, Output::Reals(v)) if ok => {
                 finite(&v, "fmi2GetContinuousStates")?;
-                self.x = v;
+                (self.x, self.x_fresh) = (v, true);
             }
             (Op::GetNominalsOfContinuousStates { .. }, Output::Reals(v)) if ok => {
                 if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
@@ -432,6 +441,7 @@ fn seen<'a>(op: &'a Op, output: &'a Output) -> Seen<'a> {
         (Op::DoStep { .. }, _) => Seen::Stepped,
         (Op::GetEventIndicators { null: false, .. }, Output::Reals(v)) => Seen::EventIndicators(v),
         (Op::GetContinuousStates { null: false, .. }, Output::Reals(v)) => Seen::ContinuousStates(v),
+        (Op::SetContinuousStates { x: Arr::Items(x) }, _) => Seen::SetStates(x),
         _ => Seen::Other,
     }
 }

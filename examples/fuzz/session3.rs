@@ -78,6 +78,8 @@ pub struct Session3<'a> {
     pub me: bool,
     /// The continuous states fmi3GetContinuousStates last returned.
     pub x: Vec<f64>,
+    /// `x` was read by the last call to the main instance.
+    pub x_fresh: bool,
     pub view: View,
     pub states: FmuStates,
     watch: Watch,
@@ -101,6 +103,7 @@ impl<'a> Session3<'a> {
             opened: false,
             me: false,
             x: Vec::new(),
+            x_fresh: false,
             view: View::fresh(),
             states: FmuStates { fmi3: true, ..FmuStates::default() },
             watch: Watch::default(),
@@ -149,6 +152,7 @@ impl<'a> Session3<'a> {
             self.check_status(&op, status, (errors, discards))?;
             self.check_required(&op, status, ok)?;
             self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
+            self.x_fresh = false;
         }
         if !matches!(op, Op3::DoStep { .. }) {
             self.discarded = None;
@@ -212,7 +216,9 @@ impl<'a> Session3<'a> {
     /// that is certain.
     fn is_retry(&self, op: &Op3) -> bool {
         let Op3::DoStep { t, h, .. } = *op else { return false };
-        self.discarded.is_some_and(|h0| self.view.phase == Phase::StepComplete && t == self.view.time && h > 0.0 && h < h0)
+        // A step below the time's resolution there cannot advance it (the FMU refuses it).
+        let advances = h > 16.0 * f64::EPSILON * t.abs();
+        self.discarded.is_some_and(|h0| self.view.phase == Phase::StepComplete && t == self.view.time && advances && h < h0)
     }
 
     /// Passes the arguments of `op` through the C ABI; output buffers are temporaries of the call.
@@ -358,6 +364,11 @@ impl<'a> Session3<'a> {
                 self.view.phase = Phase::Broken
             }
             (_, _) if !ok => {}
+            (Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. }, _)
+                if required::tunes(&vr, self.model) =>
+            {
+                self.view.tuned = true
+            }
             (Op3::SetDebugLogging { logging_on, categories }, _) => self.debug_logging(logging_on, &categories),
             (Op3::EnterInitializationMode(e), _) => {
                 let v = &mut self.view;
@@ -376,7 +387,7 @@ impl<'a> Session3<'a> {
             (Op3::GetFloat64 { vr, .. }, Output::Reals(v)) => finite_values(self.model, &vr, &v)?,
             (Op3::GetContinuousStates { .. }, Output::Reals(v)) => {
                 finite(&v, "fmi3GetContinuousStates")?;
-                self.x = v;
+                (self.x, self.x_fresh) = (v, true);
             }
             (Op3::GetNominalsOfContinuousStates { .. }, Output::Reals(v)) => {
                 if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
@@ -490,6 +501,7 @@ fn seen<'a>(op: &'a Op3, output: &'a Output) -> Seen<'a> {
         (Op3::DoStep { .. }, _) => Seen::Stepped,
         (Op3::GetEventIndicators { null: false, .. }, Output::Reals(v)) => Seen::EventIndicators(v),
         (Op3::GetContinuousStates { null: false, .. }, Output::Reals(v)) => Seen::ContinuousStates(v),
+        (Op3::SetContinuousStates { x: Arr::Items(x) }, _) => Seen::SetStates(x),
         _ => Seen::Other,
     }
 }

@@ -28,6 +28,9 @@ pub struct View {
     pub stop: Option<f64>,
     /// The startTime of the experiment (NaN before it is set up).
     pub start: f64,
+    /// A parameter was set since the instantiation or reset: its values may not fit together,
+    /// and what needs them (Initialization Mode's derivatives) may fail.
+    pub tuned: bool,
     pub set_up: bool,
     /// False for a state restored from bytes edited with the CRC recomputed.
     certain: bool,
@@ -36,12 +39,12 @@ pub struct View {
 impl View {
     /// Right after fmi2Instantiate or fmi2Reset.
     pub fn fresh() -> Self {
-        View { phase: Phase::Instantiated, time: 0.0, stop: None, start: f64::NAN, set_up: false, certain: true }
+        View { phase: Phase::Instantiated, time: 0.0, stop: None, start: f64::NAN, tuned: false, set_up: false, certain: true }
     }
 
     /// A state restored from bytes edited with the CRC recomputed: nothing is known about it.
     pub fn unknown() -> Self {
-        View { phase: Phase::Unknown, time: f64::NAN, stop: None, start: f64::NAN, set_up: true, certain: false }
+        View { phase: Phase::Unknown, time: f64::NAN, stop: None, start: f64::NAN, tuned: true, set_up: true, certain: false }
     }
 
     /// Whether the phase and time are known for certain (not from edited bytes).
