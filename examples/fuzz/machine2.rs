@@ -28,9 +28,9 @@ pub fn forbidden(op: &Op, view: &View, me: bool, m: &Description) -> Option<Stri
         }
         Op::SetDebugLogging { categories, .. } => too_many_categories(categories.len(), m),
         Op::SetContinuousStates { x } => wrong_size(x.len(), m.states, "continuous states"),
-        Op::GetDerivatives { n, .. } | Op::GetContinuousStates { n, .. } | Op::GetNominalsOfContinuousStates { n, .. } => {
-            wrong_size(*n, m.states, "continuous states")
-        }
+        Op::GetDerivatives { n, .. }
+        | Op::GetContinuousStates { n, .. }
+        | Op::GetNominalsOfContinuousStates { n, .. } => wrong_size(*n, m.states, "continuous states"),
         Op::GetEventIndicators { n, .. } => wrong_size(*n, m.event_indicators, "event indicators"),
         Op::SetTime { t } if me => view.set_time_refusal(*t),
         _ => None,

@@ -22,7 +22,10 @@ pub enum Counted {
     Set(Type),
     /// fmi2/fmi3GetDirectionalDerivative and (`adjoint`) fmi3GetAdjointDerivative: nUnknowns
     /// or (`known`) nKnowns; FMI 3.0's nSeed and nSensitivity follow.
-    Derivative { adjoint: bool, known: bool },
+    Derivative {
+        adjoint: bool,
+        known: bool,
+    },
     /// fmi2SetRealInputDerivatives, fmi2GetRealOutputDerivatives: nvr.
     InputDerivatives,
     OutputDerivatives,
@@ -103,7 +106,10 @@ impl Oversized {
             Counted::Derivative { known: false, .. } => "nUnknowns",
             Counted::Categories => "nCategories",
             Counted::GetEventIndicators => "ni",
-            Counted::SetContinuousStates | Counted::GetContinuousStates | Counted::GetDerivatives | Counted::GetNominals => "nx",
+            Counted::SetContinuousStates
+            | Counted::GetContinuousStates
+            | Counted::GetDerivatives
+            | Counted::GetNominals => "nx",
             _ => "nValueReferences",
         };
         format!("{} with {count} = {} (arrays of {})", self.function(fmi3), self.n, self.len())
@@ -113,9 +119,10 @@ impl Oversized {
     pub fn why(&self, m: &Description) -> String {
         let what = match self.counted {
             Counted::Categories => "log categories",
-            Counted::SetContinuousStates | Counted::GetContinuousStates | Counted::GetDerivatives | Counted::GetNominals => {
-                "continuous states"
-            }
+            Counted::SetContinuousStates
+            | Counted::GetContinuousStates
+            | Counted::GetDerivatives
+            | Counted::GetNominals => "continuous states",
             Counted::GetEventIndicators => "event indicators",
             _ => "value references (variables)",
         };
@@ -192,7 +199,8 @@ impl Oversized {
         let vr = self.refs(m, ty);
         let text = std::ffi::CString::new("fuzz").expect("no NUL");
         let mut strings: Vec<*const c_char> = vec![text.as_ptr(); len];
-        let (v, xp, ip, bp, sp) = (vr.as_ptr(), x.as_mut_ptr(), ints.as_mut_ptr(), flags.as_mut_ptr(), strings.as_mut_ptr());
+        let (v, xp, ip, bp, sp) =
+            (vr.as_ptr(), x.as_mut_ptr(), ints.as_mut_ptr(), flags.as_mut_ptr(), strings.as_mut_ptr());
         match self.counted {
             Get(Type::Real) => f.fmi3GetFloat64(c, v, n, xp, n),
             Get(Type::Integer) => f.fmi3GetInt32(c, v, n, ip, n),
@@ -237,9 +245,10 @@ impl Oversized {
 fn limit(counted: Counted, m: &Description) -> usize {
     match counted {
         Counted::Categories => m.categories.len(),
-        Counted::SetContinuousStates | Counted::GetContinuousStates | Counted::GetDerivatives | Counted::GetNominals => {
-            m.states
-        }
+        Counted::SetContinuousStates
+        | Counted::GetContinuousStates
+        | Counted::GetDerivatives
+        | Counted::GetNominals => m.states,
         Counted::GetEventIndicators => m.event_indicators,
         _ => max_refs(m),
     }

@@ -32,7 +32,13 @@ pub struct Planner {
 
 impl Planner {
     pub fn new(rng: &mut Rng) -> Self {
-        Planner { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false, round_trip: RoundTrip::default(), by_reference: false }
+        Planner {
+            queue: VecDeque::new(),
+            h: rng.log_uniform(1e-4, 1e-2),
+            tame: false,
+            round_trip: RoundTrip::default(),
+            by_reference: false,
+        }
     }
 
     pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
@@ -294,7 +300,8 @@ fn directional_derivative((unknowns, knowns, dv_known): (Vec<u32>, Vec<u32>, Vec
 /// (`initialization`), InitialUnknowns on inputs and initial="exact" variables.
 pub fn plausible_derivative(rng: &mut Rng, m: &Description, initialization: bool) -> (Vec<u32>, Vec<u32>, Vec<f64>) {
     let inputs: Vec<u32> = m.real_inputs.iter().map(|&i| m.variables[i].vr).collect();
-    let unknown_pool = if initialization { m.initial_unknowns.clone() } else { [&m.outputs[..], &m.derivatives].concat() };
+    let unknown_pool =
+        if initialization { m.initial_unknowns.clone() } else { [&m.outputs[..], &m.derivatives].concat() };
     let known_pool = if initialization { &m.initial_knowns } else { &inputs };
     let unknowns: Vec<u32> = (0..rng.range(1, 3)).filter_map(|_| rng.choose(&unknown_pool).copied()).collect();
     let knowns: Vec<u32> = (0..rng.range(1, 2)).filter_map(|_| rng.choose(known_pool).copied()).collect();

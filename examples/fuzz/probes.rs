@@ -21,7 +21,10 @@ pub enum Probe {
     Read(Vec<u32>),
     /// fmi2SetReal/fmi3SetFloat64.
     Set(Vec<u32>, Vec<f64>),
-    DoStep { t: f64, h: f64 },
+    DoStep {
+        t: f64,
+        h: f64,
+    },
     GetContinuousStates,
     SetContinuousStates(Vec<f64>),
     GetEventIndicators,

@@ -32,7 +32,9 @@ pub struct Derivative<'a> {
 
 /// Why the derivative must succeed, if it must.
 pub fn derivative(d: &Derivative, view: &View, me: bool, m: &Description) -> Option<&'static str> {
-    let (Arr::Items(unknowns), Arr::Items(knowns), Arr::Items(seeds)) = (d.unknowns, d.knowns, d.seeds) else { return None };
+    let (Arr::Items(unknowns), Arr::Items(knowns), Arr::Items(seeds)) = (d.unknowns, d.knowns, d.seeds) else {
+        return None;
+    };
     let seeded = if d.adjoint { unknowns.len() } else { knowns.len() };
     let right = d.outputs_right && !unknowns.is_empty() && !knowns.is_empty() && seeds.len() == seeded;
     let provided = if d.adjoint { m.adjoint } else { m.directional };
@@ -58,7 +60,8 @@ pub fn state_set(vr: &Arr<u32>, values: &Arr<f64>, view: &View, me: bool, m: &De
     let (Arr::Items(vr), Arr::Items(values)) = (vr, values) else { return None };
     let states = !vr.is_empty() && vr.len() == values.len() && vr.iter().all(|r| m.state_vrs.contains(r));
     let now = me && view.phase == Phase::ContinuousTime && view.certain();
-    (states && now && values.iter().all(|x| x.is_finite())).then_some("continuous states set by value reference in Continuous-Time Mode")
+    (states && now && values.iter().all(|x| x.is_finite()))
+        .then_some("continuous states set by value reference in Continuous-Time Mode")
 }
 
 /// Why fmi2GetDerivatives or fmi2GetNominalsOfContinuousStates with `n` must succeed, if it
@@ -81,8 +84,12 @@ pub fn tunes(vr: &Arr<u32>, m: &Description) -> bool {
 pub fn state_call(call: &StateCall, states: &FmuStates) -> Option<&'static str> {
     let live = |p| states.live.iter().find(|l| l.ptr == p);
     match call {
-        StateCall::Size { state, null_size: false } if live(*state).is_some() => Some("the serialized size of a live FMU state"),
-        StateCall::Serialize { state, size, null_buffer: false } if live(*state).is_some_and(|l| l.size == Some(*size)) => {
+        StateCall::Size { state, null_size: false } if live(*state).is_some() => {
+            Some("the serialized size of a live FMU state")
+        }
+        StateCall::Serialize { state, size, null_buffer: false }
+            if live(*state).is_some_and(|l| l.size == Some(*size)) =>
+        {
             Some("serializing a live FMU state with its size")
         }
         StateCall::Deserialize { bytes, null_state: false } if !bytes.damaged && bytes.view.is_some() => {

@@ -158,9 +158,14 @@ impl<'a> Session<'a> {
         let Some(why) = crate::machine2::forbidden(op, &self.view, self.me, self.model) else { return Ok(()) };
         let function = function(op);
         match status {
-            Some(ERROR) if self.logger && !logged => Err(format!("{function} returned fmi2Error without a log message ({why})")),
+            Some(ERROR) if self.logger && !logged => {
+                Err(format!("{function} returned fmi2Error without a log message ({why})"))
+            }
             Some(ERROR) | None => Ok(()),
-            Some(s) => Err(format!("{function} returned {}, but the call must fail: {why}", crate::report::outcome(i64::from(s), false))),
+            Some(s) => Err(format!(
+                "{function} returned {}, but the call must fail: {why}",
+                crate::report::outcome(i64::from(s), false)
+            )),
         }
     }
 
@@ -169,7 +174,8 @@ impl<'a> Session<'a> {
         let (m, view, me) = (self.model, &self.view, self.me);
         let why = match op {
             Op::GetDirectionalDerivative { unknowns, knowns, dv_known, null_dv_unknown } => {
-                let call = Derivative { unknowns, knowns, seeds: dv_known, adjoint: false, outputs_right: !null_dv_unknown };
+                let call =
+                    Derivative { unknowns, knowns, seeds: dv_known, adjoint: false, outputs_right: !null_dv_unknown };
                 required::derivative(&call, view, me, m)
             }
             Op::SetReal { vr, values } => required::state_set(vr, values, view, me, m),
@@ -180,9 +186,11 @@ impl<'a> Session<'a> {
             _ => None,
         };
         match (why, status) {
-            (Some(why), Some(s)) if !ok => {
-                Err(format!("{} returned {}, but the call must succeed: {why}", function(op), crate::report::outcome(i64::from(s), false)))
-            }
+            (Some(why), Some(s)) if !ok => Err(format!(
+                "{} returned {}, but the call must succeed: {why}",
+                function(op),
+                crate::report::outcome(i64::from(s), false)
+            )),
             _ => Ok(()),
         }
     }
@@ -340,11 +348,13 @@ impl<'a> Session<'a> {
                 self.second = null_mut();
                 self.states.foreign.clear();
             }
-            (Op::SetReal { vr, .. } | Op::SetInteger { vr, .. } | Op::SetBoolean { vr, .. } | Op::SetString { vr, .. }, _)
-                if ok && required::tunes(&vr, self.model) =>
-            {
-                self.view.tuned = true
-            }
+            (
+                Op::SetReal { vr, .. }
+                | Op::SetInteger { vr, .. }
+                | Op::SetBoolean { vr, .. }
+                | Op::SetString { vr, .. },
+                _,
+            ) if ok && required::tunes(&vr, self.model) => self.view.tuned = true,
             (Op::SetupExperiment { start, stop_defined, stop, .. }, _) if ok => {
                 let v = &mut self.view;
                 (v.time, v.start, v.stop, v.set_up) = (start, start, (stop_defined != 0).then_some(stop), true);

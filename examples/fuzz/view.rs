@@ -39,12 +39,28 @@ pub struct View {
 impl View {
     /// Right after fmi2Instantiate or fmi2Reset.
     pub fn fresh() -> Self {
-        View { phase: Phase::Instantiated, time: 0.0, stop: None, start: f64::NAN, tuned: false, set_up: false, certain: true }
+        View {
+            phase: Phase::Instantiated,
+            time: 0.0,
+            stop: None,
+            start: f64::NAN,
+            tuned: false,
+            set_up: false,
+            certain: true,
+        }
     }
 
     /// A state restored from bytes edited with the CRC recomputed: nothing is known about it.
     pub fn unknown() -> Self {
-        View { phase: Phase::Unknown, time: f64::NAN, stop: None, start: f64::NAN, tuned: true, set_up: true, certain: false }
+        View {
+            phase: Phase::Unknown,
+            time: f64::NAN,
+            stop: None,
+            start: f64::NAN,
+            tuned: true,
+            set_up: true,
+            certain: false,
+        }
     }
 
     /// Whether the phase and time are known for certain (not from edited bytes).

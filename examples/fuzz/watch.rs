@@ -54,7 +54,9 @@ impl Watch {
     pub fn see(&mut self, seen: Seen, m: &Description) -> Result<(), String> {
         let locals = &m.event_locals;
         let next = match (std::mem::take(self), seen) {
-            (Watch::Spool { before, stepped: true }, Seen::Read(vr, now)) if vr == &locals[..] && !locals.is_empty() => {
+            (Watch::Spool { before, stepped: true }, Seen::Read(vr, now))
+                if vr == &locals[..] && !locals.is_empty() =>
+            {
                 if before == now {
                     return Err(format!(
                         "the event locals {} read {now:?} after the spool reference changed and a step, as before it: not current",
@@ -71,13 +73,18 @@ impl Watch {
                 };
                 Watch::Locals { values: values[..locals.len()].to_vec(), spool }
             }
-            (Watch::Locals { values, spool: Some(old) }, Seen::Set([r], [u])) if Some(*r) == m.spool_reference && *u != old => {
+            (Watch::Locals { values, spool: Some(old) }, Seen::Set([r], [u]))
+                if Some(*r) == m.spool_reference && *u != old =>
+            {
                 Watch::Spool { before: values, stepped: false }
             }
             (Watch::Spool { before, .. }, Seen::Stepped) => Watch::Spool { before, stepped: true },
             (Watch::Locals { values, .. }, Seen::EventIndicators(z)) => {
                 if values.len() == z.len() && values.iter().zip(z).any(|(a, b)| !near(*a, *b)) {
-                    return Err(format!("the event locals {} read {values:?}, but the event indicators are {z:?}", names(m)));
+                    return Err(format!(
+                        "the event locals {} read {values:?}, but the event indicators are {z:?}",
+                        names(m)
+                    ));
                 }
                 Watch::Nothing
             }

@@ -39,6 +39,8 @@ pub const SPECIAL_REALS: [f64; 14] = [
 pub const SPECIAL_INTEGERS: [c_int; 8] = [0, 1, -1, 2, c_int::MIN, c_int::MAX, 1000, -1000];
 const SPECIAL_BOOLEANS: [c_int; 6] = [0, 1, 2, -1, 255, c_int::MIN];
 const STATUS_KINDS: [c_int; 7] = [0, 1, 2, 3, 4, -1, 99];
+/// The share of sequences on a Model Exchange instance (both versions).
+pub const ME_SHARE: f64 = 1.0 / 3.0;
 /// Valid instance names, some unusual.
 pub const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m", "%s%n%s", "a.b[1]"];
 
@@ -132,7 +134,7 @@ pub fn wild_count(rng: &mut Rng, n: usize) -> usize {
 pub fn instantiation(rng: &mut Rng, m: &Description) -> Instantiation {
     let mut spec = Instantiation {
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
-        fmu_type: if rng.chance(0.3) { MODEL_EXCHANGE } else { CO_SIMULATION },
+        fmu_type: if rng.chance(ME_SHARE) { MODEL_EXCHANGE } else { CO_SIMULATION },
         guid: Text::new(&m.guid),
         resources: rng.pick(&[Text::Null, Text::new("file:///tmp/"), Text::new("")]).clone(),
         callbacks: Some(Callbacks { logger: !rng.chance(0.1), memory: !rng.chance(0.2) }),

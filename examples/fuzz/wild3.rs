@@ -14,7 +14,7 @@ use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::wild::{
     any_vr, array, bad_guid, categories, maybe_null, variables_of, vrs, wild_count, wild_experiment, wild_integer,
-    wild_real, wild_state_call, wild_step, wild_text, INSTANCE_NAMES,
+    wild_real, wild_state_call, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
 };
 
 /// Any of the functions with any arguments (fmi3FreeInstance through a second instance).
@@ -122,7 +122,7 @@ fn wild_set3(rng: &mut Rng, m: &Description) -> Op3 {
 /// sometimes NULL), now and then with a wrong token, an empty, NULL or non-UTF-8 name,
 /// eventModeUsed or required intermediate variables.
 pub fn instantiation3(rng: &mut Rng, m: &Description) -> Instantiation3 {
-    let interface = if rng.chance(0.3) { Interface3::ModelExchange } else { Interface3::CoSimulation };
+    let interface = if rng.chance(ME_SHARE) { Interface3::ModelExchange } else { Interface3::CoSimulation };
     let mut spec = Instantiation3 {
         interface,
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
