@@ -110,11 +110,17 @@ fn run_child(library: &dyn Subject, seeds: &[u64], report: &mut Report, heartbea
         report.running = i as u64;
         HEARTBEAT.with(|h| h.set(heartbeat));
         beat();
+        let calls = report.counts.calls;
+        report.me = false;
         if let Err(violation) = library.run_sequence(seed, report) {
             report.violation.set(format_args!("{violation}"));
             return EXIT_VIOLATION;
         }
         report.counts.sequences += 1;
+        if report.me {
+            report.counts.me_sequences += 1;
+            report.counts.me_calls += report.counts.calls - calls;
+        }
     }
     report.done = true;
     0

@@ -7,7 +7,7 @@ use fmi::fmi2::binding;
 use crate::fmu_states::{FmuState, StateFunctions};
 pub use fmi::fmi2::binding::{
     fmi2CallbackFunctions as CallbackFunctions, fmi2CallbackLogger as Logger, fmi2Component as Component,
-    fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2OK as OK,
+    fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2Error as ERROR, fmi2Status_fmi2OK as OK,
     fmi2Status_fmi2Warning as WARNING, Fmi2Binding as Fmi2,
 };
 use std::ffi::CString;

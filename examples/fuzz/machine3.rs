@@ -4,15 +4,49 @@
 //! 2.4.7), and the calls whose arguments cannot be right (unknown value references, a variable
 //! of another type, nValues other than the number of scalars, NULL with elements announced).
 //! A call forbidden here must return fmi3Error. Where the text leaves room, nothing is claimed.
+//! Issue 25 adds: counts larger than the model allows (`oversized`, in any state), fmi3SetTime
+//! in Continuous-Time Mode only and not before the startTime (`View::set_time_refusal`), and
+//! continuous-time states settable in Continuous-Time Mode (FMI 3.0.2, 3.2.4).
 
 use crate::model_description::{Description, Type};
 use crate::ops::Arr;
 use crate::ops3::Op3;
-use crate::view::Phase;
+use crate::oversized::{too_many_refs, wrong_size};
+use crate::view::{Phase, View};
 
-/// Why the call must fail, if it must: `phase` is the instance's (certain), `me` its interface.
-pub fn forbidden(op: &Op3, phase: Phase, me: bool, m: &Description) -> Option<String> {
+/// Why the call must fail, if it must: `view` is the instance's, `me` its interface.
+pub fn forbidden(op: &Op3, view: &View, me: bool, m: &Description) -> Option<String> {
+    count_error(op, me, m).or_else(|| state_error(op, view, me, m))
+}
+
+/// Counts larger than the model allows, in any state (issue 25 item 1): value-reference lists
+/// longer than the model has variables, more log categories than it declares, nx and ni other
+/// than its numbers of states and event indicators.
+fn count_error(op: &Op3, me: bool, m: &Description) -> Option<String> {
+    let states = |n: usize| if me { wrong_size(n, m.states, "continuous states") } else { None };
+    match op {
+        Op3::Oversized(o) => Some(o.why(m)),
+        Op3::GetFloat64 { vr, .. } | Op3::GetInt32 { vr, .. } | Op3::GetBoolean { vr, .. } | Op3::GetString { vr, .. } => {
+            too_many_refs(vr.len(), m)
+        }
+        Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. } => {
+            too_many_refs(vr.len(), m)
+        }
+        Op3::Derivative { unknowns, knowns, .. } => too_many_refs(unknowns.len(), m).or_else(|| too_many_refs(knowns.len(), m)),
+        Op3::SetDebugLogging { categories, .. } => crate::machine2::too_many_categories(categories.len(), m),
+        Op3::SetContinuousStates { x } => states(x.len()),
+        Op3::GetContinuousStateDerivatives { n, .. }
+        | Op3::GetContinuousStates { n, .. }
+        | Op3::GetNominalsOfContinuousStates { n, .. } => states(*n),
+        Op3::GetEventIndicators { n, .. } if me => wrong_size(*n, m.event_indicators, "event indicators"),
+        _ => None,
+    }
+}
+
+/// What the state machines forbid in the instance's state (certain, else nothing).
+fn state_error(op: &Op3, view: &View, me: bool, m: &Description) -> Option<String> {
     use Phase::*;
+    let phase = view.phase;
     let phase_name = match phase {
         StepComplete | StepFailed => "Step Mode",
         Instantiated => "Instantiated",
@@ -51,7 +85,8 @@ pub fn forbidden(op: &Op3, phase: Phase, me: bool, m: &Description) -> Option<St
         Op3::DoStep { .. } => cs_only(step),
         Op3::UpdateDiscreteStates { .. } | Op3::EnterContinuousTimeMode => me_only(phase == EventMode),
         Op3::CompletedIntegratorStep { .. } => me_only(phase == ContinuousTime),
-        Op3::SetTime { .. } | Op3::SetContinuousStates { .. } => {
+        Op3::SetTime { t } => me_only(true).or_else(|| view.set_time_refusal(*t)),
+        Op3::SetContinuousStates { .. } => {
             me_only(!matches!(phase, Instantiated | Initialization | Terminated))
         }
         Op3::GetContinuousStateDerivatives { .. }
@@ -89,8 +124,9 @@ fn argument_error(op: &Op3, m: &Description) -> Option<String> {
 }
 
 /// Variables fmi3Set* may not set in `phase`: the independent variable, calculated values and
-/// constants always; after initialisation fixed parameters; in Continuous-Time Mode all but
-/// continuous inputs.
+/// constants always, but continuous-time states in Continuous-Time Mode (FMI 3.0.2, 3.2.4);
+/// after initialisation fixed parameters; in Continuous-Time Mode all but continuous inputs and
+/// continuous-time states.
 fn setter_error(op: &Op3, phase: Phase, m: &Description) -> Option<String> {
     let vr = match op {
         Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. } => vr,
@@ -100,10 +136,11 @@ fn setter_error(op: &Op3, phase: Phase, m: &Description) -> Option<String> {
     let initialised = !matches!(phase, Phase::Instantiated | Phase::Initialization);
     refs.iter().filter_map(|&r| m.variable(r)).find_map(|v| {
         let calculated = v.initial.as_deref().map_or(matches!(v.causality.as_str(), "output" | "local" | "calculatedParameter"), |i| i == "calculated");
-        let never = v.causality == "independent" || v.variability == "constant" || calculated;
+        let state = phase == Phase::ContinuousTime && m.state_vrs.contains(&v.vr);
+        let never = v.causality == "independent" || v.variability == "constant" || (calculated && !state);
         let fixed = initialised && v.causality == "parameter" && v.variability != "tunable";
         let continuous_input = v.causality == "input" && v.variability == "continuous";
-        let not_now = phase == Phase::ContinuousTime && !continuous_input;
+        let not_now = phase == Phase::ContinuousTime && !continuous_input && !state;
         (never || fixed || not_now).then(|| format!("{} cannot be set in this state", v.name))
     })
 }

@@ -8,39 +8,50 @@
 //!
 //! The time is split evenly over the libraries and the versions (`--fmi both`, the default: half
 //! each). A sequence is one instantiation (FMI 2.0: fmi2Instantiate; FMI 3.0:
-//! fmi3InstantiateCoSimulation or, a third of them, fmi3InstantiateModelExchange, with the
-//! instantiation token of modelDescription/fmi3/<Id>.xml or now and then a wrong one), 20 to 200
-//! calls and the frees, all drawn from its seed. Most calls are what a well-behaved importer does
-//! (`planner`, `planner3`: the state machines' paths, steps, an integrator's calls), so that the
-//! models really simulate (at most 0.5 s per sequence); the others are any function with
-//! arguments an importer can get wrong, also on a NULL instance (`wild`, `wild3`: NULL pointers,
-//! nValues other than the number of value references, unknown value references, wrong states,
-//! NaN and ±Inf, out-of-range values, damaged serialized states, clocks, Scheduled Execution and
-//! the other functions these FMUs do not provide). The oracle (`session`, `session3`) is checked
-//! after every call; for FMI 3.0 it includes the standard's state machines (`machine3`: a call
-//! they forbid must return fmi3Error) and a log message with every fmi3Error and fmi3Discard. A
-//! crash (a signal), a hang (a sequence still running after 10 s) or a leak (the heap larger
-//! after the sequence than before, twice; glibc's tcache is turned off for this) fails the
-//! sequence too. Log messages that report a panic the FMU caught ("internal error") are counted
-//! and the first is shown with its seed, but they are not failures.
+//! fmi3InstantiateCoSimulation or fmi3InstantiateModelExchange; in both versions a third of them
+//! for Model Exchange, with the GUID or instantiation token of the model description or now and
+//! then a wrong one), 20 to 200 calls and the frees, all drawn from its seed. Most calls are what
+//! a well-behaved importer does (`planner`, `planner3`: the state machines' paths, steps, an
+//! integrator's calls, derivatives in Initialization Mode, and the probe paths of `probes`), so
+//! that the models really simulate (at most 0.5 s per sequence); the others are any function
+//! with arguments an importer can get wrong, also on a NULL instance (`wild`, `wild3`: NULL
+//! pointers, nValues other than the number of value references, unknown value references, counts
+//! far larger than the arrays (`oversized`), wrong states, NaN and ±Inf, out-of-range values,
+//! damaged serialized states, clocks, Scheduled Execution and the other functions these FMUs do
+//! not provide). The oracle (`session`, `session3`) is checked after every call: what the
+//! standard forbids must return Error (FMI 2.0: `machine2`, counts and Model Exchange times;
+//! FMI 3.0: `machine3`, the state machines, with Terminated after any fmi3Error), what it allows
+//! with right arguments must succeed (`required`: derivatives in Initialization Mode and of
+//! `der(...)` in Step Mode, states set by value reference, FMU state round trips), the probes'
+//! expectations must hold (`watch`: event locals against the event indicators and current after
+//! steps, states set by reference as SetContinuousStates sets them), and an Error or Discard
+//! comes with a log message (FMI 2.0: for the refusals of `machine2`). A crash (a signal), a hang
+//! (a sequence still running after 10 s) or a leak (the heap larger after the sequence than
+//! before, twice; glibc's tcache is turned off for this) fails the sequence too. Log messages
+//! that report a panic the FMU caught ("internal error") are counted and the first is shown with
+//! its seed, but they are not failures.
 //!
 //! A failure prints the sequence's seed, the message and the last calls; `--seed N --replay` with
 //! that seed and its `--lib` runs exactly this sequence in-process, without fork, printing every
 //! call and log message (the seed's top bit tells the version: set for FMI 3.0). Without
 //! `--seed` the master seed comes from the clock; it is printed, and `--seed N` repeats the run
 //! (as far as the same number of sequences fit in the time budget). The summary has a line per
-//! library and version, one per version and the total. Exit status: 0 when nothing failed, 1 on
-//! a failure, 2 on a usage or setup error. A 60 s run (both versions, 7.5 s per library and
-//! version; 60.9 s in all) made 7.8 M calls: 4.13 M in 41 648 FMI 2.0 sequences and 3.69 M in
-//! 36 325 FMI 3.0 ones (FMI 3.0: 333 k calls/s controller, 50 k/s HydraulicBoom, 98 k/s
-//! HydraulicCircuit, 11 k/s BoomMechanics), no failure.
+//! library and version, one per version and the total, each with its sequences and calls on
+//! Co-Simulation (CS) and Model Exchange (ME) instances. Exit status: 0 when nothing failed, 1
+//! on a failure, 2 on a usage or setup error. A 60 s run against the issue 25 runtime (main at
+//! 136f7a4; both versions, 7.5 s per library and version; 60.2 s in all) made 5.47 M calls:
+//! 3.06 M in 31 026 FMI 2.0 sequences (ME: 9 904 sequences, 1.01 M calls) and 2.41 M in 24 225
+//! FMI 3.0 ones (ME: 7 747, 0.80 M); its failures were the runtime's (FMI 2.0 value-reference
+//! lists one longer than the variables accepted; FMU states that serialize but do not
+//! deserialize: FMI 3.0 Terminated before initialisation, FMI 2.0 after a step that failed).
 //!
 //! - `fmi2`, `fmi3`: the C ABIs and the libraries under test; `model_description`: their XML;
-//! - `sequence`, `sequence3`: one sequence, of calls (`ops`, `ops3`) from the planners and the
-//!   wild generators, drawn with `rng`; `refused`: the FMI 3.0 functions the FMUs must refuse;
-//! - `session`, `session3`: make the calls and check the oracle, with `view` (the instance's
-//!   phase and time), `fmu_states` (the FMU state functions, shared by both versions) and
-//!   `callbacks` (the loggers);
+//! - `sequence`, `sequence3`: one sequence, of calls (`ops`, `ops3`) from the planners (with
+//!   `probes`) and the wild generators (with `oversized`), drawn with `rng`; `refused`: the FMI
+//!   3.0 functions the FMUs must refuse;
+//! - `session`, `session3`: make the calls and check the oracle, with `machine2`, `machine3`,
+//!   `required` and `watch`, `view` (the instance's phase and time), `fmu_states` (the FMU state
+//!   functions, shared by both versions) and `callbacks` (the loggers);
 //! - `batch`: the forked children, heartbeat and timeout; `report`: their account in shared
 //!   memory, the tallies and the output.
 
@@ -56,20 +67,25 @@ mod callbacks;
 mod fmi2;
 mod fmi3;
 mod fmu_states;
+mod machine2;
 mod machine3;
 mod model_description;
 mod ops;
 mod ops3;
+mod oversized;
 mod planner;
 mod planner3;
+mod probes;
 mod refused;
 mod report;
+mod required;
 mod rng;
 mod sequence;
 mod sequence3;
 mod session;
 mod session3;
 mod view;
+mod watch;
 mod wild;
 mod wild3;
 

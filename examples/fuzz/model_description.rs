@@ -11,7 +11,7 @@ use std::os::raw::c_int;
 use std::path::Path;
 
 /// A variable's base type (FMI 3.0: Float64, Int32, Boolean, String).
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Type {
     Real,
     Integer,
@@ -30,6 +30,8 @@ pub struct Variable {
     pub causality: String,
     pub variability: String,
     pub initial: Option<String>,
+    /// The `derivative` attribute: the state's index (FMI 2.0, from 1) or value reference (FMI 3.0).
+    derivative: Option<u32>,
     pub min: f64,
     pub max: f64,
     start: Option<f64>,
@@ -63,6 +65,7 @@ impl Variable {
             causality: text("causality", "local"),
             variability: text("variability", "continuous"),
             initial: scalar.get("initial").cloned(),
+            derivative: typed.get("derivative").and_then(|s| s.parse().ok()),
             min: number("min").unwrap_or(lo),
             max: number("max").unwrap_or(hi),
             name,
@@ -70,6 +73,15 @@ impl Variable {
             ty,
             start,
         })
+    }
+
+    /// Whether `initial` is, explicitly or by default, "exact" (FMI 2.0 2.2.7, FMI 3.0 2.4.7.4:
+    /// parameters and constants default to exact, outputs and locals to calculated).
+    pub fn exact(&self) -> bool {
+        match self.initial.as_deref() {
+            Some(initial) => initial == "exact",
+            None => self.causality == "parameter" || self.variability == "constant",
+        }
     }
 
     /// A finite interval to draw values from: the range, or around the start where unbounded.
@@ -128,6 +140,9 @@ pub struct Description {
     pub fmi3: bool,
     /// `providesAdjointDerivatives` of the CoSimulation element (FMI 3.0).
     pub adjoint: bool,
+    /// `providesDirectionalDerivative` (FMI 3.0: `providesDirectionalDerivatives`) of the
+    /// CoSimulation element.
+    pub directional: bool,
     pub categories: Vec<String>,
     pub variables: Vec<Variable>,
     /// Value references per type, in the order of `TYPES`.
@@ -147,6 +162,22 @@ pub struct Description {
     /// (`numberOfEventIndicators`; FMI 3.0: the `EventIndicator` elements), for Model Exchange.
     pub states: usize,
     pub event_indicators: usize,
+    /// Value references of the continuous states, in the order of their derivatives.
+    pub state_vrs: Vec<u32>,
+    /// Value references of the derivatives of ModelStructure (`der(...)`; FMI 2.0 `Derivatives`,
+    /// FMI 3.0 `ContinuousStateDerivative`).
+    pub derivatives: Vec<u32>,
+    /// Value references of the Real InitialUnknowns of ModelStructure.
+    pub initial_unknowns: Vec<u32>,
+    /// Value references of the knowns of a derivative in Initialization Mode: Real inputs and
+    /// Real variables with initial="exact" but constants (FMI 2.0 3.2.1 table, FMI 3.0 2.3.3).
+    pub initial_knowns: Vec<u32>,
+    /// Value references of the event-indicator locals (`event.*`), in the order of the event
+    /// indicators (FMI 3.0: the `EventIndicator` elements; FMI 2.0, which does not name them:
+    /// the order of the variables, the same as FMI 3.0's).
+    pub event_locals: Vec<u32>,
+    /// The spool reference input (`valve.u_ref`), in the models with event locals.
+    pub spool_reference: Option<u32>,
     pub max_vr: u32,
     index: HashMap<u32, usize>,
 }
@@ -160,8 +191,11 @@ impl Description {
     fn parse(xml: &str) -> Result<Self, String> {
         let mut reader = quick_xml::Reader::from_str(xml);
         let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
-        let (mut states, mut event_indicators, mut fmi3, mut adjoint) = (0, 0, false, false);
+        let (mut states, mut event_indicators, mut fmi3, mut adjoint, mut directional) = (0, 0, false, false, false);
         let mut scalar: Option<Attributes> = None;
+        // ModelStructure: (the section, the index or value reference) of every Unknown element.
+        let (mut section, mut structure) = (String::new(), Vec::<(String, u32)>::new());
+        let mut event_vrs = Vec::new();
         loop {
             match reader.read_event().map_err(|e| e.to_string())? {
                 Event::Start(e) | Event::Empty(e) => {
@@ -178,10 +212,21 @@ impl Description {
                         "CoSimulation" => {
                             identifier = a.get("modelIdentifier").cloned();
                             adjoint = a.get("providesAdjointDerivatives").is_some_and(|v| v == "true");
+                            let key = if fmi3 { "providesDirectionalDerivatives" } else { "providesDirectionalDerivative" };
+                            directional = a.get(key).is_some_and(|v| v == "true");
                         }
                         "Category" => categories.extend(a.get("name").cloned()),
                         "ScalarVariable" => scalar = Some(a),
-                        "EventIndicator" if fmi3 => event_indicators += 1,
+                        "EventIndicator" if fmi3 => {
+                            event_indicators += 1;
+                            event_vrs.extend(a.get("valueReference").and_then(|s| s.parse::<u32>().ok()));
+                        }
+                        tag @ ("Outputs" | "Derivatives" | "InitialUnknowns") => section = tag.to_owned(),
+                        "Unknown" => structure.extend(a.get("index").and_then(|s| s.parse().ok()).map(|i| (section.clone(), i))),
+                        tag @ ("ContinuousStateDerivative" | "InitialUnknown") if fmi3 => {
+                            let section = if tag == "InitialUnknown" { "InitialUnknowns" } else { "Derivatives" };
+                            structure.extend(a.get("valueReference").and_then(|s| s.parse().ok()).map(|r| (section.into(), r)));
+                        }
                         tag @ ("Float64" | "Int32" | "Boolean" | "String") if fmi3 => {
                             states += usize::from(tag == "Float64" && a.contains_key("derivative"));
                             variables.push(Variable::new(&a, tag, &a)?);
@@ -213,6 +258,23 @@ impl Description {
         };
         let input = |v: &Variable| v.causality == "input";
         let parameter = |v: &Variable| v.causality == "parameter";
+        // FMI 2.0 refers to variables by their index (from 1), FMI 3.0 by value reference.
+        let vr_of = |reference: u32| match fmi3 {
+            true => Some(reference),
+            false => variables.get((reference as usize).wrapping_sub(1)).map(|v| v.vr),
+        };
+        let real = |vr: &u32| variables.iter().any(|v| v.vr == *vr && v.ty == Type::Real);
+        let listed = |name: &str| -> Vec<u32> {
+            structure.iter().filter(|(s, _)| s == name).filter_map(|&(_, r)| vr_of(r)).filter(real).collect()
+        };
+        let derivatives = listed("Derivatives");
+        let state_vrs = derivatives
+            .iter()
+            .filter_map(|d| variables.iter().find(|v| v.vr == *d)?.derivative.and_then(vr_of))
+            .collect();
+        if !fmi3 {
+            event_vrs = variables.iter().filter(|v| v.name.starts_with("event.")).map(|v| v.vr).collect();
+        }
         let flexible = variables.iter().find(|v| v.name == "boom.flexible" && v.ty == Type::Boolean).map(|v| v.vr);
         Ok(Description {
             by_type: TYPES.map(|t| variables.iter().filter(|v| v.ty == t).map(|v| v.vr).collect()),
@@ -224,12 +286,23 @@ impl Description {
             }),
             step_settable: indices(&|v| input(v) || (parameter(v) && v.variability == "tunable")),
             real_inputs: indices(&|v| input(v) && v.ty == Type::Real),
+            initial_unknowns: listed("InitialUnknowns"),
+            initial_knowns: variables
+                .iter()
+                .filter(|v| v.ty == Type::Real && v.variability != "constant" && (input(v) || v.exact()))
+                .map(|v| v.vr)
+                .collect(),
+            state_vrs,
+            derivatives,
+            spool_reference: variables.iter().find(|v| v.name == "valve.u_ref" && v.ty == Type::Real).map(|v| v.vr),
+            event_locals: event_vrs,
             max_vr: variables.iter().map(|v| v.vr).max().unwrap_or(0),
             index: variables.iter().enumerate().map(|(i, v)| (v.vr, i)).collect(),
             identifier: identifier.ok_or("no CoSimulation modelIdentifier")?,
             guid: guid.ok_or("no guid or instantiationToken")?,
             fmi3,
             adjoint,
+            directional,
             flexible,
             states,
             event_indicators,

@@ -257,6 +257,8 @@ pub enum Op {
         n: usize,
         null: bool,
     },
+    /// A function with a count larger than the model allows (`oversized`).
+    Oversized(crate::oversized::Oversized),
 }
 
 impl Op {

@@ -102,6 +102,8 @@ pub enum Op3 {
     GetNominalsOfContinuousStates { n: usize, null: bool },
     GetNumberOfContinuousStates { null: bool },
     GetNumberOfEventIndicators { null: bool },
+    /// A function with a count larger than the model allows (`oversized`).
+    Oversized(crate::oversized::Oversized),
 }
 
 impl Op3 {
@@ -118,6 +120,7 @@ impl Op3 {
                 format!("fmi3{}{} {{ vr: {vr:?} }}", if *set { "Set" } else { "Get" }, OTHER_TYPES[*ty])
             }
             Op3::Refused { function } => format!("fmi3{}", REFUSED[*function]),
+            Op3::Oversized(o) => o.describe(true),
             Op3::Instantiate(i) => format!("fmi3Instantiate{:?}({i:?})", i.interface),
             Op3::Derivative { adjoint: true, .. } => format!("fmi3GetAdjointDerivative{}", arguments(self)),
             Op3::Derivative { .. } => format!("fmi3GetDirectionalDerivative{}", arguments(self)),

@@ -1,11 +1,14 @@
 //! The calls of a well-behaved importer, so that the models really simulate: setup,
 //! initialisation with values in range, steps of 0.1 to 10 ms, gets, FMU states, termination,
-//! reset; mostly with the rigid boom (`boom.flexible` = false).
+//! reset; mostly with the rigid boom (`boom.flexible` = false); the probe paths of `probes`,
+//! derivatives in Initialization Mode and, in Co-Simulation, a step that clamps an interpolated
+//! input at its bound followed by an FMU state round trip.
 
 use crate::fmi2::{LAST_SUCCESSFUL_TIME, TERMINATED};
 use crate::fmu_states::{FmuStates, StateCall};
 use crate::model_description::{Description, Type, Variable};
 use crate::ops::{Arr, Op, Slot, Text};
+use crate::probes::{self, Probe, RoundTrip};
 use crate::rng::Rng;
 use crate::session::Session;
 use crate::view::Phase;
@@ -22,11 +25,20 @@ pub struct Planner {
     h: f64,
     /// Set once initialisation failed or the instance broke: plans keep the parameters' start values.
     tame: bool,
+    round_trip: RoundTrip,
+    /// A state-by-reference probe waits for the states just read.
+    by_reference: bool,
 }
 
 impl Planner {
     pub fn new(rng: &mut Rng) -> Self {
-        Planner { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false }
+        Planner {
+            queue: VecDeque::new(),
+            h: rng.log_uniform(1e-4, 1e-2),
+            tame: false,
+            round_trip: RoundTrip::default(),
+            by_reference: false,
+        }
     }
 
     pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
@@ -34,6 +46,9 @@ impl Planner {
             return self.queue.pop_front().expect("a planned call").1;
         }
         self.queue.clear();
+        if let Some(call) = self.round_trip.next(&s.states) {
+            return Op::State(call);
+        }
         let m = s.model;
         let last_successful_time = Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false };
         match s.view.phase {
@@ -106,12 +121,46 @@ impl Planner {
         if rng.chance(0.2) {
             plan(Phase::Initialization, Some(get_reals(rng, m)));
         }
+        if rng.chance(0.2) {
+            plan(Phase::Initialization, Some(directional_derivative(plausible_derivative(rng, m, true))));
+        }
+        if s.me && rng.chance(0.3) {
+            plan(Phase::Initialization, Some(Op::GetDerivatives { n: m.states, null: false }));
+            plan(Phase::Initialization, Some(Op::GetNominalsOfContinuousStates { n: m.states, null: false }));
+        }
         plan(Phase::Initialization, Some(Op::ExitInitializationMode));
+    }
+
+    /// Queues a probe's calls for `phase` and returns the first (`None` for an empty probe).
+    fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<Op> {
+        self.queue.extend(probe.into_iter().map(|p| (phase, probe_op(p, m))));
+        self.queue.pop_front().map(|(_, op)| op)
+    }
+
+    /// Co-Simulation: an input near a bound, a slope that drives it across within the step, the
+    /// step (where the FMU clamps the interpolated input), then an FMU state round trip.
+    fn clamp(&mut self, rng: &mut Rng, s: &Session, h: f64) -> Option<Op> {
+        let m = s.model;
+        let v = &m.variables[*rng.choose(&m.real_inputs)?];
+        if !(v.min.is_finite() && v.max.is_finite() && v.max > v.min) {
+            return None;
+        }
+        let (span, up) = (v.max - v.min, rng.chance(0.5));
+        let (start, slope) = if up { (v.max - 0.02 * span, span / h) } else { (v.min + 0.02 * span, -span / h) };
+        let slope = slope * rng.uniform(0.5, 5.0);
+        let vr = Arr::Items(vec![v.vr]);
+        let phase = Phase::StepComplete;
+        self.queue.push_back((phase, Op::SetReal { vr: vr.clone(), values: Arr::Items(vec![start]) }));
+        let slopes = Op::SetRealInputDerivatives { vr, orders: Arr::Items(vec![1]), values: Arr::Items(vec![slope]) };
+        self.queue.push_back((phase, slopes));
+        self.queue.push_back((phase, Op::DoStep { t: s.view.time, h, no_set_prior: 1 }));
+        self.round_trip.start();
+        self.queue.pop_front().map(|(_, op)| op)
     }
 
     /// Between steps: mostly steps, input changes and gets, some FMU state handling; once the
     /// budget or the stop time is reached, gets and the end of the simulation.
-    fn stepping(&self, rng: &mut Rng, s: &Session) -> Op {
+    fn stepping(&mut self, rng: &mut Rng, s: &Session) -> Op {
         let m = s.model;
         let room = s.view.room(s.budget());
         if room < 1e-6 {
@@ -131,8 +180,18 @@ impl Planner {
                 Op::GetInteger { vr: Arr::Items(m.of_type(Type::Integer).to_vec()), null_values: false }
             }
             83..=84 => Op::GetBoolean { vr: Arr::Items(m.of_type(Type::Boolean).to_vec()), null_values: false },
-            85..=96 => state_op(rng, s),
-            97 => plausible_directional_derivative(rng, m),
+            85..=88 => state_op(rng, s),
+            89 => {
+                self.round_trip.start();
+                state_op(rng, s)
+            }
+            90..=91 => self.clamp(rng, s, h.min(room)).unwrap_or_else(|| get_reals(rng, m)),
+            92..=94 => {
+                let probe = probes::spool(rng, m, &s.view, h.min(room));
+                self.probe(Phase::StepComplete, probe, m).unwrap_or_else(|| state_op(rng, s))
+            }
+            95..=96 => state_op(rng, s),
+            97 => directional_derivative(plausible_derivative(rng, m, false)),
             98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
             _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
         }
@@ -143,10 +202,30 @@ impl Planner {
     /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
     /// the sequence's step, states near the last ones read, derivatives, event indicators,
     /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
-    fn integrating(&self, rng: &mut Rng, s: &Session) -> Op {
+    fn integrating(&mut self, rng: &mut Rng, s: &Session) -> Op {
         let m = s.model;
         if !(s.view.time < 1.0) {
             return if rng.chance(0.7) { Op::Terminate } else { Op::Reset };
+        }
+        let phase = Phase::ContinuousTime;
+        let pending = std::mem::take(&mut self.by_reference) && s.x_fresh;
+        let probe = match rng.below(100) {
+            _ if pending => probes::state_by_reference(rng, m, &s.x),
+            0..=2 => probes::event_locals(m),
+            3..=5 if s.x_fresh => probes::state_by_reference(rng, m, &s.x),
+            3..=5 => {
+                // The states first: the probe starts from them.
+                self.by_reference = true;
+                vec![Probe::GetContinuousStates]
+            }
+            6..=7 => {
+                self.round_trip.start();
+                probes::time_back(rng, &s.view, self.h)
+            }
+            _ => Vec::new(),
+        };
+        if let Some(op) = self.probe(phase, probe, m) {
+            return op;
         }
         match rng.below(100) {
             0..=19 => Op::SetTime { t: s.view.time + self.h * rng.uniform(0.0, 1.0) },
@@ -163,7 +242,7 @@ impl Planner {
             87..=89 => Op::EnterEventMode,
             90..=94 => state_op(rng, s),
             95..=96 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
-            97 => plausible_directional_derivative(rng, m),
+            97 => directional_derivative(plausible_derivative(rng, m, false)),
             _ => Op::GetContinuousStates { n: m.states, null: false },
         }
     }
@@ -193,10 +272,21 @@ fn state_op(rng: &mut Rng, s: &Session) -> Op {
     Op::State(state_call(rng, &s.states))
 }
 
-/// fmi2GetDirectionalDerivative of one to three outputs with respect to one or two Real inputs,
-/// with seeds of order one.
-fn plausible_directional_derivative(rng: &mut Rng, m: &Description) -> Op {
-    let (unknowns, knowns, dv_known) = plausible_derivative(rng, m);
+/// A probe's call as an FMI 2.0 op.
+fn probe_op(p: Probe, m: &Description) -> Op {
+    match p {
+        Probe::Read(vr) => Op::GetReal { vr: Arr::Items(vr), null_values: false },
+        Probe::Set(vr, values) => Op::SetReal { vr: Arr::Items(vr), values: Arr::Items(values) },
+        Probe::DoStep { t, h } => Op::DoStep { t, h, no_set_prior: 1 },
+        Probe::GetContinuousStates => Op::GetContinuousStates { n: m.states, null: false },
+        Probe::GetEventIndicators => Op::GetEventIndicators { n: m.event_indicators, null: false },
+        Probe::SetTime(t) => Op::SetTime { t },
+        Probe::SetContinuousStates(x) => Op::SetContinuousStates { x: Arr::Items(x) },
+    }
+}
+
+/// fmi2GetDirectionalDerivative with these unknowns, knowns and seeds.
+fn directional_derivative((unknowns, knowns, dv_known): (Vec<u32>, Vec<u32>, Vec<f64>)) -> Op {
     Op::GetDirectionalDerivative {
         unknowns: Arr::Items(unknowns),
         knowns: Arr::Items(knowns),
@@ -205,12 +295,16 @@ fn plausible_directional_derivative(rng: &mut Rng, m: &Description) -> Op {
     }
 }
 
-/// The unknowns, knowns and seeds of a directional derivative: one to three outputs, one or
-/// two Real inputs, seeds of order one.
-pub fn plausible_derivative(rng: &mut Rng, m: &Description) -> (Vec<u32>, Vec<u32>, Vec<f64>) {
-    let unknowns: Vec<u32> = (0..rng.range(1, 3)).filter_map(|_| rng.choose(&m.outputs).copied()).collect();
-    let knowns: Vec<u32> =
-        (0..rng.range(1, 2)).filter_map(|_| rng.choose(&m.real_inputs)).map(|&i| m.variables[i].vr).collect();
+/// The unknowns, knowns and seeds of a directional derivative, seeds of order one: one to three
+/// outputs or `der(...)` derivatives on one or two Real inputs; in Initialization Mode
+/// (`initialization`), InitialUnknowns on inputs and initial="exact" variables.
+pub fn plausible_derivative(rng: &mut Rng, m: &Description, initialization: bool) -> (Vec<u32>, Vec<u32>, Vec<f64>) {
+    let inputs: Vec<u32> = m.real_inputs.iter().map(|&i| m.variables[i].vr).collect();
+    let unknown_pool =
+        if initialization { m.initial_unknowns.clone() } else { [&m.outputs[..], &m.derivatives].concat() };
+    let known_pool = if initialization { &m.initial_knowns } else { &inputs };
+    let unknowns: Vec<u32> = (0..rng.range(1, 3)).filter_map(|_| rng.choose(&unknown_pool).copied()).collect();
+    let knowns: Vec<u32> = (0..rng.range(1, 2)).filter_map(|_| rng.choose(known_pool).copied()).collect();
     let seeds = knowns.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
     (unknowns, knowns, seeds)
 }

@@ -1,12 +1,14 @@
 //! The FMI 3.0 calls of a well-behaved importer, as `planner` makes FMI 2.0's (the same plans
 //! and value generators): initialisation with values in range, steps of 0.1 to 10 ms or, for
 //! Model Exchange, an integrator's calls, gets, FMU states, termination, reset; mostly with the
-//! rigid boom (`boom.flexible` = false).
+//! rigid boom (`boom.flexible` = false); the probe paths of `probes`, derivatives in
+//! Initialization Mode, and a smaller step retried after fmi3Discard.
 
 use crate::model_description::{Description, Type};
 use crate::ops::{Arr, Text};
 use crate::ops3::Op3;
 use crate::planner::{plausible_derivative, plausible_experiment, plausible_values, some_reals, state_call};
+use crate::probes::{self, Probe, RoundTrip};
 use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::fmu_states::StateCall;
@@ -21,11 +23,14 @@ pub struct Planner3 {
     h: f64,
     /// Set once initialisation failed or the instance broke: plans keep the start values.
     tame: bool,
+    round_trip: RoundTrip,
+    /// A state-by-reference probe waits for the states just read.
+    by_reference: bool,
 }
 
 impl Planner3 {
     pub fn new(rng: &mut Rng) -> Self {
-        Planner3 { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false }
+        Planner3 { queue: VecDeque::new(), h: rng.log_uniform(1e-4, 1e-2), tame: false, round_trip: RoundTrip::default(), by_reference: false }
     }
 
     pub fn next(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
@@ -33,6 +38,9 @@ impl Planner3 {
             return self.queue.pop_front().expect("a planned call").1;
         }
         self.queue.clear();
+        if let Some(call) = self.round_trip.next(&s.states) {
+            return Op3::State(call);
+        }
         let m = s.model;
         let restore = |rng: &mut Rng| rng.choose(&s.states.live).map(|l| Op3::State(StateCall::Set { state: l.ptr }));
         match s.view.phase {
@@ -98,14 +106,27 @@ impl Planner3 {
         if rng.chance(0.2) {
             plan(Phase::Initialization, Some(get_float64(rng, m)));
         }
+        if rng.chance(0.2) {
+            plan(Phase::Initialization, Some(derivative(rng, m, true)));
+        }
         plan(Phase::Initialization, Some(Op3::ExitInitializationMode));
+    }
+
+    /// Queues a probe's calls for `phase` and returns the first (`None` for an empty probe).
+    fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<Op3> {
+        self.queue.extend(probe.into_iter().map(|p| (phase, probe_op(p, m))));
+        self.queue.pop_front().map(|(_, op)| op)
     }
 
     /// In Step Mode: mostly steps, input changes and gets, some FMU state handling; once the
     /// budget or the stop time is reached, gets and the end of the simulation.
-    fn stepping(&self, rng: &mut Rng, s: &Session3) -> Op3 {
+    fn stepping(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
         let m = s.model;
         let room = s.view.room(s.budget());
+        if let Some(h) = s.discarded.filter(|_| room >= 1e-6) {
+            // FMI 3.0 4.2.1: after fmi3Discard, a smaller step from the same time.
+            return Op3::DoStep { t: s.view.time, h: (h * rng.uniform(0.1, 0.5)).min(room), no_set_prior: true, null_outputs: false };
+        }
         if room < 1e-6 {
             return match rng.below(10) {
                 0..=5 => get_float64(rng, m),
@@ -122,18 +143,45 @@ impl Planner3 {
                 let ty = *rng.pick(&[Type::Integer, Type::Boolean, Type::String]);
                 get_all(m, ty)
             }
-            85..=96 => Op3::State(state_call(rng, &s.states)),
-            _ => derivative(rng, m),
+            85..=89 => Op3::State(state_call(rng, &s.states)),
+            90 => {
+                self.round_trip.start();
+                Op3::State(state_call(rng, &s.states))
+            }
+            91..=94 => {
+                let probe = probes::spool(rng, m, &s.view, h.min(room));
+                self.probe(Phase::StepComplete, probe, m).unwrap_or_else(|| get_float64(rng, m))
+            }
+            _ => derivative(rng, m, false),
         }
     }
 
     /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
     /// the sequence's step, states near the last ones read, derivatives, event indicators,
     /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
-    fn integrating(&self, rng: &mut Rng, s: &Session3) -> Op3 {
+    fn integrating(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
         let m = s.model;
         if !(s.view.time < 1.0) {
             return if rng.chance(0.7) { Op3::Terminate } else { Op3::Reset };
+        }
+        let pending = std::mem::take(&mut self.by_reference) && s.x_fresh;
+        let probe = match rng.below(100) {
+            _ if pending => probes::state_by_reference(rng, m, &s.x),
+            0..=2 => probes::event_locals(m),
+            3..=5 if s.x_fresh => probes::state_by_reference(rng, m, &s.x),
+            3..=5 => {
+                // The states first: the probe starts from them.
+                self.by_reference = true;
+                vec![Probe::GetContinuousStates]
+            }
+            6..=7 => {
+                self.round_trip.start();
+                probes::time_back(rng, &s.view, self.h)
+            }
+            _ => Vec::new(),
+        };
+        if let Some(op) = self.probe(Phase::ContinuousTime, probe, m) {
+            return op;
         }
         match rng.below(100) {
             0..=19 => Op3::SetTime { t: s.view.time + self.h * rng.uniform(0.0, 1.0) },
@@ -152,7 +200,7 @@ impl Planner3 {
             93 => Op3::GetNominalsOfContinuousStates { n: m.states, null: false },
             94 => Op3::GetNumberOfContinuousStates { null: false },
             95 => Op3::GetNumberOfEventIndicators { null: false },
-            96..=97 => derivative(rng, m),
+            96..=97 => derivative(rng, m, false),
             _ => Op3::GetContinuousStates { n: m.states, null: false },
         }
     }
@@ -189,9 +237,23 @@ fn get_all(m: &Description, ty: Type) -> Op3 {
     }
 }
 
-/// A directional (or, where provided, adjoint) derivative of outputs on Float64 inputs.
-fn derivative(rng: &mut Rng, m: &Description) -> Op3 {
-    let (unknowns, knowns, seeds) = plausible_derivative(rng, m);
+/// A probe's call as an FMI 3.0 op.
+fn probe_op(p: Probe, m: &Description) -> Op3 {
+    match p {
+        Probe::Read(vr) => Op3::GetFloat64 { n_values: vr.len(), vr: Arr::Items(vr), null_values: false },
+        Probe::Set(vr, values) => Op3::SetFloat64 { vr: Arr::Items(vr), values: Arr::Items(values) },
+        Probe::DoStep { t, h } => Op3::DoStep { t, h, no_set_prior: true, null_outputs: false },
+        Probe::GetContinuousStates => Op3::GetContinuousStates { n: m.states, null: false },
+        Probe::GetEventIndicators => Op3::GetEventIndicators { n: m.event_indicators, null: false },
+        Probe::SetTime(t) => Op3::SetTime { t },
+        Probe::SetContinuousStates(x) => Op3::SetContinuousStates { x: Arr::Items(x) },
+    }
+}
+
+/// A directional (or, where provided, adjoint) derivative as `plausible_derivative` draws it
+/// (`initialization`: for Initialization Mode).
+fn derivative(rng: &mut Rng, m: &Description, initialization: bool) -> Op3 {
+    let (unknowns, knowns, seeds) = plausible_derivative(rng, m, initialization);
     let adjoint = m.adjoint && rng.chance(0.3);
     // The adjoint's seeds weight the unknowns and its sensitivities are per known.
     let (seed, n_sensitivity) = if adjoint {

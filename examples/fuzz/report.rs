@@ -62,6 +62,8 @@ pub struct Report {
     pub echo: bool,
     /// The sequence running is an FMI 3.0 one (status names).
     pub fmi3: bool,
+    /// The sequence running has a Model Exchange instance (set at its main instantiation).
+    pub me: bool,
     /// Index in the batch of the sequence running (or failed).
     pub running: u64,
     /// The child finished its batch (or ran out of time) normally.
@@ -237,6 +239,9 @@ impl Drop for SharedReport {
 pub struct Counts {
     pub sequences: u64,
     pub calls: u64,
+    /// Of `sequences` and `calls`, those of Model Exchange instances (the rest: Co-Simulation).
+    pub me_sequences: u64,
+    pub me_calls: u64,
     pub messages: u64,
     pub internal_errors: u64,
 }
@@ -245,6 +250,8 @@ impl Counts {
     pub fn add(&mut self, other: Counts) {
         self.sequences += other.sequences;
         self.calls += other.calls;
+        self.me_sequences += other.me_sequences;
+        self.me_calls += other.me_calls;
         self.messages += other.messages;
         self.internal_errors += other.internal_errors;
     }
@@ -286,9 +293,13 @@ impl Tally {
             n => format!(" ({n} kinds, each shown once)"),
         };
         format!(
-            "{name} {seconds:.1} s, {} sequences, {} calls ({:.0} calls/s), {} failures{kinds}, {} log messages, {} internal errors",
+            "{name} {seconds:.1} s, {} sequences (CS {}, ME {}), {} calls (CS {}, ME {}; {:.0} calls/s), {} failures{kinds}, {} log messages, {} internal errors",
             c.sequences,
+            c.sequences - c.me_sequences,
+            c.me_sequences,
             c.calls,
+            c.calls - c.me_calls,
+            c.me_calls,
             c.calls as f64 / seconds.max(1e-9),
             self.failures,
             c.messages,

@@ -7,6 +7,9 @@
 //!   fmi2GetEventIndicators and fmi2GetDerivatives (Model Exchange), and
 //!   fmi2GetDirectionalDerivative;
 //!   fmi2GetRealStatus(fmi2LastSuccessfulTime) is the end of the last step the fuzzer saw succeed;
+//! - a call that `machine2` says must fail returns fmi2Error, with a log message when the
+//!   instance has a logger; one that `required` says must succeed returns fmi2OK or fmi2Warning;
+//!   the expectations of the planner's probes (`watch`) hold;
 //! - fmi2GetTypesPlatform is "default" and fmi2GetVersion "2.0";
 //! - the logger gets the componentEnvironment given to fmi2Instantiate, a valid status,
 //!   non-NULL strings and the format "%s" (checked in `callbacks`);
@@ -18,13 +21,16 @@
 
 use crate::callbacks::LOG;
 use crate::fmi2::{
-    CallbackFunctions, Component, EventInfo, Fmi2, Library, Status, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK, WARNING,
+    CallbackFunctions, Component, EventInfo, Fmi2, Library, Status, ERROR, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK,
+    WARNING,
 };
 use crate::fmu_states::{FmuStates, StateCall, StateOutput};
 use crate::model_description::Description;
 use crate::ops::{Arr, Instantiation, Op, Slot, Text};
 use crate::report::Report;
+use crate::required::{self, Derivative};
 use crate::view::{Phase, View};
+use crate::watch::{Seen, Watch};
 use std::ffi::CStr;
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};
@@ -64,14 +70,19 @@ pub struct Session<'a> {
     opened: bool,
     /// The main instance is a Model Exchange one.
     pub me: bool,
+    /// The main instance has a logger.
+    logger: bool,
     /// The continuous states fmi2GetContinuousStates last returned (Model Exchange).
     pub x: Vec<f64>,
+    /// `x` was read by the last call to the main instance.
+    pub x_fresh: bool,
     /// Callback structures of the instances, alive until the end of the sequence; boxed, since
     /// an FMU may keep the pointer and a Vec moves its elements.
     #[allow(clippy::vec_box)]
     callbacks: Vec<Box<CallbackFunctions>>,
     pub view: View,
     pub states: FmuStates,
+    watch: Watch,
     /// Simulated time so far (an upper bound).
     simulated: f64,
 }
@@ -86,10 +97,13 @@ impl<'a> Session<'a> {
             second: null_mut(),
             opened: false,
             me: false,
+            logger: false,
             x: Vec::new(),
+            x_fresh: false,
             callbacks: Vec::new(),
             view: View::fresh(),
             states: FmuStates::default(),
+            watch: Watch::default(),
             simulated: 0.0,
         }
     }
@@ -103,8 +117,10 @@ impl<'a> Session<'a> {
         };
         match &op {
             Op::State(call) => self.report.begin(format_args!("{}{on}", call.describe(false))),
+            Op::Oversized(o) => self.report.begin(format_args!("{}{on}", o.describe(false))),
             op => self.report.begin(format_args!("fmi2{op:?}{on}")),
         }
+        let errors = LOG.with(|sink| sink.borrow().errors);
         // SAFETY: every pointer passed is NULL or points to as many elements as announced,
         // alive for the call (see `invoke`); the instance is one of the session's or NULL.
         let (status, output) = unsafe { self.invoke(c, &op) };
@@ -115,7 +131,16 @@ impl<'a> Session<'a> {
         if let Some(violation) = LOG.with(|sink| sink.borrow_mut().violation.take()) {
             return Err(violation);
         }
+        if target == Target::Main && !c.is_null() {
+            let logged = LOG.with(|sink| sink.borrow().errors) > errors;
+            self.check_refusal(&op, status, logged)?;
+        }
         let ok = matches!(status, Some(OK | WARNING));
+        if target == Target::Main && !c.is_null() {
+            self.check_required(&op, status, ok)?;
+            self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
+            self.x_fresh = false;
+        }
         match (target, output) {
             (Target::Main, output) => self.observe(op, status, ok, output),
             (Target::Null, _) if ok => Err("returned fmi2OK or fmi2Warning for a NULL instance".into()),
@@ -123,6 +148,49 @@ impl<'a> Session<'a> {
                 self.states.foreign.push(p);
                 Ok(())
             }
+            _ => Ok(()),
+        }
+    }
+
+    /// `machine2`'s part of the oracle on a call to the main instance: a forbidden call returns
+    /// fmi2Error (`logged`: with a log message of that status).
+    fn check_refusal(&self, op: &Op, status: Option<Status>, logged: bool) -> Result<(), String> {
+        let Some(why) = crate::machine2::forbidden(op, &self.view, self.me, self.model) else { return Ok(()) };
+        let function = function(op);
+        match status {
+            Some(ERROR) if self.logger && !logged => {
+                Err(format!("{function} returned fmi2Error without a log message ({why})"))
+            }
+            Some(ERROR) | None => Ok(()),
+            Some(s) => Err(format!(
+                "{function} returned {}, but the call must fail: {why}",
+                crate::report::outcome(i64::from(s), false)
+            )),
+        }
+    }
+
+    /// `required`'s part of the oracle on a call to the main instance: the call must succeed.
+    fn check_required(&self, op: &Op, status: Option<Status>, ok: bool) -> Result<(), String> {
+        let (m, view, me) = (self.model, &self.view, self.me);
+        let why = match op {
+            Op::GetDirectionalDerivative { unknowns, knowns, dv_known, null_dv_unknown } => {
+                let call =
+                    Derivative { unknowns, knowns, seeds: dv_known, adjoint: false, outputs_right: !null_dv_unknown };
+                required::derivative(&call, view, me, m)
+            }
+            Op::SetReal { vr, values } => required::state_set(vr, values, view, me, m),
+            Op::GetDerivatives { n, null } | Op::GetNominalsOfContinuousStates { n, null } => {
+                required::initialization_getter(*n, *null, view, me, m)
+            }
+            Op::State(call) => required::state_call(call, &self.states),
+            _ => None,
+        };
+        match (why, status) {
+            (Some(why), Some(s)) if !ok => Err(format!(
+                "{} returned {}, but the call must succeed: {why}",
+                function(op),
+                crate::report::outcome(i64::from(s), false)
+            )),
             _ => Ok(()),
         }
     }
@@ -235,6 +303,7 @@ impl<'a> Session<'a> {
             Op::GetNominalsOfContinuousStates { n, null } => {
                 real_output(*n, *null, |p| f.fmi2GetNominalsOfContinuousStates(c, p, *n))
             }
+            Op::Oversized(o) => status(o.invoke2(f, c, self.model)),
         }
     }
 
@@ -265,6 +334,8 @@ impl<'a> Session<'a> {
             (Op::Instantiate(spec), Output::Instance(c)) => {
                 if !self.opened {
                     self.me = spec.fmu_type == MODEL_EXCHANGE;
+                    self.report.me = self.me;
+                    self.logger = spec.callbacks.is_some_and(|c| c.logger);
                 }
                 self.instantiated(c)?
             }
@@ -277,9 +348,16 @@ impl<'a> Session<'a> {
                 self.second = null_mut();
                 self.states.foreign.clear();
             }
+            (
+                Op::SetReal { vr, .. }
+                | Op::SetInteger { vr, .. }
+                | Op::SetBoolean { vr, .. }
+                | Op::SetString { vr, .. },
+                _,
+            ) if ok && required::tunes(&vr, self.model) => self.view.tuned = true,
             (Op::SetupExperiment { start, stop_defined, stop, .. }, _) if ok => {
                 let v = &mut self.view;
-                (v.time, v.stop, v.set_up) = (start, (stop_defined != 0).then_some(stop), true);
+                (v.time, v.start, v.stop, v.set_up) = (start, start, (stop_defined != 0).then_some(stop), true);
             }
             (Op::EnterInitializationMode, _) if ok => self.view.phase = Phase::Initialization,
             (Op::ExitInitializationMode, _) if ok => {
@@ -295,7 +373,7 @@ impl<'a> Session<'a> {
             (Op::GetEventIndicators { .. }, Output::Reals(v)) if ok => finite(&v, "fmi2GetEventIndicators")?,
             (Op::GetContinuousStates { .. }, Output::Reals(v)) if ok => {
                 finite(&v, "fmi2GetContinuousStates")?;
-                self.x = v;
+                (self.x, self.x_fresh) = (v, true);
             }
             (Op::GetNominalsOfContinuousStates { .. }, Output::Reals(v)) if ok => {
                 if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
@@ -353,6 +431,28 @@ impl<'a> Session<'a> {
     /// Simulated seconds left for the sequence.
     pub fn budget(&self) -> f64 {
         SIMULATION_BUDGET - self.simulated
+    }
+}
+
+/// The function an op calls, for messages.
+fn function(op: &Op) -> String {
+    match op {
+        Op::Oversized(o) => o.function(false),
+        Op::State(call) => call.name(false).to_owned(),
+        op => format!("fmi2{op:?}").split([' ', '(']).next().unwrap_or_default().to_owned(),
+    }
+}
+
+/// What the watch sees of a call that succeeded.
+fn seen<'a>(op: &'a Op, output: &'a Output) -> Seen<'a> {
+    match (op, output) {
+        (Op::GetReal { vr: Arr::Items(vr), null_values: false }, Output::Reals(v)) => Seen::Read(vr, v),
+        (Op::SetReal { vr: Arr::Items(vr), values: Arr::Items(v) }, _) => Seen::Set(vr, v),
+        (Op::DoStep { .. }, _) => Seen::Stepped,
+        (Op::GetEventIndicators { null: false, .. }, Output::Reals(v)) => Seen::EventIndicators(v),
+        (Op::GetContinuousStates { null: false, .. }, Output::Reals(v)) => Seen::ContinuousStates(v),
+        (Op::SetContinuousStates { x: Arr::Items(x) }, _) => Seen::SetStates(x),
+        _ => Seen::Other,
     }
 }
 

@@ -3,7 +3,8 @@
 //! - every function returns a valid fmi3Status (0..=4), and never fmi3OK or fmi3Warning for a
 //!   NULL instance;
 //! - a call that `machine3` says the standard forbids in the instance's state (or whose
-//!   arguments cannot be right) returns fmi3Error;
+//!   arguments cannot be right) returns fmi3Error; one that `required` says must succeed returns
+//!   fmi3OK or fmi3Warning; the expectations of the planner's probes (`watch`) hold;
 //! - every fmi3Error and fmi3Discard of an instance with a logger comes with a logMessage call of
 //!   that status during the call (discards only while logStatusDiscard or logAll is on), and so
 //!   does an instantiation that returns NULL;
@@ -13,7 +14,10 @@
 //!   too), fmi3Boolean outputs 0 or 1, strings non-NULL, the numbers of continuous states and
 //!   event indicators those of the XML; fmi3DoStep without early return or event handling and
 //!   with lastSuccessfulTime = currentCommunicationPoint + communicationStepSize (Discard: in
-//!   [currentCommunicationPoint, + communicationStepSize]);
+//!   [currentCommunicationPoint, + communicationStepSize]); a Discard leaves the instance as it
+//!   was (Step Mode, the same time) and a retry with a smaller step from that time is no error;
+//! - after any fmi3Error of the main instance, it is in Terminated (FMI 3.0 2.3.1), where
+//!   `machine3` allows only what Terminated allows;
 //! - fmi3GetVersion is "3.0"; the logger gets the instanceEnvironment given at instantiation, a
 //!   valid status and non-NULL strings (checked in `callbacks`);
 //! - the FMU state checks of `fmu_states`.
@@ -28,8 +32,10 @@ use crate::model_description::Description;
 use crate::ops::{Arr, Slot, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
 use crate::report::Report;
+use crate::required::{self, Derivative};
 use crate::session::{out, Target};
 use crate::view::{Phase, View};
+use crate::watch::{Seen, Watch};
 use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
@@ -72,9 +78,14 @@ pub struct Session3<'a> {
     pub me: bool,
     /// The continuous states fmi3GetContinuousStates last returned.
     pub x: Vec<f64>,
+    /// `x` was read by the last call to the main instance.
+    pub x_fresh: bool,
     pub view: View,
     pub states: FmuStates,
+    watch: Watch,
     simulated: f64,
+    /// The step size of the fmi3DoStep that returned fmi3Discard just before (at `view.time`).
+    pub discarded: Option<f64>,
     /// The main instance has a logMessage; discards are delivered (logStatusDiscard, logAll).
     logger: bool,
     discards_logged: bool,
@@ -92,9 +103,12 @@ impl<'a> Session3<'a> {
             opened: false,
             me: false,
             x: Vec::new(),
+            x_fresh: false,
             view: View::fresh(),
             states: FmuStates { fmi3: true, ..FmuStates::default() },
+            watch: Watch::default(),
             simulated: 0.0,
+            discarded: None,
             logger: false,
             discards_logged: true,
             all_logged: false,
@@ -133,22 +147,32 @@ impl<'a> Session3<'a> {
         if target == Target::Null {
             return if ok { Err("returned fmi3OK or fmi3Warning for a NULL instance".into()) } else { Ok(()) };
         }
-        if target == Target::Main && !c.is_null() && op.takes_instance() {
+        let live = target == Target::Main && !c.is_null() && op.takes_instance();
+        if live {
             self.check_status(&op, status, (errors, discards))?;
+            self.check_required(&op, status, ok)?;
+            self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
+            self.x_fresh = false;
+        }
+        if !matches!(op, Op3::DoStep { .. }) {
+            self.discarded = None;
         }
         match (target, output) {
-            (Target::Main, output) => self.observe(op, status, ok, output, errors),
-            (Target::Second, Output::Stateful(StateOutput::State(p))) if ok && !p.is_null() => {
-                self.states.foreign.push(p);
-                Ok(())
-            }
-            _ => Ok(()),
+            (Target::Main, output) => self.observe(op, status, ok, output, errors)?,
+            (Target::Second, Output::Stateful(StateOutput::State(p))) if ok && !p.is_null() => self.states.foreign.push(p),
+            _ => {}
         }
+        if live && status == Some(ERROR) {
+            // FMI 3.0 2.3.1: "If any function called in super state FMU State Settable returns
+            // fmi3Error, the FMU enters state Terminated" (issue 25 item 5).
+            self.view.phase = Phase::Terminated;
+        }
+        Ok(())
     }
 
     /// The state machine's and the logger's part of the oracle on a call to the main instance.
     fn check_status(&self, op: &Op3, status: Option<Status>, (errors, discards): (u64, u64)) -> Result<(), String> {
-        if let (Some(why), Some(s)) = (forbidden(op, self.view.phase, self.me, self.model), status) {
+        if let (Some(why), Some(s)) = (forbidden(op, &self.view, self.me, self.model), status) {
             if s != ERROR {
                 let call = op.describe();
                 let function = call.split([' ', '(']).next().unwrap_or_default();
@@ -160,8 +184,41 @@ impl<'a> Session3<'a> {
             Some(DISCARD) if self.logger && (self.discards_logged || self.all_logged) && discards == 0 => {
                 Err("returned fmi3Discard without a log message".into())
             }
+            Some(ERROR) if self.is_retry(op) => Err(format!(
+                "{} returned fmi3Error for a retry with a smaller step after fmi3Discard, which leaves the instance in Step Mode at the step's start (FMI 3.0 4.2.1)",
+                op.describe()
+            )),
             _ => Ok(()),
         }
+    }
+
+    /// `required`'s part of the oracle on a call to the main instance: the call must succeed.
+    fn check_required(&self, op: &Op3, status: Option<Status>, ok: bool) -> Result<(), String> {
+        let (m, view, me) = (self.model, &self.view, self.me);
+        let why = match op {
+            Op3::Derivative { adjoint, unknowns, knowns, seed, n_sensitivity, null_sensitivity } => {
+                let sensitivities = if *adjoint { knowns.len() } else { unknowns.len() };
+                let outputs_right = !null_sensitivity && *n_sensitivity == sensitivities;
+                let call = Derivative { unknowns, knowns, seeds: seed, adjoint: *adjoint, outputs_right };
+                required::derivative(&call, view, me, m).filter(|_| !adjoint || m.adjoint)
+            }
+            Op3::SetFloat64 { vr, values } => required::state_set(vr, values, view, me, m),
+            Op3::State(call) => required::state_call(call, &self.states),
+            _ => None,
+        };
+        match (why, status) {
+            (Some(why), Some(s)) if !ok => Err(format!("{} returned {}, but the call must succeed: {why}", op.describe(), name(s))),
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether `op` retries a discarded step: from the same time with a smaller step, in a view
+    /// that is certain.
+    fn is_retry(&self, op: &Op3) -> bool {
+        let Op3::DoStep { t, h, .. } = *op else { return false };
+        // A step below the time's resolution there cannot advance it (the FMU refuses it).
+        let advances = h > 16.0 * f64::EPSILON * t.abs();
+        self.discarded.is_some_and(|h0| self.view.phase == Phase::StepComplete && t == self.view.time && advances && h < h0)
     }
 
     /// Passes the arguments of `op` through the C ABI; output buffers are temporaries of the call.
@@ -262,6 +319,7 @@ impl<'a> Session3<'a> {
             }
             Op3::GetNumberOfContinuousStates { null } => count(*null, |p| f.fmi3GetNumberOfContinuousStates(c, p)),
             Op3::GetNumberOfEventIndicators { null } => count(*null, |p| f.fmi3GetNumberOfEventIndicators(c, p)),
+            Op3::Oversized(o) => status(o.invoke3(f, c, self.model)),
         }
     }
 
@@ -306,11 +364,16 @@ impl<'a> Session3<'a> {
                 self.view.phase = Phase::Broken
             }
             (_, _) if !ok => {}
+            (Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. }, _)
+                if required::tunes(&vr, self.model) =>
+            {
+                self.view.tuned = true
+            }
             (Op3::SetDebugLogging { logging_on, categories }, _) => self.debug_logging(logging_on, &categories),
             (Op3::EnterInitializationMode(e), _) => {
                 let v = &mut self.view;
-                (v.time, v.stop, v.set_up, v.phase) =
-                    (e.start, e.stop_defined.then_some(e.stop), true, Phase::Initialization);
+                (v.time, v.start, v.stop, v.set_up, v.phase) =
+                    (e.start, e.start, e.stop_defined.then_some(e.stop), true, Phase::Initialization);
             }
             (Op3::ExitInitializationMode, _) => {
                 self.view.phase = if self.me { Phase::EventMode } else { Phase::StepComplete }
@@ -324,7 +387,7 @@ impl<'a> Session3<'a> {
             (Op3::GetFloat64 { vr, .. }, Output::Reals(v)) => finite_values(self.model, &vr, &v)?,
             (Op3::GetContinuousStates { .. }, Output::Reals(v)) => {
                 finite(&v, "fmi3GetContinuousStates")?;
-                self.x = v;
+                (self.x, self.x_fresh) = (v, true);
             }
             (Op3::GetNominalsOfContinuousStates { .. }, Output::Reals(v)) => {
                 if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
@@ -369,6 +432,7 @@ impl<'a> Session3<'a> {
             self.opened = true;
             self.c = c;
             self.me = spec.interface == Interface3::ModelExchange;
+            self.report.me = self.me;
             (self.logger, self.all_logged) = (spec.logger, spec.logging_on);
             Ok(())
         } else if c.is_null() {
@@ -418,11 +482,27 @@ impl<'a> Session3<'a> {
             }
             _ => {}
         }
+        let before = self.view;
         self.simulated += self.view.stepped(t, h, status);
         if status == Some(DISCARD) {
-            self.view.time = last;
+            // FMI 3.0 2.2.4, 4.2.1 (issue 25 item 6): the instance stays as before the call,
+            // in Step Mode at t, so that a smaller step can be retried.
+            (self.view, self.discarded) = (before, Some(h));
         }
         Ok(())
+    }
+}
+
+/// What the watch sees of a call that succeeded.
+fn seen<'a>(op: &'a Op3, output: &'a Output) -> Seen<'a> {
+    match (op, output) {
+        (Op3::GetFloat64 { vr: Arr::Items(vr), null_values: false, .. }, Output::Reals(v)) if v.len() == vr.len() => Seen::Read(vr, v),
+        (Op3::SetFloat64 { vr: Arr::Items(vr), values: Arr::Items(v) }, _) => Seen::Set(vr, v),
+        (Op3::DoStep { .. }, _) => Seen::Stepped,
+        (Op3::GetEventIndicators { null: false, .. }, Output::Reals(v)) => Seen::EventIndicators(v),
+        (Op3::GetContinuousStates { null: false, .. }, Output::Reals(v)) => Seen::ContinuousStates(v),
+        (Op3::SetContinuousStates { x: Arr::Items(x) }, _) => Seen::SetStates(x),
+        _ => Seen::Other,
     }
 }
 

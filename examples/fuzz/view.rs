@@ -26,6 +26,11 @@ pub struct View {
     /// The instance time (NaN when unknown).
     pub time: f64,
     pub stop: Option<f64>,
+    /// The startTime of the experiment (NaN before it is set up).
+    pub start: f64,
+    /// A parameter was set since the instantiation or reset: its values may not fit together,
+    /// and what needs them (Initialization Mode's derivatives) may fail.
+    pub tuned: bool,
     pub set_up: bool,
     /// False for a state restored from bytes edited with the CRC recomputed.
     certain: bool,
@@ -34,12 +39,45 @@ pub struct View {
 impl View {
     /// Right after fmi2Instantiate or fmi2Reset.
     pub fn fresh() -> Self {
-        View { phase: Phase::Instantiated, time: 0.0, stop: None, set_up: false, certain: true }
+        View {
+            phase: Phase::Instantiated,
+            time: 0.0,
+            stop: None,
+            start: f64::NAN,
+            tuned: false,
+            set_up: false,
+            certain: true,
+        }
     }
 
     /// A state restored from bytes edited with the CRC recomputed: nothing is known about it.
     pub fn unknown() -> Self {
-        View { phase: Phase::Unknown, time: f64::NAN, stop: None, set_up: true, certain: false }
+        View {
+            phase: Phase::Unknown,
+            time: f64::NAN,
+            stop: None,
+            start: f64::NAN,
+            tuned: true,
+            set_up: true,
+            certain: false,
+        }
+    }
+
+    /// Whether the phase and time are known for certain (not from edited bytes).
+    pub fn certain(&self) -> bool {
+        self.certain && !matches!(self.phase, Phase::Unknown | Phase::Broken)
+    }
+
+    /// Why fmi2SetTime/fmi3SetTime(t) of a Model Exchange instance must fail, if it must: it is
+    /// allowed in Continuous-Time Mode only (FMI 2.0 3.2.3's table, whose note 8 on Event Mode is
+    /// for FMUs without continuous states; FMI 3.0 3.2.4: Event Mode does not list it), and a
+    /// time before the startTime is refused (issue 25 item 4).
+    pub fn set_time_refusal(&self, t: f64) -> Option<String> {
+        match self.phase {
+            Phase::Unknown | Phase::Broken => None,
+            Phase::ContinuousTime => (t < self.start).then(|| format!("time {t} before the startTime {}", self.start)),
+            _ => Some("SetTime is allowed only in Continuous-Time Mode".into()),
+        }
     }
 
     /// fmi2GetRealStatus(fmi2LastSuccessfulTime) returned `t`: the oracle's check of it.

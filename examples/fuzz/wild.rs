@@ -4,7 +4,8 @@
 //! points that do not match, input derivatives of any order and size, freed FMU states and states
 //! of a second instance, serialized states with a flipped bit, truncated, extended, random, or
 //! edited with the CRC recomputed, unknown log categories, NULL and non-UTF-8 strings; Model
-//! Exchange calls with NULL or wrongly sized arrays, special states and times.
+//! Exchange calls with NULL or wrongly sized arrays, special states and times; counts far larger
+//! than the arrays (`oversized`).
 
 use crate::callbacks::Callbacks;
 use crate::fmi2::{CO_SIMULATION, MODEL_EXCHANGE};
@@ -12,6 +13,7 @@ use crate::fmu_states::{FmuState, FmuStates, StateCall};
 use crate::view::View;
 use crate::model_description::{Description, Type, Variable, TYPES};
 use crate::ops::{Arr, Blob, Instantiation, Op, Slot, Text};
+use crate::oversized::Oversized;
 use crate::planner::Experiment;
 use crate::rng::Rng;
 use crate::session::Session;
@@ -37,6 +39,8 @@ pub const SPECIAL_REALS: [f64; 14] = [
 pub const SPECIAL_INTEGERS: [c_int; 8] = [0, 1, -1, 2, c_int::MIN, c_int::MAX, 1000, -1000];
 const SPECIAL_BOOLEANS: [c_int; 6] = [0, 1, 2, -1, 255, c_int::MIN];
 const STATUS_KINDS: [c_int; 7] = [0, 1, 2, 3, 4, -1, 99];
+/// The share of sequences on a Model Exchange instance (both versions).
+pub const ME_SHARE: f64 = 1.0 / 3.0;
 /// Valid instance names, some unusual.
 pub const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m", "%s%n%s", "a.b[1]"];
 
@@ -44,7 +48,8 @@ pub const INSTANCE_NAMES: [&str; 6] = ["fuzz", "fuzz", "fuzz", "B\u{f6}\u{f6}m",
 pub fn wild(rng: &mut Rng, s: &Session) -> Op {
     let m = s.model;
     let real = Type::Real;
-    match rng.below(38) {
+    match rng.below(40) {
+        38..=39 => Op::Oversized(Oversized::draw(rng, m, false)),
         0 => Op::GetTypesPlatform,
         1 => Op::GetVersion,
         2 => Op::SetDebugLogging { logging_on: wild_boolean(rng), categories: categories(rng, m) },
@@ -129,7 +134,7 @@ pub fn wild_count(rng: &mut Rng, n: usize) -> usize {
 pub fn instantiation(rng: &mut Rng, m: &Description) -> Instantiation {
     let mut spec = Instantiation {
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
-        fmu_type: if rng.chance(0.3) { MODEL_EXCHANGE } else { CO_SIMULATION },
+        fmu_type: if rng.chance(ME_SHARE) { MODEL_EXCHANGE } else { CO_SIMULATION },
         guid: Text::new(&m.guid),
         resources: rng.pick(&[Text::Null, Text::new("file:///tmp/"), Text::new("")]).clone(),
         callbacks: Some(Callbacks { logger: !rng.chance(0.1), memory: !rng.chance(0.2) }),

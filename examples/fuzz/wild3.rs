@@ -3,23 +3,26 @@
 //! states, damaged serialized states, any step) through the FMI 3.0 functions, plus nValues that
 //! differ from the number of value references, fmi3Boolean bytes other than 0 and 1, the types
 //! no variable has, the functions the FMUs do not provide, any function in any state, and
-//! instantiations with a wrong token, name, eventModeUsed or intermediate variables.
+//! instantiations with a wrong token, name, eventModeUsed or intermediate variables; counts far
+//! larger than the arrays (`oversized`).
 
 use crate::model_description::{Description, Type, Variable, TYPES};
 use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3, OTHER_TYPES, REFUSED};
+use crate::oversized::Oversized;
 use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::wild::{
     any_vr, array, bad_guid, categories, maybe_null, variables_of, vrs, wild_count, wild_experiment, wild_integer,
-    wild_real, wild_state_call, wild_step, wild_text, INSTANCE_NAMES,
+    wild_real, wild_state_call, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
 };
 
 /// Any of the functions with any arguments (fmi3FreeInstance through a second instance).
 pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
     let m = s.model;
     let real = Type::Real;
-    match rng.below(32) {
+    match rng.below(34) {
+        32..=33 => Op3::Oversized(Oversized::draw(rng, m, true)),
         0 => Op3::GetVersion,
         1 => Op3::SetDebugLogging { logging_on: rng.chance(0.5), categories: categories(rng, m) },
         2 => Op3::Instantiate(instantiation3(rng, m)),
@@ -119,7 +122,7 @@ fn wild_set3(rng: &mut Rng, m: &Description) -> Op3 {
 /// sometimes NULL), now and then with a wrong token, an empty, NULL or non-UTF-8 name,
 /// eventModeUsed or required intermediate variables.
 pub fn instantiation3(rng: &mut Rng, m: &Description) -> Instantiation3 {
-    let interface = if rng.chance(0.3) { Interface3::ModelExchange } else { Interface3::CoSimulation };
+    let interface = if rng.chance(ME_SHARE) { Interface3::ModelExchange } else { Interface3::CoSimulation };
     let mut spec = Instantiation3 {
         interface,
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
