@@ -286,3 +286,22 @@ fn an_input_stopped_at_its_bound_serialises() {
     assert_eq!(status, OK, "{}", c.last_error());
     assert_eq!(unsafe { api::free_fmu_state::<Pfc>(c.c, &mut st) }, OK);
 }
+
+/// A snapshot's computed values are not trusted (they are what the model computed, a non-finite
+/// one too, and every state the FMU wrote reads back): restored, the outputs are computed anew
+/// from the restored model, so a forged output (u = Inf) is never read; u is the untouched
+/// instance's, bit for bit.
+#[test]
+fn a_forged_output_in_a_snapshot_is_computed_anew() {
+    let c = Slave::<Pfc>::initialized("p", &[(pfc::P, 40e5)]);
+    assert_eq!(c.step(0.0, H), OK);
+    let mut bytes = common::serialized(&c);
+    forge_value::<Pfc>(&mut bytes, 2, f64::INFINITY);
+    let mut st = null_mut();
+    let status = unsafe { api::deserialize_fmu_state::<Pfc>(c.c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut st) };
+    assert_eq!(status, OK, "{}", c.last_error());
+    let u = c.real(pfc::U);
+    assert_eq!(unsafe { api::set_fmu_state::<Pfc>(c.c, st) }, OK);
+    assert_eq!(c.real(pfc::U).to_bits(), u.to_bits(), "u computed anew, not the forged inf");
+    assert_eq!(unsafe { api::free_fmu_state::<Pfc>(c.c, &mut st) }, OK);
+}

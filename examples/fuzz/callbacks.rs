@@ -20,6 +20,8 @@ pub struct LogSink {
     /// or discard comes with a message compares them before and after a call).
     pub discards: u64,
     pub errors: u64,
+    /// Whether the last Error or Fatal message refused the call as illegal in the state.
+    pub refused_by_state: bool,
     pub internal_errors: u64,
     pub first_internal_error: Option<String>,
     /// The first oracle violation in a logger call.
@@ -81,12 +83,15 @@ unsafe fn record(violation: Option<String>, status: c_int, category: *const c_ch
             sink.violation.get_or_insert(violation);
             return;
         }
+        let message = CStr::from_ptr(message);
         match status {
             2 => sink.discards += 1,
-            3..=4 => sink.errors += 1,
+            3..=4 => {
+                sink.errors += 1;
+                sink.refused_by_state = message.to_bytes().windows(21).any(|w| w == b"illegal call in state");
+            }
             _ => {}
         }
-        let message = CStr::from_ptr(message);
         if message.to_bytes().windows(15).any(|w| w == b"internal error:") {
             sink.internal_errors += 1;
             sink.first_internal_error.get_or_insert_with(|| message.to_string_lossy().into_owned());

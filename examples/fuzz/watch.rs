@@ -95,7 +95,13 @@ impl Watch {
             (Watch::State { index, value, after: None }, Seen::ContinuousStates(x)) => {
                 Watch::State { index, value, after: Some(x.to_vec()) }
             }
-            (Watch::State { index, value, after: Some(after) }, Seen::SetStates(x)) if x.get(index) == Some(&value) => {
+            // The comparison: SetContinuousStates of the states the set by reference gave (the
+            // other states as they were then), not any later set that happens to share the value.
+            (Watch::State { index, value, after: Some(after) }, Seen::SetStates(x))
+                if x.get(index) == Some(&value)
+                    && x.len() == after.len()
+                    && x.iter().zip(&after).enumerate().all(|(k, (a, b))| k == index || a == b) =>
+            {
                 Watch::Whole { index, after }
             }
             (Watch::Whole { index, after }, Seen::ContinuousStates(x)) => {

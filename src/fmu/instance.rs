@@ -2,8 +2,8 @@
 //! [`super::api`] wraps these methods in the C ABI.
 
 use super::log::{num, Logger, Status};
-use super::model::{initial_unknown, Log, Model};
 use super::machine::{Interface, Mode};
+use super::model::{initial_unknown, Log, Model};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
 use std::borrow::Cow;
@@ -427,12 +427,12 @@ impl<M: Model> Instance<M> {
     }
 
     /// The directional derivative in Initialization Mode, where the start state is computed
-    /// from the parameters by [`Model::initialize`] (not a function of dual numbers): a central
-    /// difference along the seed (FMI 2.0, 2.1.9: "may compute the directional derivatives by
-    /// numerical differentiation"). The step moves each known by about 6e-6 of its magnitude
-    /// (cube root of the unit round-off: truncation and round-off errors balance at ~1e-10
-    /// relative), where a known at or near 0 counts with a thousandth of its range; one-sided
-    /// (error ~6e-6 relative) where a known sits at a bound of its range.
+    /// from the parameters by [`Model::initialize`] (not a function of dual numbers): the sum
+    /// over the seeded knowns of the seed times a difference quotient in that known (FMI 2.0,
+    /// 2.1.9: "may compute the directional derivatives by numerical differentiation"). Central
+    /// with a step of 6e-6 of the known's magnitude (cube root of the unit round-off: truncation
+    /// and round-off errors balance at ~1e-10 relative; a known at or near 0 counts with a
+    /// thousandth of its range), one-sided (error ~6e-6 relative) where it sits at a bound.
     fn initial_derivative(
         &self,
         unknowns: &[u32],
@@ -441,42 +441,31 @@ impl<M: Model> Instance<M> {
         out: &mut [f64],
     ) -> Result<(), String> {
         let values = &self.core.values;
-        let magnitude = |r: u32| -> Result<f64, String> {
-            let (_, v) = self.lookup(r, BaseType::Real)?;
-            let width = match v.kind {
-                Kind::Real { min, max, .. } if (max - min).is_finite() => 1e-3 * (max - min),
-                _ => 1.0,
+        out.fill(0.0);
+        let mut base = None;
+        for (&r, &seed) in knowns.iter().zip(seeds).filter(|(_, d)| **d != 0.0) {
+            let (i, var) = self.lookup(r, BaseType::Real)?;
+            let (x, width) = match var.kind {
+                Kind::Real { min, max, .. } if (max - min).is_finite() => (values.real(r), 1e-3 * (max - min)),
+                _ => (values.real(r), 1.0),
             };
-            Ok(values.real(r).abs().max(width))
-        };
-        let mut scale: f64 = 0.0;
-        for (&r, d) in knowns.iter().zip(seeds).filter(|(_, d)| **d != 0.0) {
-            scale = scale.max(d.abs() / magnitude(r)?);
-        }
-        if scale == 0.0 {
-            out.fill(0.0);
-            return Ok(());
-        }
-        let h = f64::EPSILON.cbrt() / scale;
-        let at = |step: f64| -> Result<Vec<f64>, String> {
-            let mut v = values.clone();
-            for (&r, d) in knowns.iter().zip(seeds) {
-                let (i, var) = self.lookup(r, BaseType::Real)?;
-                let x = Value::Real(v.real(r) + step * d);
+            let h = f64::EPSILON.cbrt() * x.abs().max(width);
+            let at = |x: f64| -> Result<Vec<f64>, String> {
+                let x = Value::Real(x);
                 in_range(var, &x)?;
+                let mut v = values.clone();
                 v.put(i, x);
+                initial_values::<M>(&v, unknowns)
+            };
+            let (hi, lo, span) = match (at(x + h), at(x - h)) {
+                (Ok(p), Ok(m)) => (p, m, 2.0 * h),
+                (Ok(p), Err(_)) => (p, base.get_or_insert(initial_values::<M>(values, unknowns)?).clone(), h),
+                (Err(_), Ok(m)) => (base.get_or_insert(initial_values::<M>(values, unknowns)?).clone(), m, h),
+                (Err(e), Err(_)) => return Err(format!("no start state near these values: {e}")),
+            };
+            for ((o, a), b) in out.iter_mut().zip(hi).zip(lo) {
+                *o += seed * (a - b) / span;
             }
-            initial_values::<M>(&v, unknowns)
-        };
-        let (plus, minus) = (at(h), at(-h));
-        let (hi, lo, span) = match (plus, minus) {
-            (Ok(p), Ok(m)) => (p, m, 2.0 * h),
-            (Ok(p), Err(_)) => (p, initial_values::<M>(values, unknowns)?, h),
-            (Err(_), Ok(m)) => (initial_values::<M>(values, unknowns)?, m, h),
-            (Err(e), Err(_)) => return Err(format!("no start state near these values: {e}")),
-        };
-        for ((o, a), b) in out.iter_mut().zip(hi).zip(lo) {
-            *o = (a - b) / span;
         }
         Ok(())
     }

@@ -12,9 +12,9 @@
 
 use super::instance::{in_range, Core, TOLERANCE_RANGE};
 use super::log::num;
-use super::model::Model;
 use super::machine::Mode;
-use super::variables::{Value, Values};
+use super::model::Model;
+use super::variables::{Causality, Value, Values, Variable};
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.
@@ -130,7 +130,8 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         Ok(some.then_some(x))
     };
     let (stop_time, tolerance) = (opt()?, opt()?);
-    let outputs_current = r.take(1)?[0] != 0;
+    // Computed values are not trusted: they are computed anew before a get (see below).
+    let _outputs_current = r.take(1)?[0] != 0;
     let mut values = Values::new(M::VARIABLES);
     let count = r.u64()? as usize;
     if count != M::VARIABLES.len() {
@@ -154,32 +155,40 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         };
         values.put(i, v);
     }
-    // A model that left its valid range ended in the Error state (FMI 3.0: Terminated) with the
-    // non-finite values it computed, for debugging (FMI 2.0, 2.1.3); such a state reads back.
-    let broken = matches!(state, Mode::Error | Mode::Terminated);
-    for (v, x) in M::VARIABLES.iter().zip(values.all()) {
-        if !(broken && matches!(x, Value::Real(r) if !r.is_finite())) {
-            in_range(v, x).map_err(|e| format!("the serialised FMU state holds {e}"))?;
-        }
+    // What the importer sets (parameters, inputs) is checked as fmi2SetReal checks it; what the
+    // model computed (outputs, locals, der()) is whatever it was, a non-finite value too (a
+    // model outside its valid range, a derivative Model Exchange answered with fmi2Discard), and
+    // is computed anew from the restored model before the next get (`outputs_current` false), so
+    // a forged one is never read.
+    let settable = |v: &Variable| matches!(v.causality, Causality::Parameter | Causality::Input);
+    for (v, x) in M::VARIABLES.iter().zip(values.all()).filter(|(v, _)| settable(v)) {
+        in_range(v, x).map_err(|e| format!("the serialised FMU state holds {e}"))?;
     }
     check_times(time, start_time, last_successful_time, stop_time, tolerance)?;
     let input_derivatives = (0..count).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
     if let Some(i) = input_derivatives.iter().position(|d| !d.is_finite()) {
         return Err(format!("the serialised FMU state holds a non-finite derivative of \"{}\"", M::VARIABLES[i].name));
     }
+    let broken = matches!(state, Mode::Error | Mode::Terminated | Mode::StepFailed);
     let model = match r.take(1)?[0] {
         0 => None,
         _ => {
             let n = r.u64()? as usize;
             let s = (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>()?;
-            Some(M::load(&values, &s)?)
+            // A model a failed step or an error broke may not load (its solver stopped at NaN):
+            // the state reads back without it, in StepFailed, Error or Terminated, where no step
+            // follows (only gets, terminate, reset and restore).
+            match M::load(&values, &s) {
+                Err(_) if broken => None,
+                loaded => Some(loaded?),
+            }
         }
     };
     if r.at != body.len() {
         return Err(format!("{} unexpected bytes after the state", body.len() - r.at));
     }
     // A model exists exactly once initialisation has ended; Error and Terminated may come before
-    // it (a panic, FMI 3.0: any fmi3Error) and so may lack one.
+    // it (a panic, FMI 3.0: any fmi3Error), and a broken one may not load (above).
     let initialised = !matches!(state, Mode::Instantiated | Mode::InitializationMode);
     if model.is_some() != initialised && !broken {
         return Err(format!("state {state:?} {} a model", if initialised { "needs" } else { "cannot have" }));
@@ -194,7 +203,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         stop_time,
         tolerance,
         last_successful_time,
-        outputs_current,
+        outputs_current: false,
         derivatives_current: false,
     })
 }
