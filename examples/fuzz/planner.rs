@@ -208,22 +208,14 @@ impl Planner {
             return if rng.chance(0.7) { Op::Terminate } else { Op::Reset };
         }
         let phase = Phase::ContinuousTime;
-        let pending = std::mem::take(&mut self.by_reference) && s.x_fresh;
-        let probe = match rng.below(100) {
-            _ if pending => probes::state_by_reference(rng, m, &s.x),
-            0..=2 => probes::event_locals(m),
-            3..=5 if s.x_fresh => probes::state_by_reference(rng, m, &s.x),
-            3..=5 => {
-                // The states first: the probe starts from them.
-                self.by_reference = true;
-                vec![Probe::GetContinuousStates]
-            }
-            6..=7 => {
-                self.round_trip.start();
-                probes::time_back(rng, &s.view, self.h)
-            }
-            _ => Vec::new(),
-        };
+        let probe = probes::integrating(
+            rng,
+            m,
+            (&s.x, s.x_fresh),
+            (&s.view, self.h),
+            &mut self.by_reference,
+            &mut self.round_trip,
+        );
         if let Some(op) = self.probe(phase, probe, m) {
             return op;
         }

@@ -71,6 +71,36 @@ pub fn state_by_reference(rng: &mut Rng, m: &Description, x: &[f64]) -> Vec<Prob
     ]
 }
 
+/// The probes of one step of an integrator in Continuous-Time Mode (both versions): now and
+/// then the event locals, a state set by its value reference (the states read first where the
+/// last ones are stale; `by_reference` remembers the wish), or the time set back with an FMU
+/// state round trip after it.
+pub fn integrating(
+    rng: &mut Rng,
+    m: &Description,
+    (x, x_fresh): (&[f64], bool),
+    (view, h): (&View, f64),
+    by_reference: &mut bool,
+    round_trip: &mut RoundTrip,
+) -> Vec<Probe> {
+    let pending = std::mem::take(by_reference) && x_fresh;
+    match rng.below(100) {
+        _ if pending => state_by_reference(rng, m, x),
+        0..=2 => event_locals(m),
+        3..=5 if x_fresh => state_by_reference(rng, m, x),
+        3..=5 => {
+            // The states first: the probe starts from them.
+            *by_reference = true;
+            vec![Probe::GetContinuousStates]
+        }
+        6..=7 => {
+            round_trip.start();
+            time_back(rng, view, h)
+        }
+        _ => Vec::new(),
+    }
+}
+
 /// Model Exchange: the time set back by up to `h`, not before the startTime (the round trip
 /// follows).
 pub fn time_back(rng: &mut Rng, view: &View, h: f64) -> Vec<Probe> {
