@@ -20,8 +20,9 @@ pub struct LogSink {
     /// or discard comes with a message compares them before and after a call).
     pub discards: u64,
     pub errors: u64,
-    /// Whether the last Error or Fatal message refused the call as illegal in the state.
-    pub refused_by_state: bool,
+    /// The last Error or Fatal message (the oracle tells a refusal the standard allows, such as
+    /// a state outside the model's domain, from one it forbids, such as an illegal call).
+    pub last_error: String,
     pub internal_errors: u64,
     pub first_internal_error: Option<String>,
     /// The first oracle violation in a logger call.
@@ -35,6 +36,11 @@ thread_local! {
 /// The componentEnvironment given to fmi2Instantiate (FMI 3.0: instanceEnvironment): the logger
 /// checks that it comes back.
 static ENVIRONMENT: u8 = 0;
+
+/// Whether the last Error or Fatal message contains `text`.
+pub fn last_error_says(text: &str) -> bool {
+    LOG.with(|l| l.borrow().last_error.contains(text))
+}
 
 pub fn environment() -> *mut c_void {
     &ENVIRONMENT as *const u8 as *mut c_void
@@ -88,7 +94,7 @@ unsafe fn record(violation: Option<String>, status: c_int, category: *const c_ch
             2 => sink.discards += 1,
             3..=4 => {
                 sink.errors += 1;
-                sink.refused_by_state = message.to_bytes().windows(21).any(|w| w == b"illegal call in state");
+                sink.last_error = message.to_string_lossy().into_owned();
             }
             _ => {}
         }

@@ -54,9 +54,13 @@ pub fn derivative(d: &Derivative, view: &View, me: bool, m: &Description) -> Opt
     }
 }
 
-/// Why setting Reals must succeed, if it must: continuous states of a Model Exchange instance
-/// in Continuous-Time Mode, finite values.
+/// Why setting Reals must not be refused as unsettable, if it must not: continuous states of a
+/// Model Exchange instance in Continuous-Time Mode, finite values (the model may still refuse a
+/// state outside its domain, as fmi2SetContinuousStates does, naming it; not "cannot set").
 pub fn state_set(vr: &Arr<u32>, values: &Arr<f64>, view: &View, me: bool, m: &Description) -> Option<&'static str> {
+    if !crate::callbacks::last_error_says("cannot set") {
+        return None;
+    }
     let (Arr::Items(vr), Arr::Items(values)) = (vr, values) else { return None };
     let states = !vr.is_empty() && vr.len() == values.len() && vr.iter().all(|r| m.state_vrs.contains(r));
     let now = me && view.phase == Phase::ContinuousTime && view.certain();

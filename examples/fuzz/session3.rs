@@ -24,7 +24,7 @@
 //!
 //! Crashes and hangs are caught by `batch`, leaks by `sequence`.
 
-use crate::callbacks::{environment, log_message, LOG};
+use crate::callbacks::{environment, last_error_says, log_message, LOG};
 use crate::fmi3::{Fmi3, Instance, Library, Status};
 use crate::fmu_states::{FmuStates, StateCall, StateOutput};
 use crate::machine3::forbidden;
@@ -186,7 +186,7 @@ impl<'a> Session3<'a> {
             }
             // The retry may fail on its own (the model leaving its range), but not as a call the
             // state forbids.
-            Some(ERROR) if self.is_retry(op) && LOG.with(|l| l.borrow().refused_by_state) => Err(format!(
+            Some(ERROR) if self.is_retry(op) && last_error_says("illegal call in state") => Err(format!(
                 "{} was refused as illegal in its state, a retry with a smaller step after fmi3Discard, which leaves the instance in Step Mode at the step's start (FMI 3.0 4.2.1)",
                 op.describe()
             )),
