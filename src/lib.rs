@@ -1,8 +1,13 @@
 //! boomsim: the hydraulically actuated boom of the thesis "Stabilization of hydraulically actuated
-//! boom using pressure feedback" as FMI 2.0 Co-Simulation FMUs.
+//! boom using pressure feedback" as FMUs with a C ABI: FMI 2.0 and 3.0, Model Exchange and
+//! Co-Simulation in one .fmu.
 //!
 //! Physics lives in [`hydraulics`], [`mechanics`] and [`control`] and knows nothing about FMI;
-//! [`models`] composes it into FMU models; [`fmi2`] exposes any model through the C ABI.
+//! [`models`] composes it into FMU models; [`fmu`] is what both FMI versions share (the model
+//! contract, the instance and its state machine, the bodies of the C calls), and [`fmi2`] and
+//! [`fmi3`] export any model through their C functions. Beside the runtime: the packer and
+//! documentation ([`fmu::pack`]), the bench, the native scenario runner ([`cosim`]) and the
+//! linear analysis ([`analysis`]) of the `boomsim` binary.
 
 pub mod analysis;
 /// Timing through dlopen: Unix only (the library itself builds for every platform).

@@ -1,6 +1,6 @@
-//! The model contract: what a physics model provides so that [`crate::fmi2`] can export it as
-//! Model Exchange (its continuous states, their derivatives, its outputs) and as Co-Simulation
-//! (a step of its own, with the internal solver).
+//! The model contract: what a physics model provides so that [`crate::fmi2`] and
+//! [`crate::fmi3`] can export it as Model Exchange (its continuous states, their derivatives, its
+//! outputs) and as Co-Simulation (a step of its own, with the internal solver).
 
 use super::variables::{Causality, Initial, Value, Values, Variable};
 

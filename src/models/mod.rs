@@ -1,4 +1,5 @@
-//! The FMU models: each struct composes the physics and implements [`crate::fmi2::Model`].
+//! The FMU models: each struct composes the physics and implements [`crate::fmu::Model`], the
+//! contract both FMI versions export.
 
 pub mod boom;
 pub mod boom_mechanics;
