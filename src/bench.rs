@@ -6,7 +6,7 @@
 //! as an importer would.
 
 use crate::fmi2::types::*;
-use crate::fmi2::{guid::guid, Model, Value};
+use crate::fmu::{guid::guid, Model, Value};
 pub use crate::fmu::in_process::{InProcess, Slave};
 use crate::models::hydraulic_boom::vr as hb;
 use crate::models::pressure_feedback_controller::vr as pfc;

@@ -8,10 +8,10 @@
 
 mod common;
 
-use boomsim::fmi2::instance::Instance;
-use boomsim::fmi2::variables::BaseType;
+use boomsim::fmu::instance::Instance;
+use boomsim::fmu::variables::BaseType;
 use boomsim::fmi2::xml::initial_dependencies;
-use boomsim::fmi2::{Causality, Initial, Kind, Model, Value};
+use boomsim::fmu::{Causality, Initial, Kind, Model, Value};
 use boomsim::models::vr;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController};
 use std::collections::{BTreeMap, BTreeSet};
@@ -138,7 +138,7 @@ fn boom_mechanics_dependencies_are_exact() {
 /// Moves of 1e-3 and 1e-6 nominal, both signs, at 10 times per run; a change above 1e-12
 /// relative counts (round-off of a recomputation is below 1e-15).
 fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
-    let declared = boomsim::fmi2::xml::dependencies::<M>(&boomsim::fmi2::structure::probe::<M>());
+    let declared = boomsim::fmi2::xml::dependencies::<M>(&boomsim::fmu::structure::probe::<M>());
     let name = |r: u32| M::VARIABLES.iter().find(|v| v.vr == r).map_or("?", |v| v.name);
     let mut missing = BTreeSet::new();
     for setup in configurations {
@@ -153,7 +153,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
             let mut model = i.core.model.clone().unwrap();
             let mut x = vec![0.0; M::STATES.len()];
             model.continuous_states(&mut x);
-            let base = boomsim::fmi2::structure::unknowns(&model, &values);
+            let base = boomsim::fmu::structure::unknowns(&model, &values);
             let moved = |known: u32, unknowns: Vec<(u32, f64)>, missing: &mut BTreeSet<_>| {
                 for ((r, a), (_, b)) in base.iter().zip(unknowns) {
                     if (a - b).abs() > 1e-12 * a.abs().max(b.abs()).max(1e-300) && !declared[r].contains(&known) {
@@ -166,7 +166,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
                     let mut y = x.clone();
                     y[j] += d * s.nominal;
                     if model.set_continuous_states(&y).is_ok() {
-                        moved(s.state, boomsim::fmi2::structure::unknowns(&model, &values), &mut missing);
+                        moved(s.state, boomsim::fmu::structure::unknowns(&model, &values), &mut missing);
                     }
                 }
             }
@@ -174,7 +174,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
             for input in M::VARIABLES.iter().filter(|v| v.causality == Causality::Input) {
                 let mut v = values.clone();
                 v.set_real(input.vr, perturbed(input.kind, values.real(input.vr)));
-                moved(input.vr, boomsim::fmi2::structure::unknowns(&model, &v), &mut missing);
+                moved(input.vr, boomsim::fmu::structure::unknowns(&model, &v), &mut missing);
             }
         }
     }

@@ -12,10 +12,10 @@
 mod common;
 
 use boomsim::fmi2::api;
-use boomsim::fmi2::structure::{probe, unknowns};
+use boomsim::fmu::structure::{probe, unknowns};
 use boomsim::fmi2::types::*;
 use boomsim::fmi2::xml::dependencies;
-use boomsim::fmi2::{Causality, Kind, Model, Value, Values};
+use boomsim::fmu::{Causality, Kind, Model, Value, Values};
 use boomsim::models::vr;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit};
 
@@ -210,7 +210,7 @@ fn directional_derivative_arguments_are_checked() {
 fn initialization_mode_derivatives_follow_the_start_equilibrium() {
     let (start_p4, d_piston, d_rod) = (32, 120, 121);
     for fmu_type in [FMI2_COSIMULATION, FMI2_MODEL_EXCHANGE] {
-        let s = common::Slave::<HydraulicBoom>::try_new("init", &boomsim::fmi2::guid::guid::<HydraulicBoom>(), fmu_type)
+        let s = common::Slave::<HydraulicBoom>::try_new("init", &boomsim::fmu::guid::guid::<HydraulicBoom>(), fmu_type)
             .unwrap();
         unsafe {
             assert_eq!(api::setup_experiment::<HydraulicBoom>(s.c, 0, 0.0, 0.0, 0, 0.0), fmi2Status::OK);

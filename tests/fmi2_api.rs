@@ -4,9 +4,9 @@
 mod common;
 
 use boomsim::fmi2::api;
-use boomsim::fmi2::guid::guid;
+use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
-use boomsim::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
+use boomsim::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::PressureFeedbackController as Pfc;
 use common::Slave;

@@ -2,7 +2,7 @@
 //! instantiation, stepping, and the controller's analytic step response.
 //! Needs `boomsim pack` first (scripts/test runs it).
 
-use boomsim::fmi2::guid::guid;
+use boomsim::fmu::guid::guid;
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::PressureFeedbackController;
 use fmi::fmi2::import::Fmi2Import;

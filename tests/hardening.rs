@@ -8,7 +8,7 @@ mod common;
 
 use boomsim::fmi2::api;
 use boomsim::fmi2::types::*;
-use boomsim::fmi2::Model;
+use boomsim::fmu::Model;
 use boomsim::mechanics::params::BoomParams;
 use boomsim::mechanics::rigid_boom::RigidBoom;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
@@ -47,7 +47,7 @@ fn index_of<M: Model>(name: &str) -> (usize, u32) {
 
 /// Every Real of the table, read through fmi2GetReal: all must be there and finite.
 fn all_reals<M: Model>(s: &Slave<M>) -> Vec<f64> {
-    M::VARIABLES.iter().filter(|v| matches!(v.kind, boomsim::fmi2::Kind::Real { .. })).map(|v| s.real(v.vr)).collect()
+    M::VARIABLES.iter().filter(|v| matches!(v.kind, boomsim::fmu::Kind::Real { .. })).map(|v| s.real(v.vr)).collect()
 }
 
 /// BoomMechanics alone with its default input (cylinder.F = 0) used to fall through the bottom
@@ -111,7 +111,7 @@ fn input_slopes_stop_at_the_declared_range() {
     assert_eq!(h.step(0.0, H), WARN);
     assert_eq!(h.real(vr::V), 10.0, "cylinder.v stops at its maximum 10 m/s");
     let x = HydraulicCircuit::VARIABLES.iter().find(|v| v.vr == vr::X).unwrap();
-    let boomsim::fmi2::Kind::Real { max: x_max, .. } = x.kind else { panic!("cylinder.x is a Real") };
+    let boomsim::fmu::Kind::Real { max: x_max, .. } = x.kind else { panic!("cylinder.x is a Real") };
     assert_eq!(h.real(vr::X), x_max, "cylinder.x stops at its declared maximum");
     assert!(all_reals(&h).iter().all(|x| x.is_finite()));
 }

@@ -31,9 +31,10 @@
 //!
 //! Run: `cargo test --release --test leaks -- --nocapture` (prints the measured numbers).
 
-use boomsim::fmi2::guid::guid;
+use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
-use boomsim::fmi2::{api, Model};
+use boomsim::fmi2::api;
+use boomsim::fmu::Model;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::ffi::{CStr, CString};

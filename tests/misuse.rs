@@ -15,7 +15,7 @@
 mod common;
 
 use boomsim::fmi2::api;
-use boomsim::fmi2::guid::guid;
+use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::{HydraulicBoom, PressureFeedbackController as Pfc};

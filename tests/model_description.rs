@@ -1,7 +1,7 @@
 //! modelDescription.xml: the committed files are the generator's output, and every variable
 //! table obeys the FMI 2.0 rules the generator relies on.
 
-use boomsim::fmi2::{Causality, Kind, Variable};
+use boomsim::fmu::{Causality, Kind, Variable};
 use boomsim::fmu::Version;
 use boomsim::models;
 use boomsim::units::unit;
@@ -41,7 +41,7 @@ fn check_table(id: &str, vars: &[Variable]) {
 
 #[test]
 fn variable_tables_obey_fmi_rules() {
-    use boomsim::fmi2::Model;
+    use boomsim::fmu::Model;
     check_table("PressureFeedbackController", models::PressureFeedbackController::VARIABLES);
     check_table("HydraulicBoom", models::HydraulicBoom::VARIABLES);
 }
@@ -50,11 +50,11 @@ fn variable_tables_obey_fmi_rules() {
 /// states" while the default was the flexible arm): it follows `boom.flexible`'s start value.
 #[test]
 fn the_documentation_names_the_default_boom() {
-    use boomsim::fmi2::Model;
+    use boomsim::fmu::Model;
     use boomsim::models::HydraulicBoom;
     let flexible = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "boom.flexible").unwrap();
     let Kind::Boolean { start } = flexible.kind else { panic!("boom.flexible is a Boolean") };
-    let doc = boomsim::fmi2::pack::documentation::<HydraulicBoom>(Version::Fmi2, &boomsim::platform::PLATFORMS);
+    let doc = boomsim::fmu::pack::documentation::<HydraulicBoom>(Version::Fmi2, &boomsim::platform::PLATFORMS);
     let says = if start { "by default the lumped flexible" } else { "by default the rigid" };
     assert!(doc.contains(says), "the documentation does not say \"{says}\"");
     assert!(!doc.contains("eight states"));
@@ -80,10 +80,10 @@ fn every_fmu_carries_the_project_version() {
 /// thesis' valve, not only 0.0004166666666666667 m3/s).
 #[test]
 fn the_page_states_generated_facts() {
-    use boomsim::fmi2::{guid::guid, Model};
+    use boomsim::fmu::{guid::guid, Model};
     use boomsim::models::PressureFeedbackController as Pfc;
     let platforms = &boomsim::platform::PLATFORMS[..2];
-    let page = boomsim::fmi2::pack::documentation::<Pfc>(Version::Fmi2, platforms);
+    let page = boomsim::fmu::pack::documentation::<Pfc>(Version::Fmi2, platforms);
     assert!(page.contains(&guid::<Pfc>()));
     assert!(page.contains("<td>linux64, win64</td>"), "platforms");
     assert!(page.contains("(25 l/min)"), "Q_rated in l/min");
@@ -94,7 +94,7 @@ fn the_page_states_generated_facts() {
 /// The two halves of the cut carry the same coupling recipe (start.F, Z_c, step order, end stops).
 #[test]
 fn the_split_models_pages_carry_the_coupling_recipe() {
-    use boomsim::fmi2::pack::documentation;
+    use boomsim::fmu::pack::documentation;
     use boomsim::models::{BoomMechanics, HydraulicCircuit};
     for page in
         [documentation::<HydraulicCircuit>(Version::Fmi2, &[]), documentation::<BoomMechanics>(Version::Fmi2, &[])]
@@ -111,8 +111,8 @@ fn the_split_models_pages_carry_the_coupling_recipe() {
 /// are the analytic ones to their rounding. HydraulicBoom's lowering run ends lower than it starts.
 #[test]
 fn the_pages_figures_follow_the_models() {
-    use boomsim::fmi2::pack::documentation;
-    use boomsim::fmi2::Model;
+    use boomsim::fmu::pack::documentation;
+    use boomsim::fmu::Model;
     use boomsim::models::{HydraulicCircuit, PressureFeedbackController as Pfc};
     let names = [
         "p1",

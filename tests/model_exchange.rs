@@ -6,7 +6,7 @@ mod common;
 
 use boomsim::fmi2::api;
 use boomsim::fmi2::types::*;
-use boomsim::fmi2::Model;
+use boomsim::fmu::Model;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
 use boomsim::models::{vr, BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
 use common::Slave;
@@ -17,7 +17,7 @@ const ERR: fmi2Status = fmi2Status::Error;
 
 /// A Model Exchange instance of `M`.
 fn model<M: Model>(name: &str) -> Slave<M> {
-    Slave::<M>::try_new(name, &boomsim::fmi2::guid::guid::<M>(), FMI2_MODEL_EXCHANGE).expect("instantiates")
+    Slave::<M>::try_new(name, &boomsim::fmu::guid::guid::<M>(), FMI2_MODEL_EXCHANGE).expect("instantiates")
 }
 
 /// A HydraulicBoom ME instance set up at t = 0, in Initialization Mode.

@@ -3,7 +3,7 @@
 //! load at rest held, bad values refused.
 
 use boomsim::bench::{case_b, case_u, InProcess, Slave, RTOL, STEP};
-use boomsim::fmi2::Value;
+use boomsim::fmu::Value;
 use boomsim::models::hydraulic_boom::vr as hb;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController};
@@ -110,7 +110,7 @@ fn real_time_lowering_follows_the_adaptive_mode() {
 /// and the valid range, in every plant model.
 #[test]
 fn bad_solver_settings_are_refused() {
-    fn refuse<M: boomsim::fmi2::Model>(vr: u32, x: i32, says: &str) {
+    fn refuse<M: boomsim::fmu::Model>(vr: u32, x: i32, says: &str) {
         let e = InProcess::<M>::new(RTOL, &[(vr, Value::Integer(x))]).err().expect("refused");
         assert!(e.contains(says), "{}: {e}", M::INFO.identifier);
     }

@@ -2,7 +2,7 @@
 //! (central differences), as natural frequencies and damping ratios.
 
 use crate::analysis::poly::eigenvalues;
-use crate::fmi2::{Model, Value, Values};
+use crate::fmu::{Model, Value, Values};
 use crate::models::hydraulic_boom::{vr, Plant};
 use crate::models::HydraulicBoom;
 use crate::solver::OdeSystem;

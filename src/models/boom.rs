@@ -3,8 +3,8 @@
 
 use super::table::param_value;
 use super::vr;
-use crate::fmi2::log::num;
-use crate::fmi2::{Value, Values};
+use crate::fmu::log::num;
+use crate::fmu::{Value, Values};
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
 use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
 use crate::mechanics::rigid_boom::RigidBoom;

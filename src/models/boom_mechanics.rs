@@ -13,7 +13,7 @@ use super::boom::Boom;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
 use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION};
-use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;

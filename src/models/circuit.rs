@@ -3,7 +3,7 @@
 
 use super::table::param_value;
 use super::vr;
-use crate::fmi2::Values;
+use crate::fmu::Values;
 use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
 use crate::scalar::Scalar;
 

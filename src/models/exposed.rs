@@ -8,7 +8,7 @@
 //! theta2 in every slot (its Co-Simulation solver keeps the stroke, see [`super::boom::Boom`]).
 
 use super::vr;
-use crate::fmi2::{ContinuousState, Variable};
+use crate::fmu::{ContinuousState, Variable};
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::scalar::Dual64;
 

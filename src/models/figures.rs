@@ -3,7 +3,7 @@
 //! through the FMI layer (the same instance code an importer drives).
 
 use super::vr;
-use crate::fmi2::{Value, Variable};
+use crate::fmu::{Value, Variable};
 use crate::fmu::chart::{chart, escape, Panel};
 use crate::fmu::in_process::{InProcess, Slave};
 use crate::fmu::log::num;

@@ -17,7 +17,7 @@ use super::exposed::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
 use super::table::{
     out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_P4, START_STROKE, U_REF_INPUT,
 };
-use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;

@@ -19,7 +19,7 @@ pub use hydraulic_boom::HydraulicBoom;
 pub use hydraulic_circuit::HydraulicCircuit;
 pub use pressure_feedback_controller::PressureFeedbackController;
 
-use crate::fmi2::Fmu;
+use crate::fmu::Fmu;
 
 /// Every FMU boomsim ships, with the cdylib package that exports it.
 pub fn all() -> Vec<Fmu> {

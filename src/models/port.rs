@@ -17,7 +17,7 @@
 //!   series with the oil column and a mass `Z_c h` at the pin; `Z_c = sqrt(k_oil m_eff)` makes
 //!   both relative errors equal to omega h.
 
-use crate::fmi2::{Value, Values, Variable};
+use crate::fmu::{Value, Values, Variable};
 use crate::params::ParamSpec;
 
 /// Value references of the port (the same in both FMUs; 80-99, after the section angles 41-72).

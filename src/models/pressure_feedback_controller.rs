@@ -11,8 +11,8 @@
 
 use super::port::Ramp;
 use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
-use crate::fmi2::instance::bounded_slope;
-use crate::fmi2::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::fmu::instance::bounded_slope;
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
 
 /// Value references (stable across releases).
 pub mod vr {

@@ -2,10 +2,10 @@
 //! integrator step with logging, the solver's counters as outputs, and the saved-state layout
 //! (head, state, integrator).
 //!
-//! [`ModelInfo`]: crate::fmi2::ModelInfo
+//! [`ModelInfo`]: crate::fmu::ModelInfo
 
 use super::vr;
-use crate::fmi2::{Log, StepError, Values};
+use crate::fmu::{Log, StepError, Values};
 use crate::solver::{OdeSystem, Radau5, SolverStats};
 
 /// `solver.mode` of the real-time mode (0, the default, is the adaptive integrator).
@@ -64,7 +64,7 @@ pub(crate) fn advance<S: OdeSystem>(
 
 /// What the plant models (HydraulicBoom, HydraulicCircuit, BoomMechanics) share in their
 /// [`ModelInfo`]: the thesis' 15 s experiments at 1 ms, rtol 1e-6, the solver log category.
-pub(crate) const PLANT_INFO: crate::fmi2::ModelInfo = crate::fmi2::ModelInfo {
+pub(crate) const PLANT_INFO: crate::fmu::ModelInfo = crate::fmu::ModelInfo {
     identifier: "",
     description: "",
     version: env!("CARGO_PKG_VERSION"),

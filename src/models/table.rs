@@ -3,7 +3,7 @@
 //! every model, the boom's section outputs.
 
 use super::vr;
-use crate::fmi2::{Values, Variable};
+use crate::fmu::{Values, Variable};
 use crate::hydraulics::params::Param;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::mechanics::params::{BEAM_SPECS, SPECS as BOOM_SPECS};

@@ -3,9 +3,9 @@
 #![allow(dead_code)]
 
 use boomsim::fmi2::api;
-use boomsim::fmi2::guid::guid;
+use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
-use boomsim::fmi2::Model;
+use boomsim::fmu::Model;
 use std::ffi::{CStr, CString};
 use std::marker::PhantomData;
 use std::os::raw::{c_char, c_int, c_void};
@@ -204,8 +204,8 @@ pub fn serialized<M: Model>(s: &Slave<M>) -> Vec<u8> {
 
 /// A silent in-process Co-Simulation instance of `M` in Initialization Mode with the values of
 /// `setup` set (the safe Rust API under the C ABI).
-pub fn in_initialization<M: Model>(setup: &[(u32, boomsim::fmi2::Value)]) -> boomsim::fmi2::instance::Instance<M> {
-    use boomsim::fmi2::{instance::Instance, log::Logger, machine::Interface};
+pub fn in_initialization<M: Model>(setup: &[(u32, boomsim::fmu::Value)]) -> boomsim::fmu::instance::Instance<M> {
+    use boomsim::fmu::{instance::Instance, log::Logger, machine::Interface};
     let log = Logger::new(None, "test", &[], false);
     let mut i = Instance::<M>::new(log, guid::<M>(), boomsim::fmu::Version::Fmi2, Interface::CoSimulation);
     i.setup_experiment(None, 0.0, None).unwrap();
