@@ -26,8 +26,9 @@
 //! expectations must hold (`watch`: event locals against the event indicators and current after
 //! steps, states set by reference as SetContinuousStates sets them), and an Error or Discard
 //! comes with a log message (FMI 2.0: for the refusals of `machine2`). A crash (a signal), a hang
-//! (a sequence still running after 10 s) or a leak (the heap larger after the sequence than
-//! before, twice; glibc's tcache is turned off for this) fails the sequence too. Log messages
+//! (a sequence still running after 120 s; legal extreme parameters can make one slow) or a leak
+//! (the heap larger after the sequence than before, twice; glibc's tcache is turned off for this)
+//! fails the sequence too. Log messages
 //! that report a panic the FMU caught ("internal error") are counted and the first is shown with
 //! its seed, but they are not failures.
 //!
