@@ -81,7 +81,7 @@ pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) ->
 }
 
 /// The state an error leaves, and what the message adds about it. FMI 3.0, 2.3.1: "If any
-/// function called in super state FMU Mode Settable returns fmi3Error, the FMU enters state
+/// function called in super state FMU State Settable returns fmi3Error, the FMU enters state
 /// Terminated". FMI 2.0 leaves the state after fmi2Error open (2.1.3: "it is possible to
 /// restore a previously retrieved FMU state"): a refused call changes nothing there, and only
 /// a broken model (a panic, a non-finite result) puts the instance in the Error state.
