@@ -110,8 +110,9 @@ fn write_outputs<M: Model>(model: &M, values: &mut Values) {
     }
 }
 
-/// The values of `unknowns` (InitialUnknowns) that a model built from `values` starts with.
-fn initial_values<M: Model>(values: &Values, unknowns: &[u32]) -> Result<Vec<f64>, String> {
+/// The values a model built from `values` starts with: the values with its outputs, locals,
+/// continuous states and their derivatives written (the InitialUnknowns among them).
+pub(crate) fn start_values<M: Model>(values: &Values) -> Result<Values, String> {
     let model = M::initialize(values)?;
     let mut v = values.clone();
     write_outputs(&model, &mut v);
@@ -123,6 +124,12 @@ fn initial_values<M: Model>(values: &Values, unknowns: &[u32]) -> Result<Vec<f64
         v.set_real(s.state, x);
         v.set_real(s.derivative, d);
     }
+    Ok(v)
+}
+
+/// The values of `unknowns` (InitialUnknowns) that a model built from `values` starts with.
+fn initial_values<M: Model>(values: &Values, unknowns: &[u32]) -> Result<Vec<f64>, String> {
+    let v = start_values::<M>(values)?;
     Ok(unknowns.iter().map(|&r| v.real(r)).collect())
 }
 

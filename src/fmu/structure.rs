@@ -8,6 +8,7 @@
 //! sample (by more than round-off, see [`record`]). A dependency that shows only outside the
 //! sampled states would be missed; `tests/dependencies.rs` probes other states, along runs.
 
+use super::instance::start_values;
 use super::model::Model;
 use super::variables::{Causality, Kind, Values};
 use std::collections::{BTreeMap, BTreeSet};
@@ -78,13 +79,9 @@ pub fn unknowns<M: Model>(model: &M, values: &Values) -> Vec<(u32, f64)> {
 
 /// The initial unknowns a model built from `values` gives: its states and their derivatives.
 fn initial_unknowns<M: Model>(values: &Values) -> Option<Vec<(u32, f64)>> {
-    let model = M::initialize(values).ok()?;
-    let mut x = vec![0.0; M::STATES.len()];
-    model.continuous_states(&mut x);
-    let mut dx = vec![0.0; M::STATES.len()];
-    model.derivatives(values, &mut dx);
-    let states = M::STATES.iter().zip(x).map(|(s, x)| (s.state, x));
-    Some(states.chain(M::STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d))).collect())
+    let v = start_values::<M>(values).ok()?;
+    let states = M::STATES.iter().map(|s| (s.state, v.real(s.state)));
+    Some(states.chain(M::STATES.iter().map(|s| (s.derivative, v.real(s.derivative)))).collect())
 }
 
 /// Records `known` for every unknown that differs between `a` and `b` by more than 1e-12
