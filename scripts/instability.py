@@ -13,7 +13,7 @@ script
      C2 = (V_L4 + V_CH2 + mu_c A (s_c - x)) / beta;
    - eq. 2.84 with everything the model has: the hose compliance C_w = c_hose V_L (eq. 5.2)
      added to C1 and C2, the effective bulk modulus of the oil-air law at the steady pressures
-     (src/hydraulics/line.rs), and the factor 2 dp / (2 dp + u_cbv p_fo,cbv) of the steady
+     (runtime/src/hydraulics/line.rs), and the factor 2 dp / (2 dp + u_cbv p_fo,cbv) of the steady
      lowering state of eq. 2.72, 2.73, 2.85 (with the back pressure p2 of the A->T metering
      edge in the CBV pressure drop dp = p3 - p2, which the thesis neglects);
    The linearised model's frequency: omega_n = A / sqrt(C1 m) of eq. 2.81 (piston side only)

@@ -249,7 +249,7 @@ fn identifier(path: &Path) -> Result<&str, String> {
 
 /// The repository root, with `modelDescription/` and `target/`.
 fn repository() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
 }
 
 /// A master seed from the clock.

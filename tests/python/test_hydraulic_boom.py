@@ -4,7 +4,7 @@ circuit of thesis Fig. 2.8 on the rigid boom.
 Every expected value comes from outside the FMU: the thesis' parameter list and equations, a
 hand computation of the boom's statics (virtual work on the geometry of Fig. 2.1, re-derived
 here, not the Rust closed forms), conservation of oil mass with the compressibility law the
-model documents (src/hydraulics/line.rs), and the stability criterion of section 2.3. Each test
+model documents (runtime/src/hydraulics/line.rs), and the stability criterion of section 2.3. Each test
 states how its tolerance follows from the physics or from the solver tolerance.
 """
 

@@ -3,7 +3,7 @@ tests/host/fmu_host.c, compiled with gcc, MinGW-w64 and aarch64 gcc, loads the l
 under wine64 and under qemu-aarch64, and the numbers must agree with linux64. The same for the
 FMI 3.0 .fmu (binaries/x86_64-linux, x86_64-windows, aarch64-linux: the same library), through the
 host's FMI 3.0 entry points (`fmu_host --fmi3`), and there FMI 3.0 must equal FMI 2.0 on the same
-platform bit for bit: the same binary runs the same code (src/fmu/calls.rs) for both versions' calls.
+platform bit for bit: the same binary runs the same code (runtime/src/fmu/calls.rs) for both versions' calls.
 
 Needs `boomsim pack --platforms all` (scripts/test does it) and scripts/setup-cross.
 

@@ -1,0 +1,173 @@
+//! The model contract: what a physics model provides so that [`crate::fmi2`] and
+//! [`crate::fmi3`] can export it as Model Exchange (its continuous states, their derivatives, its
+//! outputs) and as Co-Simulation (a step of its own, with the internal solver).
+
+use super::variables::{Causality, Initial, Value, Values, Variable};
+
+/// Static facts about a model, written to modelDescription.xml.
+#[derive(Debug, Clone, Copy)]
+pub struct ModelInfo {
+    /// modelIdentifier: the .so name and the cdylib's `lib.name`.
+    pub identifier: &'static str,
+    pub description: &'static str,
+    /// Model version; part of the GUID.
+    pub version: &'static str,
+    /// DefaultExperiment: start, stop, step size.
+    pub start_time: f64,
+    pub stop_time: f64,
+    pub step_size: f64,
+    /// Relative tolerance used when fmi2SetupExperiment defines none.
+    pub default_tolerance: f64,
+    /// The model's own log categories (name, description), beside the generic ones.
+    pub log_categories: &'static [(&'static str, &'static str)],
+    /// The Real inputs whose first derivative (fmi2SetRealInputDerivatives) doStep uses;
+    /// `canInterpolateInputs` when there is one. Derivatives of other inputs are refused.
+    pub interpolated_inputs: &'static [u32],
+    /// HTML fragment for documentation/index.html: equations, sources, notes.
+    pub documentation: &'static str,
+}
+
+impl ModelInfo {
+    /// `canInterpolateInputs`: some input is linear over a step with its derivative.
+    pub const fn can_interpolate_inputs(&self) -> bool {
+        !self.interpolated_inputs.is_empty()
+    }
+}
+
+/// A continuous state of Model Exchange: the value references of the state variable and of its
+/// derivative (`der(...)`, a local Real), and the state's nominal value (its typical magnitude:
+/// fmi2GetNominalsOfContinuousStates; importers scale absolute tolerances with it).
+#[derive(Debug, Clone, Copy)]
+pub struct ContinuousState {
+    pub state: u32,
+    pub derivative: u32,
+    pub nominal: f64,
+}
+
+/// A failed step: how far the model got and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepError {
+    /// Time of the last good state the model now holds.
+    pub time: f64,
+    pub message: String,
+}
+
+/// What a model says while it steps, routed to a log category by the FMI layer.
+pub trait Log {
+    /// Whether messages of a category are delivered (skip formatting them when not).
+    fn enabled(&self, category: &str) -> bool;
+    /// Logs an info message in one of the model's own categories.
+    fn info(&mut self, category: &str, message: &str);
+    /// Logs a warning.
+    fn warning(&mut self, message: &str);
+}
+
+/// A model exported as an FMI 2.0 Model Exchange and Co-Simulation FMU.
+///
+/// The FMI layer owns the variable values (`Values`) and the state machine; the model holds its
+/// continuous state and reads parameters and inputs from `Values`. Model Exchange hands
+/// [`Model::STATES`] and [`Model::derivatives`] to the importer's integrator; Co-Simulation calls
+/// [`Model::do_step`], where a model integrates the same equations with [`crate::solver`].
+pub trait Model: Clone + Send + Sized + 'static {
+    const INFO: ModelInfo;
+    /// The variable table (unique value references across all types).
+    const VARIABLES: &'static [Variable];
+    /// The continuous states in the order of fmi2GetContinuousStates. FMI 2.0 fixes their number
+    /// in modelDescription.xml, so it is the same for every parameter value.
+    const STATES: &'static [ContinuousState];
+
+    /// The event indicators' variables (Real locals), in the order of fmi2GetEventIndicators:
+    /// functions of states and inputs whose sign changes where the right-hand side jumps.
+    /// FMI 2.0 counts them (`numberOfEventIndicators`), FMI 3.0 lists them (`<EventIndicator>`).
+    /// Default: none.
+    const EVENT_INDICATORS: &'static [u32] = &[];
+
+    /// Parameter settings that change the model's equations (rigid/flexible, port couplings):
+    /// ModelStructure's dependencies hold in each. Default: the start values only.
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        vec![vec![]]
+    }
+
+    /// Refuses parameter values Model Exchange cannot run (a co-simulation-only coupling), with
+    /// the reason. Default: all can.
+    fn model_exchange_check(_values: &Values) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// Builds the model from final parameter and input values at the end of initialisation
+    /// (and, in initialisation mode, to compute initial outputs). Returns a message naming the
+    /// offending variables when their combination is inconsistent.
+    fn initialize(values: &Values) -> Result<Self, String>;
+
+    /// Re-reads tunable parameters changed between steps; keeps the continuous state.
+    fn retune(&mut self, values: &Values) -> Result<(), String>;
+
+    /// Writes outputs and locals from the current state and inputs.
+    fn outputs(&self, values: &mut Values);
+
+    /// Writes the continuous states ([`Model::STATES`] order).
+    fn continuous_states(&self, x: &mut [f64]);
+
+    /// Takes new continuous states (fmi2SetContinuousStates, all finite); refuses states outside
+    /// the model's domain, naming the state, its value and its valid range.
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
+
+    /// Writes the states' time derivatives at the current states with the inputs of `values`.
+    /// A non-finite value tells the importer to retry with a smaller step (fmi2Discard).
+    fn derivatives(&self, values: &Values, dx: &mut [f64]);
+
+    /// Whether [`Model::directional_derivative`] is provided (`providesDirectionalDerivative`).
+    const DIRECTIONAL_DERIVATIVES: bool = false;
+
+    /// fmi2GetDirectionalDerivative at the current states and inputs: for each unknown (an
+    /// output or a `der()` variable) the sum over the knowns (states and inputs, with their
+    /// seeds) of its partial derivative times the seed, by exact forward-mode differentiation.
+    /// The FMI layer has checked the references; `Err` names what the model cannot differentiate.
+    fn directional_derivative(
+        &self,
+        _values: &Values,
+        _knowns: &[(u32, f64)],
+        _unknowns: &[u32],
+        _out: &mut [f64],
+    ) -> Result<(), String> {
+        Err("providesDirectionalDerivative=\"false\"".into())
+    }
+
+    /// Writes the [`Model::EVENT_INDICATORS`] event indicators at the current states and inputs.
+    fn event_indicators(&self, _values: &Values, _z: &mut [f64]) {}
+
+    /// The master set the variables `vrs` between two steps (inputs and tunable parameters,
+    /// after [`Model::retune`]): a model that extrapolates an input takes a new value as a sample
+    /// at the current time. Default: nothing to do.
+    fn inputs_set(&mut self, _vrs: &[u32]) {}
+
+    /// Advances from `t` to `t + h`. Inputs are `values` at `t`, changing with the given first
+    /// derivatives (one per table row; zero unless set) when the model interpolates inputs.
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError>;
+
+    /// The internal state as numbers, for FMU state serialisation.
+    fn save(&self) -> Vec<f64>;
+
+    /// Restores a model saved by [`Model::save`] under the given variable values.
+    fn load(values: &Values, state: &[f64]) -> Result<Self, String>;
+}
+
+/// FMI 2.0, 2.2.8 (FMI 3.0, 2.4.8 alike): whether `v` is an InitialUnknown of model `M`: an
+/// output with initial approx or calculated, a calculated parameter, a continuous state with
+/// initial approx or calculated, or a `der()` variable.
+pub fn initial_unknown<M: Model>(v: &Variable) -> bool {
+    let state = M::STATES.iter().any(|s| s.state == v.vr && v.initial != Initial::Exact);
+    let derivative = M::STATES.iter().any(|s| s.derivative == v.vr);
+    derivative
+        || state
+        || (v.causality == Causality::Output && v.initial != Initial::Exact)
+        || v.causality == Causality::CalculatedParameter
+}

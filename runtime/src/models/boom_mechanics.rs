@@ -1,0 +1,339 @@
+//! The BoomMechanics FMU model: the rigid or lumped flexible boom of HydraulicBoom alone, driven
+//! through the mechanical port ([`super::port`]) by the cylinder force (plain) or the TLM wave of
+//! [`super::HydraulicCircuit`], advanced by the Radau IIA integrator.
+//!
+//! States: the boom's generalised coordinates and velocities (rigid: the stroke; flexible: the
+//! section angles). The boom carries the rod and piston (mass and weight), as in HydraulicBoom,
+//! and the cylinder's end stops: they are the contact of the piston with the barrel, mechanics on
+//! this side of the cut, with the law and parameters of [`crate::hydraulics::cylinder`]
+//! (`cylinder.k_stop`, `cylinder.c_stop`). HydraulicCircuit's port force has none, so the pair
+//! coupled equals HydraulicBoom, and the boom alone with no force comes to rest on the bottom stop.
+
+use super::boom::Boom;
+use super::port::{self, Coupling, Ramp, FORCE_RANGE};
+use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
+use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::hydraulics::circuit::Circuit;
+use crate::hydraulics::cylinder::Cylinder;
+use crate::hydraulics::params::PARAMS;
+use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::scalar::{Dual64, Scalar};
+use crate::solver::{OdeSystem, Radau5, SecondOrder};
+
+/// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
+/// ([`port::vr`]; its `F` is `port.F`).
+pub mod vr {
+    pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, START_F, Z_C};
+    pub use crate::models::vr::*;
+}
+
+/// The circuit parameters the boom uses (indices in [`PARAMS`]): the cylinder's stroke, its range
+/// of motion, and its end stops.
+const STROKE: usize = super::table::param_index("cylinder.stroke");
+const K_STOP: usize = super::table::param_index("cylinder.k_stop");
+const C_STOP: usize = super::table::param_index("cylinder.c_stop");
+
+#[rustfmt::skip]
+const OWN: [Variable; 17] = [
+    Variable::real_input("cylinder.F", vr::F, 0.0, "N", "kN", FORCE_RANGE,
+        "Plain port: force on the rod from the circuit, pushing it out (linear over a step with its derivative)"),
+    out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
+    out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
+    out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
+    out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
+    out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
+    out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
+    Variable::param(vr::X0, START_STROKE).fixed(),
+    FLEXIBLE_SWITCH,
+    TIP_DEFLECTION,
+    port::COUPLING,
+    Variable::param(vr::Z_C, port::Z_C).fixed(),
+    Variable::param(vr::ALPHA, port::ALPHA).fixed(),
+    out("start.F", vr::START_F, "N", "kN",
+        "Cylinder force that holds the boom at rest at start.x (set HydraulicCircuit's start.F to it)"),
+    Variable::real_input("port.c_h", vr::C_H, 0.0, "N", "kN", FORCE_RANGE,
+        "TLM port: wave from the circuit, c_h = F_H + Z_c v_H (linear over a step with its derivative)"),
+    // Plain port: the wave and the line force are the input cylinder.F.
+    out("port.c_m", vr::C_M, "N", "kN", "TLM port: wave to the circuit, c_m = F_M - Z_c v_M at the step end")
+        .depends(&[vr::F]),
+    port::PORT_F.depends(&[vr::F]),
+];
+
+const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 3 + N_BOOM_ROWS + BOOM_DERIVATIVES.len();
+const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
+    .vars(&SOLVER_LOCALS)
+    .sections()
+    .hydraulics(PARAMS, STROKE, STROKE + 1)
+    .boom_params()
+    .hydraulics(PARAMS, K_STOP, K_STOP + 1)
+    .hydraulics(PARAMS, C_STOP, C_STOP + 1)
+    .vars(&BOOM_DERIVATIVES)
+    .build();
+
+const DOCUMENTATION: &str = concat!(
+    r#"<p>The boom of HydraulicBoom without the hydraulics: rigid (sections 2.1.1-2.1.2) or lumped
+flexible (2.1.4, 3.1.2), with the same parameters, names and value references, the rod and piston included. It
+starts at rest at <code>start.x</code>; <code>start.F</code> is the cylinder force that holds it there.
+<code>port.coupling</code> selects the port, as in HydraulicCircuit: <b>0, plain</b>: input <code>cylinder.F</code>
+(linear over a step with fmi2SetRealInputDerivatives); <b>1, TLM</b>: input wave c<sub>h</sub>, the boom is pushed by
+F<sub>M</sub> = c<sub>h</sub> &minus; Z<sub>c</sub>v<sub>M</sub> and emits c<sub>m</sub> = F<sub>M</sub> &minus;
+Z<sub>c</sub>v<sub>M</sub> (<code>port.Z_c</code> equal in both FMUs). The cylinder's end stops act here
+(<code>cylinder.k_stop</code>, <code>cylinder.c_stop</code>; HydraulicCircuit's port force has none): with no force
+the boom comes to rest on the bottom stop. Outputs: stroke, velocity, boom angle, payload position, tip deflection
+and section angles.</p>"#,
+    "<p>Model Exchange runs the plain port (<code>port.coupling</code> = 0): the TLM port is a delay line of one \
+communication step, which Model Exchange does not have.</p>",
+    port::coupling_recipe!()
+);
+
+/// The boom driven through the port, as one ODE over a step.
+#[derive(Debug, Clone)]
+pub struct PortedBoom {
+    pub boom: Boom,
+    pub coupling: Coupling,
+    /// Plain: the cylinder force; TLM: the wave c_h.
+    pub input: Ramp,
+    /// The cylinder whose end stops bound the stroke.
+    pub cylinder: Cylinder,
+}
+
+impl PortedBoom {
+    /// Port force pushing the rod out at `t` and stroke rate `v`.
+    pub fn force(&self, t: f64, v: f64) -> f64 {
+        match self.coupling {
+            Coupling::Plain => self.input.at(t),
+            Coupling::Tlm { z_c, .. } => self.input.at(t) - z_c * v,
+        }
+    }
+
+    /// Everything that pushes the rod out at `t`, stroke `x`, rate `v`: port and end stops.
+    fn rod_force(&self, t: f64, x: f64, v: f64) -> f64 {
+        self.force(t, v) + self.cylinder.end_stop_force(x, v)
+    }
+}
+
+impl PortedBoom {
+    /// The derivatives `dx` of the Model Exchange states at `q`, `qd` under the plain port's
+    /// force `f` and the end stops; allocation-free.
+    fn me_rhs<T: Scalar>(&self, q: &[T], qd: &[T], f: T, dx: &mut [T]) {
+        let mut qdd = [T::from(0.0); MAX_SECTIONS];
+        let qdd = &mut qdd[..q.len()];
+        self.boom.kinetics().accelerations(q, qd, &mut |x, v| f + self.cylinder.end_stop_force(x, v), qdd);
+        self.boom.me_derivatives(q, qd, qdd, dx);
+    }
+}
+
+impl OdeSystem for PortedBoom {
+    fn dim(&self) -> usize {
+        2 * self.boom.mechanics().dof()
+    }
+
+    fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
+        let b = self.boom.mechanics();
+        let (q, qd) = s.split_at(b.dof());
+        let (dq, dqd) = dx.split_at_mut(b.dof());
+        dq.copy_from_slice(qd);
+        b.accelerations(q, qd, &mut |x, v| self.rod_force(t, x, v), dqd);
+    }
+
+    /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
+    fn second_order(&self) -> Option<SecondOrder> {
+        let dof = self.boom.mechanics().dof();
+        Some(SecondOrder { pos: 0, vel: dof, len: dof })
+    }
+}
+
+/// The BoomMechanics model: ported boom, state, integrator.
+#[derive(Debug, Clone)]
+pub struct BoomMechanics {
+    sys: PortedBoom,
+    /// Holding force at the start.
+    f_start: f64,
+    t: f64,
+    /// The wave emitted at `t` (TLM).
+    c_m: f64,
+    state: Vec<f64>,
+    solver: Radau5,
+}
+
+impl BoomMechanics {
+    /// The model at time `t` with the port input `input`, the emitted wave `c_m` and the given
+    /// state (at rest at start.x if `None`).
+    fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [input, c_m]: [f64; 2]) -> Result<Self, String> {
+        let mut circuit = Circuit::default();
+        for k in [STROKE, K_STOP, C_STOP] {
+            (PARAMS[k].set)(&mut circuit, values.real(vr::HYDRAULICS + k as u32));
+        }
+        let (cylinder, stroke) = (circuit.cylinder, circuit.cylinder.stroke);
+        let boom = Boom::from_values(values, stroke)?;
+        let x0 = values.real(vr::X0);
+        if !(0.0..=stroke).contains(&x0) {
+            return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
+        }
+        let rest =
+            boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
+        let input = Ramp { t0: t, y0: input, slope: 0.0 };
+        let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input, cylinder };
+        let state =
+            super::stepping::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
+        let solver = Radau5::new(sys.dim());
+        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
+    }
+
+    /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
+    fn input_vr(&self) -> u32 {
+        match self.sys.coupling {
+            Coupling::Plain => vr::F,
+            Coupling::Tlm { .. } => vr::C_H,
+        }
+    }
+}
+
+impl Model for BoomMechanics {
+    const INFO: ModelInfo = ModelInfo {
+        identifier: "BoomMechanics",
+        description:
+            "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
+        interpolated_inputs: &[vr::F, vr::C_H],
+        documentation: DOCUMENTATION,
+        ..super::stepping::PLANT_INFO
+    };
+    const VARIABLES: &'static [Variable] = &TABLE;
+    const STATES: &'static [ContinuousState] = &BOOM_STATES;
+
+    /// Rigid and flexible boom, each with the plain and the TLM port.
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        let ports = port::configurations();
+        super::boom::boom_configurations()
+            .iter()
+            .flat_map(|b| ports.iter().map(move |p| [&b[..], p].concat()))
+            .collect()
+    }
+
+    fn model_exchange_check(values: &Values) -> Result<(), String> {
+        port::model_exchange_check(values)
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) {
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        self.sys.boom.me_states(q, qd, x);
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let dof = self.sys.boom.mechanics().dof();
+        let (q, qd) = self.state.split_at_mut(dof);
+        self.sys.boom.read_me_states(x, q, qd)
+    }
+
+    /// The plain port: pushed by the input cylinder.F and the end stops.
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        self.sys.me_rhs(q, qd, values.real(vr::F), dx);
+    }
+
+    const DIRECTIONAL_DERIVATIVES: bool = true;
+
+    /// The plain port's boom evaluated once in dual numbers from its Model Exchange states and
+    /// the input cylinder.F, each carrying its seed: the derivatives and outputs carry the
+    /// directional derivative, exact to round-off. The TLM port's wave is sampled at
+    /// communication points: not provided.
+    fn directional_derivative(
+        &self,
+        values: &Values,
+        knowns: &[(u32, f64)],
+        unknowns: &[u32],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        port::directional_derivative_check(self.sys.coupling)?;
+        let mut x = [0.0; BOOM_STATES.len()];
+        self.continuous_states(&mut x);
+        let x = super::exposed::seeded_states(&BOOM_STATES, &x, knowns);
+        let f = super::exposed::seeded(knowns, vr::F, values.real(vr::F));
+        let dof = self.sys.boom.mechanics().dof();
+        let (mut q, mut qd) = ([Dual64::from(0.0); MAX_SECTIONS], [Dual64::from(0.0); MAX_SECTIONS]);
+        let (q, qd) = (&mut q[..dof], &mut qd[..dof]);
+        self.sys.boom.read_me_states(&x, q, qd)?;
+        let mut dx = [Dual64::from(0.0); BOOM_STATES.len()];
+        self.sys.me_rhs(q, qd, f, &mut dx);
+        let k = self.sys.boom.kinetics();
+        let port = [
+            (vr::X, k.stroke(q)),
+            (vr::V, k.stroke_rate(q, qd)),
+            (vr::START_F, Dual64::from(self.f_start)),
+            (vr::C_M, f),
+            (port::vr::F, f),
+        ];
+        let boom = self.sys.boom.output_rows(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y]);
+        let derivatives = BOOM_STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d));
+        let rows: Vec<(u32, Dual64)> = port.into_iter().chain(boom).chain(derivatives).collect();
+        super::exposed::pick_derivatives(&rows, unknowns, out)
+    }
+
+    /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).
+    fn initialize(values: &Values) -> Result<Self, String> {
+        let mut m = Self::with_state(values, None, 0.0, [0.0, 0.0])?;
+        m.sys.input.y0 = if m.sys.coupling == Coupling::Plain { values.real(vr::F) } else { m.f_start };
+        m.c_m = m.f_start;
+        Ok(m)
+    }
+
+    fn retune(&mut self, _values: &Values) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn outputs(&self, values: &mut Values) {
+        let mut sys = self.sys.clone();
+        if sys.coupling == Coupling::Plain {
+            sys.input = Ramp { t0: self.t, y0: values.real(vr::F), slope: 0.0 };
+        }
+        let b = sys.boom.mechanics();
+        let (q, qd) = self.state.split_at(b.dof());
+        let (x, v) = (b.stroke(q), b.stroke_rate(q, qd));
+        let f = sys.force(self.t, v);
+        let c_m = if sys.coupling == Coupling::Plain { f } else { self.c_m };
+        for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
+            values.set_real(r, y);
+        }
+        super::stepping::solver_outputs(&self.solver, values);
+        sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
+    }
+
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
+        let sys = &self.sys;
+        super::stepping::advance(
+            &mut self.solver,
+            sys,
+            &mut self.state,
+            (t, h, tolerance),
+            || sys.boom.scale().collect(),
+            values,
+            log,
+        )?;
+        self.t = t + h;
+        let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
+        let v = self.sys.boom.mechanics().stroke_rate(q, qd);
+        self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, v), -v);
+        Ok(())
+    }
+
+    fn save(&self) -> Vec<f64> {
+        super::stepping::save(&[self.t, self.sys.input.at(self.t), self.c_m], &self.state, &self.solver)
+    }
+
+    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
+        let (head, state, solver) = super::stepping::split_saved(saved, 3)?;
+        let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
+        Ok(m)
+    }
+}

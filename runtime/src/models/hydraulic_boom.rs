@@ -1,0 +1,324 @@
+//! The HydraulicBoom FMU model: the circuit of thesis Fig. 2.8 ([`crate::hydraulics::circuit`])
+//! driving the boom, rigid (sections 2.1.1-2.1.2, [`crate::mechanics::rigid_boom`]) or lumped
+//! flexible (2.1.4, 3.1.2, [`crate::mechanics::flexible_boom`]), advanced inside fmi2DoStep by
+//! the stiff Radau IIA integrator ([`crate::solver`]).
+//!
+//! States: the circuit's six (p1..p4, spool position, load-holding opening), then the boom's
+//! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
+//! angle of each section). The operator's reference `valve.u_ref` is linear over a step with the
+//! slope the master passes with fmi2SetRealInputDerivatives (held without one).
+
+pub use super::boom::Boom;
+use super::circuit::CIRCUIT_SCALE;
+use super::port::Ramp;
+use super::exposed::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
+use super::table::{
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_P4,
+    START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
+};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
+use crate::hydraulics::params::PARAMS;
+use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::scalar::{Dual64, Scalar};
+use crate::solver::{OdeSystem, Radau5, SecondOrder};
+
+/// Value references (stable across releases: append, never renumber).
+pub mod vr {
+    pub use crate::models::vr::*;
+}
+
+#[rustfmt::skip]
+const OWN: [Variable; 38] = TableBuilder::new(&[U_REF_INPUT])
+    .vars(&CIRCUIT_OUTPUTS)
+    .vars(&[
+        out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),
+        out("cylinder.v", vr::V, "m/s", "mm/s", "Cylinder velocity, > 0 extending"),
+        out("cylinder.F", vr::F, "N", "kN", "Force on the rod: pressure forces - friction + end stops"),
+        out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity"),
+        out("boom.theta", vr::THETA, "rad", "deg", "Boom angle theta2 to the horizontal, > 0 up"),
+        out("boom.omega", vr::OMEGA, "rad/s", "deg/s", "Boom angular velocity"),
+        out("payload.x", vr::PAYLOAD_X, "m", "mm", "Payload mass centre, horizontal, from the lower cylinder pin"),
+        out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
+    ])
+    .vars(&CIRCUIT_LOCALS)
+    .vars(&SOLVER_LOCALS)
+    .vars(&[
+        Variable::param(vr::X0, START_STROKE).fixed(),
+        Variable::param(vr::START_P4, START_P4).fixed(),
+        FLEXIBLE_SWITCH,
+        TIP_DEFLECTION,
+    ])
+    .build();
+
+const N_VARS: usize = OWN.len() + PARAMS.len() + N_BOOM_ROWS + PLANT_STATES.len();
+
+/// The table: own variables, the section angles and rates, every hydraulic, boom and beam
+/// parameter (fixed: set them before initialisation ends), the states' derivatives.
+const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
+    .sections()
+    .hydraulics(PARAMS, 0, PARAMS.len())
+    .boom_params()
+    .vars(&CIRCUIT_DERIVATIVES)
+    .vars(&BOOM_DERIVATIVES)
+    .build();
+
+const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressure compensator (eq. 2.49, 2.50),
+PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48; with <code>valve.omega_loop</code> &gt; 0 the
+PVES's own position loop, speed-limited by the reaction times of Table 4.2), counterbalance valve with check valve and
+piloted load-holding valve (eq. 2.55-2.59), asymmetric cylinder with end stops and friction (eq. 2.60-2.65), line
+volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving the boom, by default the lumped flexible
+arm of sections 2.1.4 and 3.1.2 (<code>boom.n2</code> + <code>boom.n3</code> sections, eq. 2.34-2.39), or with
+<code>boom.flexible</code> = false the rigid boom of sections 2.1.1-2.1.2 (kinematics eq. 2.1-2.15, kinetics eq.
+2.16-2.19) as one degree of freedom in the cylinder stroke. A stiff Radau IIA (order 5) integrator advances the
+circuit's six states and the boom's coordinates and velocities (rigid: the stroke; flexible: one angle per section)
+inside fmi2DoStep with the tolerance of fmi2SetupExperiment; the flexible arm costs about ten times the rigid
+boom's time (see the README's speed table).</p>
+<p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
+static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
+spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>
+<p>Model Exchange: the importer's integrator gets the same states in every configuration (FMI 2.0 fixes their number;
+the table above lists them): the circuit's six, then the section angles <code>boom.section[k].phi</code> and their rates
+<code>boom.section[k].omega</code>. Slots beyond the last section repeat it, with its derivative; the rigid boom is
+its angle theta2 in every slot (Co-Simulation integrates it in the stroke). Three event indicators mark where the
+right-hand side jumps: the spool reference through zero (the dead band) and the spool at either edge of the dead
+band (the load-sensing switch), readable as <code>event.spool_reference</code>, <code>event.dead_band_upper</code> and
+<code>event.dead_band_lower</code>; elsewhere the model is continuous (regularised orifices and friction, end stops as
+stiff springs), except that with <code>valve.omega_loop</code> &gt; 0 the spool's speed limit switches where a
+saturated spool passes neutral, inside the dead band, where no oil flows. Directional derivatives are exact (forward-mode dual numbers through the same equations).</p>"#;
+
+/// Circuit + boom as one ODE, with the operator's reference held.
+#[derive(Debug, Clone)]
+pub struct Plant {
+    pub circuit: Circuit,
+    pub boom: Boom,
+    /// The operator's reference over the step.
+    pub u_ref: Ramp,
+}
+
+impl OdeSystem for Plant {
+    fn dim(&self) -> usize {
+        N_CIRCUIT + 2 * self.boom.mechanics().dof()
+    }
+
+    fn rhs(&self, t: f64, s: &[f64], dx: &mut [f64]) {
+        self.rhs_with(self.u_ref.at(t), s, dx);
+    }
+
+    /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
+    fn second_order(&self) -> Option<SecondOrder> {
+        let dof = self.boom.mechanics().dof();
+        Some(SecondOrder { pos: N_CIRCUIT, vel: N_CIRCUIT + dof, len: dof })
+    }
+}
+
+impl Plant {
+    /// The right-hand side with the operator's reference `u_ref`.
+    fn rhs_with<T: Scalar>(&self, u_ref: T, s: &[T], dx: &mut [T]) {
+        let dof = self.boom.mechanics().dof();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(dof);
+        let c: &[T; N_CIRCUIT] = c.try_into().expect("circuit slice");
+        let (dc, dboom) = dx.split_at_mut(N_CIRCUIT);
+        let (dq, dqd) = dboom.split_at_mut(dof);
+        dq.copy_from_slice(qd);
+        let mut force = |x, v| {
+            let e = self.circuit.evaluate(c, u_ref, x, v);
+            dc.copy_from_slice(&e.dx);
+            e.force
+        };
+        self.boom.kinetics().accelerations(q, qd, &mut force, dqd);
+    }
+
+    /// The derivatives `dx` of the Model Exchange states at the plant state `s` (native
+    /// coordinates) with the reference `u_ref`. No allocation: Model Exchange calls this for
+    /// every right-hand side of its integrator.
+    fn me_rhs<T: Scalar>(&self, u_ref: T, s: &[T], dx: &mut [T]) {
+        let mut ds = [T::from(0.0); N_CIRCUIT + 2 * MAX_SECTIONS];
+        let ds = &mut ds[..s.len()];
+        self.rhs_with(u_ref, s, ds);
+        let dof = self.boom.mechanics().dof();
+        let (q, qd) = s[N_CIRCUIT..].split_at(dof);
+        dx[..N_CIRCUIT].copy_from_slice(&ds[..N_CIRCUIT]);
+        self.boom.me_derivatives(q, qd, &ds[N_CIRCUIT + dof..], &mut dx[N_CIRCUIT..]);
+    }
+
+    /// The outputs (circuit, stroke and velocity, boom) at the plant state `s` with the
+    /// reference `u_ref`, as (value reference, value).
+    fn output_rows<T: Scalar>(&self, u_ref: T, s: &[T]) -> impl Iterator<Item = (u32, T)> {
+        let k = self.boom.kinetics();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(self.boom.mechanics().dof());
+        let c: &[T; N_CIRCUIT] = c.try_into().expect("circuit slice");
+        let (x, v) = (k.stroke(q), k.stroke_rate(q, qd));
+        let e = self.circuit.evaluate(c, u_ref, x, v);
+        let stroke = [(vr::X, x), (vr::V, v)];
+        let boom = self.boom.output_rows(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y]);
+        super::circuit::circuit_rows(c, &e).into_iter().chain(stroke).chain(boom)
+    }
+
+    /// The plant from the FMU's parameter values; refuses inconsistent combinations.
+    pub fn from_values(values: &Values) -> Result<Self, String> {
+        let circuit = super::circuit::circuit_from_values(values)?;
+        let boom = Boom::from_values(values, circuit.cylinder.stroke)?;
+        Ok(Plant { circuit, boom, u_ref: Ramp { t0: 0.0, y0: values.real(vr::U_REF), slope: 0.0 } })
+    }
+
+    /// Static equilibrium at stroke `x0`: the load held at rest by the closed CBV, the rod side
+    /// at tank pressure or trapped at `p4` (see [`crate::hydraulics::circuit::Circuit::equilibrium`]).
+    pub fn equilibrium(&self, x0: f64, p4: Option<f64>) -> Result<Vec<f64>, String> {
+        let stroke = self.circuit.cylinder.stroke;
+        if !(0.0..=stroke).contains(&x0) {
+            return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
+        }
+        let b = self.boom.mechanics();
+        let rest = b.equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
+        let c = self.circuit.equilibrium(rest.f_cyl, p4).map_err(|e| {
+            format!(
+                "no static equilibrium at start.x = {x0} m with the load of {:.0} N and start.p4 = {} Pa (payload.m, cbv.p_set): {e}",
+                rest.f_cyl,
+                p4.unwrap_or(self.circuit.supply.p_t)
+            )
+        })?;
+        let mut s = c.to_vec();
+        s.extend_from_slice(&rest.q);
+        s.resize(self.dim(), 0.0);
+        Ok(s)
+    }
+
+    /// Typical magnitude of each state (atol = rtol x scale).
+    pub fn state_scale(&self) -> Vec<f64> {
+        CIRCUIT_SCALE.iter().copied().chain(self.boom.scale()).collect()
+    }
+}
+
+/// The HydraulicBoom model: plant, state and integrator.
+#[derive(Debug, Clone)]
+pub struct HydraulicBoom {
+    plant: Plant,
+    state: Vec<f64>,
+    solver: Radau5,
+}
+
+impl HydraulicBoom {
+    /// The model with the plant of `values` and the given state (the equilibrium if `None`).
+    fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
+        let plant = Plant::from_values(values)?;
+        let state = super::stepping::checked_state(plant.dim(), state, || {
+            plant.equilibrium(values.real(vr::X0), super::table::trapped_p4(values))
+        })?;
+        let solver = Radau5::new(plant.dim());
+        Ok(HydraulicBoom { plant, state, solver })
+    }
+}
+
+impl Model for HydraulicBoom {
+    const INFO: ModelInfo = ModelInfo {
+        identifier: "HydraulicBoom",
+        description:
+            "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
+        interpolated_inputs: &[vr::U_REF],
+        documentation: DOCUMENTATION,
+        ..super::stepping::PLANT_INFO
+    };
+    const VARIABLES: &'static [Variable] = &TABLE;
+    const STATES: &'static [ContinuousState] = &PLANT_STATES;
+    const EVENT_INDICATORS: &'static [u32] = super::circuit::EVENT_INDICATORS;
+
+    fn configurations() -> Vec<Vec<(u32, Value)>> {
+        super::boom::boom_configurations()
+    }
+
+    fn initialize(values: &Values) -> Result<Self, String> {
+        Self::with_state(values, None)
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) {
+        let (c, boom) = self.state.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(self.plant.boom.mechanics().dof());
+        x[..N_CIRCUIT].copy_from_slice(c);
+        self.plant.boom.me_states(q, qd, &mut x[N_CIRCUIT..]);
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let dof = self.plant.boom.mechanics().dof();
+        let (c, boom) = self.state.split_at_mut(N_CIRCUIT);
+        let (q, qd) = boom.split_at_mut(dof);
+        self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)?;
+        c.copy_from_slice(&x[..N_CIRCUIT]);
+        Ok(())
+    }
+
+    fn event_indicators(&self, values: &Values, z: &mut [f64]) {
+        super::circuit::event_indicators(&self.plant.circuit, self.state[circuit::X_V], values.real(vr::U_REF), z);
+    }
+
+    fn derivatives(&self, values: &Values, dx: &mut [f64]) {
+        self.plant.me_rhs(values.real(vr::U_REF), &self.state, dx);
+    }
+
+    const DIRECTIONAL_DERIVATIVES: bool = true;
+
+    /// The plant evaluated once in dual numbers from its Model Exchange states and the input,
+    /// each carrying its seed: the derivatives and outputs carry the directional derivative,
+    /// exact to round-off (padded state slots are copies the model does not read: zero).
+    fn directional_derivative(
+        &self,
+        values: &Values,
+        knowns: &[(u32, f64)],
+        unknowns: &[u32],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let mut x = [0.0; PLANT_STATES.len()];
+        self.continuous_states(&mut x);
+        let x = super::exposed::seeded_states(&PLANT_STATES, &x, knowns);
+        let u_ref = super::exposed::seeded(knowns, vr::U_REF, values.real(vr::U_REF));
+        let mut s = [Dual64::from(0.0); N_CIRCUIT + 2 * MAX_SECTIONS];
+        let s = &mut s[..self.state.len()];
+        s[..N_CIRCUIT].copy_from_slice(&x[..N_CIRCUIT]);
+        let (q, qd) = s[N_CIRCUIT..].split_at_mut(self.plant.boom.mechanics().dof());
+        self.plant.boom.read_me_states(&x[N_CIRCUIT..], q, qd)?;
+        let mut dx = [Dual64::from(0.0); PLANT_STATES.len()];
+        self.plant.me_rhs(u_ref, s, &mut dx);
+        let derivatives = PLANT_STATES.iter().zip(dx).map(|(st, d)| (st.derivative, d));
+        let rows: Vec<(u32, Dual64)> = self.plant.output_rows(u_ref, s).chain(derivatives).collect();
+        super::exposed::pick_derivatives(&rows, unknowns, out)
+    }
+
+    fn retune(&mut self, _values: &Values) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn outputs(&self, values: &mut Values) {
+        for (r, y) in self.plant.output_rows(values.real(vr::U_REF), &self.state) {
+            values.set_real(r, y);
+        }
+        super::stepping::solver_outputs(&self.solver, values);
+    }
+
+    fn do_step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        t: f64,
+        h: f64,
+        tolerance: f64,
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        self.plant.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
+        let plant = &self.plant;
+        let scale = || plant.state_scale();
+        super::stepping::advance(&mut self.solver, plant, &mut self.state, (t, h, tolerance), scale, values, log)
+    }
+
+    fn save(&self) -> Vec<f64> {
+        super::stepping::save(&[], &self.state, &self.solver)
+    }
+
+    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
+        let (_, state, solver) = super::stepping::split_saved(saved, 0)?;
+        let mut m = Self::with_state(values, Some(state))?;
+        m.solver.load_state(solver).map_err(|e| e.to_string())?;
+        Ok(m)
+    }
+}

@@ -1,0 +1,19 @@
+//! The FMU models: each struct composes the physics and implements [`crate::fmu::Model`], the
+//! contract both FMI versions export.
+
+pub mod boom;
+pub mod boom_mechanics;
+pub mod circuit;
+pub mod hydraulic_boom;
+pub mod hydraulic_circuit;
+pub mod port;
+pub mod pressure_feedback_controller;
+pub mod exposed;
+pub mod stepping;
+pub mod table;
+pub mod vr;
+
+pub use boom_mechanics::BoomMechanics;
+pub use hydraulic_boom::HydraulicBoom;
+pub use hydraulic_circuit::HydraulicCircuit;
+pub use pressure_feedback_controller::PressureFeedbackController;

@@ -1,0 +1,4 @@
+//! The `boomsim` command line and the generated modelDescription.xml and documentation pages.
+
+mod cli;
+mod model_description;

@@ -1,0 +1,216 @@
+//! Modes of a nonlinear model linearised at a state: eigenvalues of the Jacobian of its ODE
+//! (central differences), as natural frequencies and damping ratios.
+
+use crate::analysis::poly::eigenvalues;
+use boomsim::fmu::{Model, Value, Values};
+use boomsim::models::hydraulic_boom::{vr, Plant};
+use boomsim::models::HydraulicBoom;
+use boomsim::solver::OdeSystem;
+use nalgebra::DMatrix;
+
+/// One oscillatory mode: eigenvalue pair lambda = -zeta w_n +- j w_n sqrt(1 - zeta^2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    /// Undamped natural frequency w_n / (2 pi) = |lambda| / (2 pi) [Hz].
+    pub frequency_hz: f64,
+    /// Damping ratio zeta = -Re(lambda) / |lambda|.
+    pub damping_ratio: f64,
+}
+
+impl Mode {
+    /// Frequency of the decaying oscillation, w_n sqrt(1 - zeta^2) / (2 pi) [Hz].
+    pub fn damped_frequency_hz(&self) -> f64 {
+        self.frequency_hz * (1.0 - self.damping_ratio.powi(2)).max(0.0).sqrt()
+    }
+}
+
+/// Jacobian d f / d x at `x` by central differences with steps `1e-6 max(|x_i|, scale_i)`.
+pub fn jacobian(sys: &dyn OdeSystem, t: f64, x: &[f64], scale: &[f64]) -> DMatrix<f64> {
+    let n = sys.dim();
+    let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
+    let mut xp = x.to_vec();
+    let mut j = DMatrix::zeros(n, n);
+    for k in 0..n {
+        let d = 1e-6 * x[k].abs().max(scale[k]);
+        xp[k] = x[k] + d;
+        sys.rhs(t, &xp, &mut plus);
+        xp[k] = x[k] - d;
+        sys.rhs(t, &xp, &mut minus);
+        xp[k] = x[k];
+        for i in 0..n {
+            j[(i, k)] = (plus[i] - minus[i]) / (2.0 * d);
+        }
+    }
+    j
+}
+
+/// The oscillatory modes of `jacobian`, lowest natural frequency first (one per conjugate pair).
+pub fn modes(jacobian: DMatrix<f64>) -> Vec<Mode> {
+    let mut modes: Vec<Mode> = eigenvalues(jacobian)
+        .iter()
+        .filter(|l| l.im > 0.0)
+        .map(|l| Mode { frequency_hz: l.norm() / std::f64::consts::TAU, damping_ratio: -l.re / l.norm() })
+        .collect();
+    modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    modes
+}
+
+/// The HydraulicBoom at rest with the boom horizontal (stroke where the rigid boom's theta2 = 0),
+/// full payload and the spool closed, the rod side at tank pressure or trapped at `p4` (Pa,
+/// gauge; p3 then carries the load on top of it), linearised: (stroke [m], modes).
+///
+/// Friction is left out (`friction.c_p_bak` = `friction.p_static` = 0): Coulomb friction has no
+/// small-signal linearisation at rest; its tanh regularisation would act as a viscous damper of
+/// F/v_s ~ 5e6 N s/m and lock the cylinder. Its effect on an oscillation depends on the amplitude.
+pub fn hydraulic_boom_modes(flexible: bool, p4: Option<f64>) -> Result<(f64, Vec<Mode>), String> {
+    modes_with(flexible, p4, &[])
+}
+
+/// [`hydraulic_boom_modes`] with some Real parameters changed (name, value).
+fn modes_with(flexible: bool, p4: Option<f64>, changes: &[(&str, f64)]) -> Result<(f64, Vec<Mode>), String> {
+    let mut values = Values::new(HydraulicBoom::VARIABLES);
+    let mut set = |name: &str, v: Value| {
+        let i = HydraulicBoom::VARIABLES.iter().position(|x| x.name == name).expect("variable name");
+        values.put(i, v);
+    };
+    set("friction.c_p_bak", Value::Real(0.0));
+    set("friction.p_static", Value::Real(0.0));
+    set("boom.flexible", Value::Boolean(flexible));
+    for (name, x) in changes {
+        set(name, Value::Real(*x));
+    }
+    let rigid = {
+        let mut v = values.clone();
+        v.put(v.position(vr::FLEXIBLE).expect("flexible switch"), Value::Boolean(false));
+        Plant::from_values(&v)?
+    };
+    let (mut lo, mut hi) = (0.0, rigid.circuit.cylinder.stroke);
+    let theta = |x: f64| match &rigid.boom {
+        boomsim::models::hydraulic_boom::Boom::Rigid(b) => b.state(x, 0.0).theta2,
+        boomsim::models::hydraulic_boom::Boom::Flexible(_) => unreachable!("built rigid"),
+    };
+    if theta(lo) > 0.0 || theta(hi) < 0.0 {
+        return Err("the boom is not horizontal anywhere in the stroke".into());
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if theta(mid) < 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    let x0 = 0.5 * (lo + hi);
+    values.set_real(vr::X0, x0);
+    let plant = Plant::from_values(&values)?;
+    let state = plant.equilibrium(x0, p4)?;
+    Ok((x0, modes(jacobian(&plant, 0.0, &state, &plant.state_scale()))))
+}
+
+/// The lowest mode at the conditions of the rig's eigenfrequency measurement, thesis 5.1.3.
+pub struct Rig {
+    pub conditions: &'static str,
+    /// The trapped rod-side pressure (Pa, gauge).
+    pub p4: f64,
+    pub flexible: Mode,
+    pub rigid: Mode,
+    /// The measurement: 2.85 Hz (eq. 5.5 over the decaying p3 of Fig. 5.5).
+    pub measured_hz: f64,
+    /// What moves the flexible boom's frequency: (change, lowest mode with it).
+    pub sensitivity: Vec<(&'static str, Mode)>,
+}
+
+/// The rig's eigenfrequency measurement (thesis 5.1.3: the main boom horizontal, excited by
+/// hand, p3 logged) in the model: the boom horizontal, spool and CBV closed, full payload, and
+/// the rod side at 1 bar, the only rod-side pressure at rest the thesis gives (the initial p4 of
+/// its simulations, section 6.2); friction off, as for every small-signal mode here.
+pub fn rig() -> Result<Rig, String> {
+    const P4: f64 = 1e5;
+    let lowest = |flexible, p4, changes: &[(&str, f64)]| -> Result<Mode, String> {
+        let (_, modes) = modes_with(flexible, p4, changes)?;
+        modes.into_iter().next().ok_or_else(|| "no mode".to_string())
+    };
+    let variants: [(&'static str, Option<f64>, &[(&str, f64)]); 4] = [
+        ("rod side at tank pressure (0 bar)", None, &[]),
+        ("no entrained air (fluid.air_fraction at its minimum, 1e-7)", Some(P4), &[("fluid.air_fraction", 1e-7)]),
+        ("rigid hoses (line.c_hose = 0)", Some(P4), &[("line.c_hose", 0.0)]),
+        ("no air and rigid hoses", Some(P4), &[("fluid.air_fraction", 1e-7), ("line.c_hose", 0.0)]),
+    ];
+    let sensitivity =
+        variants.iter().map(|(what, p4, c)| Ok((*what, lowest(true, *p4, c)?))).collect::<Result<Vec<_>, String>>()?;
+    Ok(Rig {
+        sensitivity,
+        conditions: "boom horizontal, spool and CBV closed, full payload, rod side at 1 bar (thesis 6.2), no friction",
+        p4: P4,
+        flexible: lowest(true, Some(P4), &[])?,
+        rigid: lowest(false, Some(P4), &[])?,
+        measured_hz: 2.85,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rig's mode (thesis 5.1.3) as the README states it, and its physics: trapping the rod
+    /// side at 1 bar compresses its air (isothermal: the gas stiffness grows with p_abs^2), so
+    /// the mode lies above the 0 bar one and below the one without air; each softening removed
+    /// (air, hose compliance) raises it; the flexible arm is softer than the rigid boom.
+    #[test]
+    fn the_rig_mode_is_what_the_readme_says() {
+        let rig = rig().unwrap();
+        let f = |what: &str| rig.sensitivity.iter().find(|(w, _)| w.starts_with(what)).unwrap().1.frequency_hz;
+        let fl = rig.flexible.frequency_hz;
+        assert!(
+            f("rod side at tank") < fl && fl < f("no entrained air") && f("no entrained air") < f("no air and rigid")
+        );
+        assert!(fl < f("rigid hoses") && f("rigid hoses") < f("no air and rigid"));
+        assert!(fl < rig.rigid.frequency_hz);
+        let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
+        let start = readme.find("- **Eigenfrequency**").expect("the README's Eigenfrequency note");
+        let note = &readme[start..start + readme[start..].find("\n- **").unwrap()];
+        let hz: Vec<f64> = note.split(" Hz").filter_map(|w| w.rsplit(' ').next()?.parse().ok()).collect();
+        let expected: Vec<f64> = [rig.measured_hz, fl, rig.rigid.frequency_hz]
+            .into_iter()
+            .chain(rig.sensitivity.iter().map(|s| s.1.frequency_hz))
+            .map(|x| (x * 100.0).round() / 100.0)
+            .collect();
+        assert_eq!(hz, expected, "{note}");
+        let off = format!("({:+.1} %)", 100.0 * (fl / rig.measured_hz - 1.0)).replace('+', "");
+        assert!(note.contains(&off), "{off} in {note}");
+    }
+
+    /// Two unit masses on two unit springs (fixed-free chain) with stiffness-proportional damping,
+    /// x'' = -K (x + c x'): the textbook modes w^2 = (3 -+ sqrt 5)/2 with zeta_i = c w_i / 2.
+    struct Chain {
+        c: f64,
+    }
+
+    impl OdeSystem for Chain {
+        fn dim(&self) -> usize {
+            4
+        }
+        fn rhs(&self, _t: f64, x: &[f64], dx: &mut [f64]) {
+            let k = [[2.0, -1.0], [-1.0, 1.0]];
+            dx[0] = x[2];
+            dx[1] = x[3];
+            for i in 0..2 {
+                dx[2 + i] = -(k[i][0] * (x[0] + self.c * x[2]) + k[i][1] * (x[1] + self.c * x[3]));
+            }
+        }
+    }
+
+    #[test]
+    fn two_mass_chain_matches_the_textbook_modes() {
+        let c = 0.01;
+        let j = jacobian(&Chain { c }, 0.0, &[0.0; 4], &[1.0; 4]);
+        let m = modes(j);
+        assert_eq!(m.len(), 2);
+        for (mode, w2) in m.iter().zip([(3.0 - 5f64.sqrt()) / 2.0, (3.0 + 5f64.sqrt()) / 2.0]) {
+            let w = w2.sqrt();
+            // Central differences of a linear system are exact up to rounding.
+            assert!((mode.frequency_hz * std::f64::consts::TAU - w).abs() < 1e-8 * w);
+            assert!((mode.damping_ratio - c * w / 2.0).abs() < 1e-8);
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! The FMI 2.0 modelDescription.xml, generated with quick-xml from the model's variable table
+//! (the parts FMI 3.0 writes alike are in [`crate::xml`]).
+
+use crate::xml::{
+    default_experiment, document, element, flag, initial_unknowns, log_categories, real_attrs, root_attrs,
+    unit_definitions, variable_attrs, Attrs, Xml,
+};
+use boomsim::fmu::guid::guid;
+use boomsim::fmu::model::Model;
+use boomsim::fmu::structure::probe;
+use boomsim::fmu::variables::{Causality, Kind, Variable};
+use std::io;
+
+pub use crate::xml::{dependencies, initial_dependencies};
+
+fn type_attrs(v: &Variable) -> (&'static str, Attrs) {
+    let start = v.has_start();
+    match v.kind {
+        Kind::Real { start: s, unit, display_unit, min, max } => {
+            ("Real", real_attrs(unit, display_unit, (min, max), start.then_some(s)))
+        }
+        Kind::Integer { start: s, min, max } => {
+            let mut a: Attrs = vec![("min", min.to_string()), ("max", max.to_string())];
+            if start {
+                a.push(("start", s.to_string()));
+            }
+            ("Integer", a)
+        }
+        Kind::Boolean { start: s } => ("Boolean", if start { vec![("start", s.to_string())] } else { vec![] }),
+        Kind::String { start: s } => ("String", if start { vec![("start", s.into())] } else { vec![] }),
+    }
+}
+
+/// 1-based ModelVariables indices of value references, space separated.
+fn indices<M: Model>(vrs: &[u32]) -> String {
+    let mut i: Vec<usize> = vrs.iter().filter_map(|vr| M::VARIABLES.iter().position(|v| v.vr == *vr)).collect();
+    // FMI 2.0, 2.2.8: dependencies are ordered by index.
+    i.sort_unstable();
+    i.dedup();
+    i.iter().map(|i| (i + 1).to_string()).collect::<Vec<_>>().join(" ")
+}
+
+/// The complete modelDescription.xml of model `M`.
+pub fn model_description<M: Model>() -> String {
+    write::<M>().expect("writing XML to memory cannot fail")
+}
+
+fn write<M: Model>() -> io::Result<String> {
+    let info = &M::INFO;
+    let root = root_attrs::<M>(
+        "2.0",
+        ("guid", guid::<M>()),
+        vec![("numberOfEventIndicators", M::EVENT_INDICATORS.len().to_string())],
+    );
+    document(&root, |w| {
+        // The capabilities both interfaces share, around each one's own (schema order).
+        let interface = |own: Attrs| -> Attrs {
+            let head: Attrs = vec![("modelIdentifier", info.identifier.into()), ("needsExecutionTool", flag(false))];
+            let tail: Attrs = vec![
+                ("canBeInstantiatedOnlyOncePerProcess", flag(false)),
+                ("canNotUseMemoryManagementFunctions", flag(true)),
+                ("canGetAndSetFMUstate", flag(true)),
+                ("canSerializeFMUstate", flag(true)),
+                ("providesDirectionalDerivative", flag(M::DIRECTIONAL_DERIVATIVES)),
+            ];
+            [head, own, tail].concat()
+        };
+        element(w, "ModelExchange", &interface(vec![("completedIntegratorStepNotNeeded", flag(true))]))?;
+        let cs = interface(vec![
+            ("canHandleVariableCommunicationStepSize", flag(true)),
+            ("canInterpolateInputs", flag(info.can_interpolate_inputs())),
+            ("maxOutputDerivativeOrder", "0".into()),
+            ("canRunAsynchronuously", flag(false)),
+        ]);
+        element(w, "CoSimulation", &cs)?;
+        unit_definitions::<M>(w, &[])?;
+        log_categories::<M>(w, str::to_owned)?;
+        default_experiment::<M>(w)?;
+        w.create_element("ModelVariables").write_inner_content(|w| {
+            for v in M::VARIABLES {
+                let attrs = variable_attrs(v);
+                w.create_element("ScalarVariable")
+                    .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
+                    .write_inner_content(|w| {
+                        let (ty, mut a) = type_attrs(v);
+                        if let Some(s) = M::STATES.iter().find(|s| s.derivative == v.vr) {
+                            a.push(("derivative", indices::<M>(&[s.state])));
+                        }
+                        element(w, ty, &a)
+                    })?;
+            }
+            Ok(())
+        })?;
+        model_structure::<M>(w)
+    })
+}
+
+fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
+    let structure = probe::<M>();
+    let deps = dependencies::<M>(&structure);
+    w.create_element("ModelStructure").write_inner_content(|w| {
+        let unknown = |w: &mut Xml, vr: u32, deps: &[u32]| {
+            element(w, "Unknown", &vec![("index", indices::<M>(&[vr])), ("dependencies", indices::<M>(deps))])
+        };
+        let outputs: Vec<&Variable> = M::VARIABLES.iter().filter(|v| v.causality == Causality::Output).collect();
+        if !outputs.is_empty() {
+            w.create_element("Outputs").write_inner_content(|w| {
+                for v in &outputs {
+                    unknown(w, v.vr, &deps[&v.vr])?;
+                }
+                Ok(())
+            })?;
+        }
+        if !M::STATES.is_empty() {
+            // The order of the state vector (fmi2GetContinuousStates).
+            w.create_element("Derivatives").write_inner_content(|w| {
+                for s in M::STATES {
+                    unknown(w, s.derivative, &deps[&s.derivative])?;
+                }
+                Ok(())
+            })?;
+        }
+        let initial = initial_unknowns::<M>(&structure);
+        if !initial.is_empty() {
+            w.create_element("InitialUnknowns").write_inner_content(|w| {
+                for (vr, deps) in &initial {
+                    unknown(w, *vr, deps)?;
+                }
+                Ok(())
+            })?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
