@@ -150,7 +150,7 @@ fn check_states<M: Model>(configurations: &[&[(u32, Value)]], steps: usize) {
                 continue;
             }
             let values = i.core.values.clone();
-            let mut model = i.core.model.clone().unwrap();
+            let mut model = M::clone(i.core.model.as_ref().unwrap());
             let mut x = vec![0.0; M::STATES.len()];
             model.continuous_states(&mut x);
             let base = boomsim::fmu::structure::unknowns(&model, &values);

@@ -57,7 +57,7 @@ fn check<M: Model>(setup: &[(u32, Value)], steps: usize, samples: usize) -> (usi
         if (k + 1) % (steps / samples) != 0 {
             continue;
         }
-        let (model, values) = (inst.core.model.clone().unwrap(), inst.core.values.clone());
+        let (model, values) = (M::clone(inst.core.model.as_ref().unwrap()), inst.core.values.clone());
         let base = unknowns(&model, &values);
         // The unknowns of Continuous-Time Mode (FMI 3.0, 2.2.11): outputs and derivatives, not
         // the event indicators.

@@ -4,6 +4,7 @@
 use crate::common;
 
 use boomsim::fmi2::api;
+use boomsim::fmu::driver::Step;
 use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
 use boomsim::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
@@ -255,31 +256,32 @@ impl Model for Faulty {
     fn initialize(values: &Values) -> Result<Self, String> {
         Ok(Faulty { mode: values.real(0), t: 0.0 })
     }
-    fn retune(&mut self, _: &Values) -> Result<(), String> {
-        Ok(())
-    }
     fn outputs(&self, values: &mut Values) {
         values.set_real(1, if self.mode == 3.0 && self.t > 0.5 { f64::NAN } else { self.mode })
     }
-    fn do_step(&mut self, v: &Values, _: &[f64], t: f64, h: f64, _: f64, _: &mut dyn Log) -> Result<(), StepError> {
+    type Ode = ();
+    fn begin_step(&mut self, v: &Values, _: &[f64], t: f64, h: f64, _: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
         self.t = t + h;
         match v.real(0) as i32 {
             1 if t + h >= 1.0 => panic!("model bug"),
             2 if t + h > 0.5 => Err(StepError { time: 0.5, message: "solver gave up".into() }),
-            _ => Ok(()),
+            _ => Ok(Step::Done),
         }
+    }
+    fn scale(_: &()) -> Vec<f64> {
+        Vec::new()
+    }
+    fn state(&self) -> &[f64] {
+        &[]
+    }
+    fn restore(values: &Values, _: &[f64], _: &[f64]) -> Result<Self, String> {
+        Self::initialize(values)
     }
     fn continuous_states(&self, _: &mut [f64]) {}
     fn set_continuous_states(&mut self, _: &[f64]) -> Result<(), String> {
         Ok(())
     }
     fn derivatives(&self, _: &Values, _: &mut [f64]) {}
-    fn save(&self) -> Vec<f64> {
-        vec![]
-    }
-    fn load(values: &Values, _: &[f64]) -> Result<Self, String> {
-        Self::initialize(values)
-    }
 }
 
 /// Principle 4: a panic becomes fmi2Error with a message and the Error state; fmi2Reset recovers.

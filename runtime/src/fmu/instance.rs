@@ -1,6 +1,7 @@
 //! One FMU instance: variable values, model, time and state machine, in safe Rust.
 //! [`super::api`] wraps these methods in the C ABI.
 
+use super::driver::Driven;
 use super::log::{num, Logger, Status};
 use super::machine::{Interface, Mode};
 use super::model::{initial_unknown, Log, Model};
@@ -56,8 +57,8 @@ pub struct Core<M: Model> {
     pub values: Values,
     /// First derivatives of Real inputs (fmi2SetRealInputDerivatives), per table row.
     pub input_derivatives: Vec<f64>,
-    /// The model, built when initialisation ends.
-    pub model: Option<M>,
+    /// The model with the driver's integrator, built when initialisation ends.
+    pub model: Option<Driven<M>>,
     pub time: f64,
     pub start_time: f64,
     pub stop_time: Option<f64>,
@@ -99,8 +100,9 @@ impl<M: Model> Default for Core<M> {
 /// with the outputs after every step, on the stack.
 const MAX_EVENT_INDICATORS: usize = 8;
 
-/// Writes the outputs and locals of `model`, the event indicators' variables included.
-fn write_outputs<M: Model>(model: &M, values: &mut Values) {
+/// Writes the outputs and locals of `model` (the integrator's counters and the event indicators'
+/// variables included).
+fn write_outputs<M: Model>(model: &Driven<M>, values: &mut Values) {
     model.outputs(values);
     const { assert!(M::EVENT_INDICATORS.len() <= MAX_EVENT_INDICATORS) };
     let z = &mut [0.0; MAX_EVENT_INDICATORS][..M::EVENT_INDICATORS.len()];
@@ -113,7 +115,7 @@ fn write_outputs<M: Model>(model: &M, values: &mut Values) {
 /// The values a model built from `values` starts with: the values with its outputs, locals,
 /// continuous states and their derivatives written (the InitialUnknowns among them).
 pub(crate) fn start_values<M: Model>(values: &Values) -> Result<Values, String> {
-    let model = M::initialize(values)?;
+    let model = Driven::new(M::initialize(values)?);
     let mut v = values.clone();
     write_outputs(&model, &mut v);
     let mut x = vec![0.0; M::STATES.len()];
@@ -243,7 +245,7 @@ impl<M: Model> Instance<M> {
         if self.interface == Interface::ModelExchange {
             M::model_exchange_check(&c.values)?;
         }
-        let model = M::initialize(&c.values)?;
+        let model = Driven::new(M::initialize(&c.values)?);
         write_outputs(&model, &mut c.values);
         c.model = Some(model);
         c.outputs_current = true;
@@ -257,7 +259,7 @@ impl<M: Model> Instance<M> {
     }
 
     /// The model, built when initialisation ended.
-    fn model(&mut self) -> Result<&mut M, String> {
+    fn model(&mut self) -> Result<&mut Driven<M>, String> {
         self.core.model.as_mut().ok_or_else(|| "the model is not initialised".to_string())
     }
 
@@ -512,7 +514,7 @@ impl<M: Model> Instance<M> {
         }
         if c.mode == Mode::InitializationMode {
             // Initial outputs follow from the values set so far.
-            write_outputs(&M::initialize(&c.values)?, &mut c.values);
+            write_outputs(&Driven::new(M::initialize(&c.values)?), &mut c.values);
         } else if let Some(model) = &c.model {
             write_outputs(model, &mut c.values);
         }
@@ -729,7 +731,7 @@ impl<M: Model> Instance<M> {
         let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
         // FMI 3.0, 2.2.4: after fmi3Discard "the FMU is in the same state as before the call".
         let before = (self.version == Version::Fmi3).then(|| model.clone());
-        let result = model.do_step(&c.values, &slopes, start, end - start, tolerance, &mut ModelLog(&self.log));
+        let result = model.step(&c.values, &slopes, (start, end - start, tolerance), &mut ModelLog(&self.log));
         c.outputs_current = false;
         c.derivatives_current = false;
         if let Err(e) = result {

@@ -5,6 +5,7 @@
 //! [`crate::fmi2`] and [`crate::fmi3`] add only what their version names or types differently.
 
 pub mod calls;
+pub mod driver;
 pub mod snapshot;
 pub mod guid;
 pub mod instance;

@@ -1,8 +1,11 @@
 //! The model contract: what a physics model provides so that [`crate::fmi2`] and
 //! [`crate::fmi3`] can export it as Model Exchange (its continuous states, their derivatives, its
-//! outputs) and as Co-Simulation (a step of its own, with the internal solver).
+//! outputs, its event indicators) and as Co-Simulation (its ODE, which the one driver,
+//! [`super::driver`], integrates).
 
+use super::driver::Step;
 use super::variables::{Causality, Initial, Value, Values, Variable};
+use crate::solver::OdeSystem;
 
 /// Static facts about a model, written to modelDescription.xml.
 #[derive(Debug, Clone, Copy)]
@@ -62,12 +65,14 @@ pub trait Log {
     fn warning(&mut self, message: &str);
 }
 
-/// A model exported as an FMI 2.0 Model Exchange and Co-Simulation FMU.
+/// A model exported as an FMI 2.0 and 3.0 Model Exchange and Co-Simulation FMU.
 ///
 /// The FMI layer owns the variable values (`Values`) and the state machine; the model holds its
 /// continuous state and reads parameters and inputs from `Values`. Model Exchange hands
-/// [`Model::STATES`] and [`Model::derivatives`] to the importer's integrator; Co-Simulation calls
-/// [`Model::do_step`], where a model integrates the same equations with [`crate::solver`].
+/// [`Model::STATES`] and [`Model::derivatives`] to the importer's integrator; Co-Simulation
+/// hands [`Model::begin_step`]'s ODE to the driver ([`super::driver::Driven`]), which integrates
+/// it with [`crate::solver`]. The two see the same equations; their coordinates differ where
+/// a model says so ([`Model::Ode`]).
 pub trait Model: Clone + Send + Sized + 'static {
     const INFO: ModelInfo;
     /// The variable table (unique value references across all types).
@@ -99,8 +104,11 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// offending variables when their combination is inconsistent.
     fn initialize(values: &Values) -> Result<Self, String>;
 
-    /// Re-reads tunable parameters changed between steps; keeps the continuous state.
-    fn retune(&mut self, values: &Values) -> Result<(), String>;
+    /// Re-reads tunable parameters changed between steps; keeps the continuous state. Default:
+    /// the model has no tunable parameters.
+    fn retune(&mut self, _values: &Values) -> Result<(), String> {
+        Ok(())
+    }
 
     /// Writes outputs and locals from the current state and inputs.
     fn outputs(&self, values: &mut Values);
@@ -141,23 +149,47 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// at the current time. Default: nothing to do.
     fn inputs_set(&mut self, _vrs: &[u32]) {}
 
-    /// Advances from `t` to `t + h`. Inputs are `values` at `t`, changing with the given first
-    /// derivatives (one per table row; zero unless set) when the model interpolates inputs.
-    fn do_step(
+    /// The ODE Co-Simulation integrates: the same equations as [`Model::derivatives`], in the
+    /// model's native coordinates (the rigid boom in its stroke, where Model Exchange exposes
+    /// its angle; the flexible boom without the padded slots of Model Exchange's fixed layout).
+    /// `()` for a model that steps in closed form.
+    type Ode: OdeSystem;
+
+    /// Co-Simulation, at the start of the step from `t` to `t + h`: takes the step's inputs
+    /// (`values` at `t`, changing with the given first derivatives, one per table row, zero
+    /// unless set, where the model interpolates inputs) and returns its ODE with its state for
+    /// the driver to integrate, or steps itself in closed form ([`Step::Done`]).
+    fn begin_step(
         &mut self,
         values: &Values,
         input_derivatives: &[f64],
         t: f64,
         h: f64,
-        tolerance: f64,
         log: &mut dyn Log,
-    ) -> Result<(), StepError>;
+    ) -> Result<Step<'_, Self::Ode>, StepError>;
 
-    /// The internal state as numbers, for FMU state serialisation.
-    fn save(&self) -> Vec<f64>;
+    /// Typical magnitude of each state of `ode` (absolute tolerance = rtol x scale).
+    fn scale(ode: &Self::Ode) -> Vec<f64>;
 
-    /// Restores a model saved by [`Model::save`] under the given variable values.
-    fn load(values: &Values, state: &[f64]) -> Result<Self, String>;
+    /// After the driver reached the communication point `t`: what the model does there (the TLM
+    /// port emits its wave). Default: nothing.
+    fn communication_point(&mut self, _t: f64) {}
+
+    /// The ODE state the driver integrates (empty for a model that steps in closed form).
+    fn state(&self) -> &[f64];
+
+    /// The length of [`Model::head`].
+    const HEAD: usize = 0;
+
+    /// What a restored model needs beside its ODE state (time, port values, a closed-form
+    /// model's whole state), for FMU states. Default: nothing.
+    fn head(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// The model under the given variable values with a saved head and ODE state; refuses
+    /// numbers that are no state of it.
+    fn restore(values: &Values, head: &[f64], state: &[f64]) -> Result<Self, String>;
 }
 
 /// FMI 2.0, 2.2.8 (FMI 3.0, 2.4.8 alike): whether `v` is an InitialUnknown of model `M`: an

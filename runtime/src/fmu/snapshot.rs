@@ -10,6 +10,7 @@
 //! parameter or input outside its range, inconsistent times): a checksum only proves the bytes
 //! were not damaged, not that they were written by this FMU.
 
+use super::driver::Driven;
 use super::instance::{in_range, Core, TOLERANCE_RANGE};
 use super::log::num;
 use super::machine::Mode;
@@ -178,7 +179,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
             // A model a failed step or an error broke may not load (its solver stopped at NaN):
             // the state reads back without it, in StepFailed, Error or Terminated, where no step
             // follows (only gets, terminate, reset and restore).
-            match M::load(&values, &s) {
+            match Driven::<M>::load(&values, &s) {
                 Err(_) if broken => None,
                 loaded => Some(loaded?),
             }

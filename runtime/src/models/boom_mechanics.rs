@@ -12,14 +12,15 @@
 use super::boom::Boom;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
-use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_STROKE, TIP_DEFLECTION};
+use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_VARIABLES, START_STROKE, TIP_DEFLECTION};
+use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::scalar::{Dual64, Scalar};
-use crate::solver::{OdeSystem, Radau5, SecondOrder};
+use crate::solver::{OdeSystem, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
 /// ([`port::vr`]; its `F` is `port.F`).
@@ -60,9 +61,9 @@ const OWN: [Variable; 17] = [
     port::PORT_F.depends(&[vr::F]),
 ];
 
-const N_VARS: usize = OWN.len() + SOLVER_LOCALS.len() + 3 + N_BOOM_ROWS + BOOM_DERIVATIVES.len();
+const N_VARS: usize = OWN.len() + SOLVER_VARIABLES.len() + 3 + N_BOOM_ROWS + BOOM_DERIVATIVES.len();
 const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
-    .vars(&SOLVER_LOCALS)
+    .vars(&SOLVER_VARIABLES)
     .sections()
     .hydraulics(PARAMS, STROKE, STROKE + 1)
     .boom_params()
@@ -144,7 +145,7 @@ impl OdeSystem for PortedBoom {
     }
 }
 
-/// The BoomMechanics model: ported boom, state, integrator.
+/// The BoomMechanics model: ported boom and state.
 #[derive(Debug, Clone)]
 pub struct BoomMechanics {
     sys: PortedBoom,
@@ -154,7 +155,6 @@ pub struct BoomMechanics {
     /// The wave emitted at `t` (TLM).
     c_m: f64,
     state: Vec<f64>,
-    solver: Radau5,
 }
 
 impl BoomMechanics {
@@ -176,9 +176,8 @@ impl BoomMechanics {
         let input = Ramp { t0: t, y0: input, slope: 0.0 };
         let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input, cylinder };
         let state =
-            super::stepping::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
-        let solver = Radau5::new(sys.dim());
-        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state, solver })
+            super::plant::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
+        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state })
     }
 
     /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
@@ -197,7 +196,7 @@ impl Model for BoomMechanics {
             "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
         interpolated_inputs: &[vr::F, vr::C_H],
         documentation: DOCUMENTATION,
-        ..super::stepping::PLANT_INFO
+        ..super::plant::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &BOOM_STATES;
@@ -278,10 +277,6 @@ impl Model for BoomMechanics {
         Ok(m)
     }
 
-    fn retune(&mut self, _values: &Values) -> Result<(), String> {
-        Ok(())
-    }
-
     fn outputs(&self, values: &mut Values) {
         let mut sys = self.sys.clone();
         if sys.coupling == Coupling::Plain {
@@ -295,45 +290,47 @@ impl Model for BoomMechanics {
         for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
             values.set_real(r, y);
         }
-        super::stepping::solver_outputs(&self.solver, values);
         sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);
     }
 
-    fn do_step(
+    type Ode = PortedBoom;
+
+    fn begin_step(
         &mut self,
         values: &Values,
         input_derivatives: &[f64],
         t: f64,
-        h: f64,
-        tolerance: f64,
-        log: &mut dyn Log,
-    ) -> Result<(), StepError> {
+        _h: f64,
+        _log: &mut dyn Log,
+    ) -> Result<Step<'_, PortedBoom>, StepError> {
         self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
-        let sys = &self.sys;
-        super::stepping::advance(
-            &mut self.solver,
-            sys,
-            &mut self.state,
-            (t, h, tolerance),
-            || sys.boom.scale().collect(),
-            values,
-            log,
-        )?;
-        self.t = t + h;
+        Ok(Step::Integrate(&self.sys, &mut self.state))
+    }
+
+    fn scale(sys: &PortedBoom) -> Vec<f64> {
+        sys.boom.scale().collect()
+    }
+
+    /// The TLM port emits its wave from the state reached.
+    fn communication_point(&mut self, t: f64) {
+        self.t = t;
         let (q, qd) = self.state.split_at(self.sys.boom.mechanics().dof());
         let v = self.sys.boom.mechanics().stroke_rate(q, qd);
         self.c_m = self.sys.coupling.emit(self.c_m, self.sys.force(self.t, v), -v);
-        Ok(())
     }
 
-    fn save(&self) -> Vec<f64> {
-        super::stepping::save(&[self.t, self.sys.input.at(self.t), self.c_m], &self.state, &self.solver)
+    fn state(&self) -> &[f64] {
+        &self.state
     }
 
-    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let (head, state, solver) = super::stepping::split_saved(saved, 3)?;
-        let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
-        m.solver.load_state(solver).map_err(|e| e.to_string())?;
-        Ok(m)
+    /// Time, port input and emitted wave.
+    const HEAD: usize = 3;
+
+    fn head(&self) -> Vec<f64> {
+        vec![self.t, self.sys.input.at(self.t), self.c_m]
+    }
+
+    fn restore(values: &Values, head: &[f64], state: &[f64]) -> Result<Self, String> {
+        Self::with_state(values, Some(state), head[0], [head[1], head[2]])
     }
 }

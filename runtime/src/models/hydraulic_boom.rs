@@ -13,15 +13,16 @@ use super::circuit::CIRCUIT_SCALE;
 use super::port::Ramp;
 use super::exposed::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
 use super::table::{
-    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_LOCALS, START_P4,
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_VARIABLES, START_P4,
     START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
 };
+use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::scalar::{Dual64, Scalar};
-use crate::solver::{OdeSystem, Radau5, SecondOrder};
+use crate::solver::{OdeSystem, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
 pub mod vr {
@@ -42,7 +43,7 @@ const OWN: [Variable; 38] = TableBuilder::new(&[U_REF_INPUT])
         out("payload.y", vr::PAYLOAD_Y, "m", "mm", "Payload mass centre, vertical, from the lower cylinder pin"),
     ])
     .vars(&CIRCUIT_LOCALS)
-    .vars(&SOLVER_LOCALS)
+    .vars(&SOLVER_VARIABLES)
     .vars(&[
         Variable::param(vr::X0, START_STROKE).fixed(),
         Variable::param(vr::START_P4, START_P4).fixed(),
@@ -192,23 +193,21 @@ impl Plant {
     }
 }
 
-/// The HydraulicBoom model: plant, state and integrator.
+/// The HydraulicBoom model: plant and state.
 #[derive(Debug, Clone)]
 pub struct HydraulicBoom {
     plant: Plant,
     state: Vec<f64>,
-    solver: Radau5,
 }
 
 impl HydraulicBoom {
     /// The model with the plant of `values` and the given state (the equilibrium if `None`).
     fn with_state(values: &Values, state: Option<&[f64]>) -> Result<Self, String> {
         let plant = Plant::from_values(values)?;
-        let state = super::stepping::checked_state(plant.dim(), state, || {
+        let state = super::plant::checked_state(plant.dim(), state, || {
             plant.equilibrium(values.real(vr::X0), super::table::trapped_p4(values))
         })?;
-        let solver = Radau5::new(plant.dim());
-        Ok(HydraulicBoom { plant, state, solver })
+        Ok(HydraulicBoom { plant, state })
     }
 }
 
@@ -219,7 +218,7 @@ impl Model for HydraulicBoom {
             "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
         interpolated_inputs: &[vr::U_REF],
         documentation: DOCUMENTATION,
-        ..super::stepping::PLANT_INFO
+        ..super::plant::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &PLANT_STATES;
@@ -285,40 +284,35 @@ impl Model for HydraulicBoom {
         super::exposed::pick_derivatives(&rows, unknowns, out)
     }
 
-    fn retune(&mut self, _values: &Values) -> Result<(), String> {
-        Ok(())
-    }
-
     fn outputs(&self, values: &mut Values) {
         for (r, y) in self.plant.output_rows(values.real(vr::U_REF), &self.state) {
             values.set_real(r, y);
         }
-        super::stepping::solver_outputs(&self.solver, values);
     }
 
-    fn do_step(
+    type Ode = Plant;
+
+    fn begin_step(
         &mut self,
         values: &Values,
         input_derivatives: &[f64],
         t: f64,
-        h: f64,
-        tolerance: f64,
-        log: &mut dyn Log,
-    ) -> Result<(), StepError> {
+        _h: f64,
+        _log: &mut dyn Log,
+    ) -> Result<Step<'_, Plant>, StepError> {
         self.plant.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
-        let plant = &self.plant;
-        let scale = || plant.state_scale();
-        super::stepping::advance(&mut self.solver, plant, &mut self.state, (t, h, tolerance), scale, values, log)
+        Ok(Step::Integrate(&self.plant, &mut self.state))
     }
 
-    fn save(&self) -> Vec<f64> {
-        super::stepping::save(&[], &self.state, &self.solver)
+    fn scale(plant: &Plant) -> Vec<f64> {
+        plant.state_scale()
     }
 
-    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let (_, state, solver) = super::stepping::split_saved(saved, 0)?;
-        let mut m = Self::with_state(values, Some(state))?;
-        m.solver.load_state(solver).map_err(|e| e.to_string())?;
-        Ok(m)
+    fn state(&self) -> &[f64] {
+        &self.state
+    }
+
+    fn restore(values: &Values, _head: &[f64], state: &[f64]) -> Result<Self, String> {
+        Self::with_state(values, Some(state))
     }
 }

@@ -15,14 +15,15 @@ use super::circuit::CIRCUIT_SCALE;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
 use super::table::{
-    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_LOCALS, START_P4, START_STROKE, U_REF_INPUT,
+    out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_VARIABLES, START_P4, START_STROKE, U_REF_INPUT,
 };
+use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
 use crate::scalar::Dual64;
-use crate::solver::{OdeSystem, Radau5, SecondOrder};
+use crate::solver::{OdeSystem, SecondOrder};
 
 /// Value references: HydraulicBoom's for the same names ([`super::vr::vr`]), the port's
 /// ([`port::vr`]; its `F` is `port.F`).
@@ -71,7 +72,7 @@ const OWN: [Variable; 42] = TableBuilder::new(&[U_REF_INPUT])
         out("cylinder.F_fr", vr::F_FR, "N", "kN", "Friction force, with the sign of the velocity").depends(&[vr::X, vr::V]),
     ])
     .vars(&CIRCUIT_LOCALS)
-    .vars(&SOLVER_LOCALS)
+    .vars(&SOLVER_VARIABLES)
     .vars(&[
         Variable::param(vr::X0, START_STROKE).fixed(),
         Variable::param(vr::START_P4, START_P4).fixed(),
@@ -183,7 +184,7 @@ impl OdeSystem for PortedCircuit {
     }
 }
 
-/// The HydraulicCircuit model: ported circuit, state, integrator.
+/// The HydraulicCircuit model: ported circuit and state.
 #[derive(Debug, Clone)]
 pub struct HydraulicCircuit {
     sys: PortedCircuit,
@@ -192,7 +193,6 @@ pub struct HydraulicCircuit {
     /// The wave emitted at `t` (TLM).
     c_h: f64,
     state: Vec<f64>,
-    solver: Radau5,
 }
 
 impl HydraulicCircuit {
@@ -214,7 +214,7 @@ impl HydraulicCircuit {
             v: Ramp { t0: t, y0: values.real(vr::V), slope: 0.0 },
             c_m: Ramp { t0: t, y0: c_m, slope: 0.0 },
         };
-        let state = super::stepping::checked_state(sys.dim(), state, || {
+        let state = super::plant::checked_state(sys.dim(), state, || {
             if !(0.0..=stroke).contains(&x0) {
                 return Err(format!("start.x = {x0} is outside the stroke [0, {stroke}] m (cylinder.stroke)"));
             }
@@ -227,8 +227,7 @@ impl HydraulicCircuit {
             let rod = if sys.dim() > N_CIRCUIT { vec![x0, 0.0] } else { vec![] };
             Ok([&c[..], &rod].concat())
         })?;
-        let solver = Radau5::new(sys.dim());
-        Ok(HydraulicCircuit { sys, t, c_h, state, solver })
+        Ok(HydraulicCircuit { sys, t, c_h, state })
     }
 
     /// Typical magnitude of each of `n` states (atol = rtol x scale): the circuit's scales, 1 mm
@@ -245,7 +244,7 @@ impl Model for HydraulicCircuit {
         // cylinder.x follows the integral of cylinder.v within a step: it has no slope of its own.
         interpolated_inputs: &[vr::U_REF, vr::X, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
-        ..super::stepping::PLANT_INFO
+        ..super::plant::PLANT_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
@@ -308,10 +307,6 @@ impl Model for HydraulicCircuit {
         dx.copy_from_slice(&e.dx);
     }
 
-    fn retune(&mut self, _values: &Values) -> Result<(), String> {
-        Ok(())
-    }
-
     fn outputs(&self, values: &mut Values) {
         let mut sys = self.sys.clone();
         sys.u_ref = Ramp { t0: self.t, y0: values.real(vr::U_REF), slope: 0.0 };
@@ -323,51 +318,53 @@ impl Model for HydraulicCircuit {
         let (e, f_line) = sys.evaluate(self.t, s);
         let c_h = if sys.coupling == Coupling::Plain { f_line } else { self.c_h };
         super::circuit::circuit_outputs(s[..N_CIRCUIT].try_into().expect("circuit slice"), &e, values);
-        super::stepping::solver_outputs(&self.solver, values);
         for (r, y) in [(vr::C_H, c_h), (port::vr::F, f_line), (vr::PORT_X, x), (vr::PORT_V, v)] {
             values.set_real(r, y);
         }
     }
 
-    fn do_step(
+    type Ode = PortedCircuit;
+
+    fn begin_step(
         &mut self,
         values: &Values,
         input_derivatives: &[f64],
         t: f64,
-        h: f64,
-        tolerance: f64,
-        log: &mut dyn Log,
-    ) -> Result<(), StepError> {
+        _h: f64,
+        _log: &mut dyn Log,
+    ) -> Result<Step<'_, PortedCircuit>, StepError> {
         let sys = &mut self.sys;
         sys.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
         sys.x0 = values.real(vr::X);
         sys.v = Ramp::read(values, input_derivatives, vr::V, t);
         sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);
-        let n = self.sys.dim();
-        super::stepping::advance(
-            &mut self.solver,
-            &self.sys,
-            &mut self.state,
-            (t, h, tolerance),
-            || Self::state_scale(n),
-            values,
-            log,
-        )?;
-        self.t = t + h;
+        Ok(Step::Integrate(&self.sys, &mut self.state))
+    }
+
+    fn scale(sys: &PortedCircuit) -> Vec<f64> {
+        Self::state_scale(sys.dim())
+    }
+
+    /// The TLM port emits its wave from the state reached.
+    fn communication_point(&mut self, t: f64) {
+        self.t = t;
         let (_, v) = self.sys.motion(self.t, &self.state);
         self.c_h = self.sys.coupling.emit(self.c_h, self.sys.evaluate(self.t, &self.state).1, v);
-        Ok(())
     }
 
-    fn save(&self) -> Vec<f64> {
-        super::stepping::save(&[self.t, self.sys.c_m.at(self.t), self.c_h], &self.state, &self.solver)
+    fn state(&self) -> &[f64] {
+        &self.state
     }
 
-    fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
-        let (head, state, solver) = super::stepping::split_saved(saved, 3)?;
-        let mut m = Self::with_state(values, Some(state), head[0], [head[1], head[2]])?;
-        m.solver.load_state(solver).map_err(|e| e.to_string())?;
-        Ok(m)
+    /// Time, received wave and emitted wave.
+    const HEAD: usize = 3;
+
+    fn head(&self) -> Vec<f64> {
+        vec![self.t, self.sys.c_m.at(self.t), self.c_h]
+    }
+
+    fn restore(values: &Values, head: &[f64], state: &[f64]) -> Result<Self, String> {
+        Self::with_state(values, Some(state), head[0], [head[1], head[2]])
     }
 }
 

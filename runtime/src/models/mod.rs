@@ -6,10 +6,10 @@ pub mod boom_mechanics;
 pub mod circuit;
 pub mod hydraulic_boom;
 pub mod hydraulic_circuit;
+pub mod plant;
 pub mod port;
 pub mod pressure_feedback_controller;
 pub mod exposed;
-pub mod stepping;
 pub mod table;
 pub mod vr;
 

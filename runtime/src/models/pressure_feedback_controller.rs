@@ -12,6 +12,7 @@
 use super::port::Ramp;
 use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
 use crate::fmu::instance::bounded_slope;
+use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
 
 /// Value references (stable across releases).
@@ -270,15 +271,19 @@ impl Model for PressureFeedbackController {
         self.fresh |= vrs.contains(&vr::P);
     }
 
-    fn do_step(
+    /// No ODE for the driver: the filter steps in closed form (below).
+    type Ode = ();
+
+    /// The filter x' = omega_f (p - x) over the step, exact for the pressure ramped with its
+    /// slope ([`HighPassFeedback::advance`]): a closed form no integrator beats.
+    fn begin_step(
         &mut self,
         values: &Values,
         input_derivatives: &[f64],
         t: f64,
         h: f64,
-        _tolerance: f64,
         log: &mut dyn Log,
-    ) -> Result<(), StepError> {
+    ) -> Result<Step<'_, ()>, StepError> {
         let p = self.pressure_ramp(values, input_derivatives, t, h);
         self.x = self.feedback.advance(self.x, p.at(t), p.slope, h);
         (self.p, self.sampled, self.fresh, self.t) = (p, true, false, t + h);
@@ -289,25 +294,36 @@ impl Model for PressureFeedbackController {
                 &format!("t = {}: u_ref + u_comp = {u} clamped to [{}, {}]", t + h, self.u_min, self.u_max),
             );
         }
-        Ok(())
+        Ok(Step::Done)
     }
 
-    fn save(&self) -> Vec<f64> {
+    fn scale(_: &()) -> Vec<f64> {
+        Vec::new()
+    }
+
+    fn state(&self) -> &[f64] {
+        &[]
+    }
+
+    /// The filter state, the time, the pressure ramp (t0, p, slope) and two flags (0/1).
+    const HEAD: usize = 7;
+
+    fn head(&self) -> Vec<f64> {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         vec![self.x, self.t, self.p.t0, self.p.y0, self.p.slope, flag(self.sampled), flag(self.fresh)]
     }
 
-    fn load(values: &Values, state: &[f64]) -> Result<Self, String> {
-        match *state {
+    fn restore(values: &Values, head: &[f64], _state: &[f64]) -> Result<Self, String> {
+        match *head {
             [x, t, t0, y0, slope, sampled, fresh]
-                if state.iter().all(|v| v.is_finite()) && [sampled, fresh].iter().all(|f| *f == 0.0 || *f == 1.0) =>
+                if head.iter().all(|v| v.is_finite()) && [sampled, fresh].iter().all(|f| *f == 0.0 || *f == 1.0) =>
             {
                 let c = Self::from_values(values, x)?;
                 let p = Ramp { t0, y0, slope };
                 Ok(PressureFeedbackController { t, p, sampled: sampled == 1.0, fresh: fresh == 1.0, ..c })
             }
             _ => Err(format!(
-                "expected the filter state, time, pressure ramp (t0, p, slope) and two flags (0/1), all finite; got {state:?}"
+                "expected the filter state, time, pressure ramp (t0, p, slope) and two flags (0/1), all finite; got {head:?}"
             )),
         }
     }

@@ -63,27 +63,7 @@ pub(crate) const CIRCUIT_LOCALS: [Variable; 6] = [
         "Event indicator x_v + x_db: at 0 the load-sensing pressure switches between p4 and tank"),
 ];
 
-/// The integrator's mode ([`super::stepping::advance`]) and counters.
-#[rustfmt::skip]
-pub(crate) const SOLVER_LOCALS: [Variable; 8] = [
-    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
-    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
-    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
-    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
-    Variable::int_param("solver.mode", vr::SOLVER_MODE, 0, (0, 1),
-        "Integrator of the Co-Simulation doStep (no effect in Model Exchange): 0 adaptive (error control with the \
-         experiment's tolerance, as many steps as that needs), 1 real-time (the same within solver.rhs_budget \
-         right-hand-side evaluations per communication step, a bounded cost: when the budget runs short, one closing \
-         step of bounded work reaches the communication point and its accuracy is reported in solver.accuracy_loss \
-         instead of a rejected step)"),
-    Variable::int_param("solver.rhs_budget", vr::RHS_BUDGET, 400, (100, 1_000_000),
-        "Real-time mode: right-hand-side evaluations (Jacobian columns included) per communication step, at most"),
-    Variable::real_local("solver.accuracy_loss", vr::ACCURACY_LOSS, "1", "",
-        "Real-time mode: local error estimate of the closing step of the last communication step, in units of the \
-         tolerance (above 1: a step the adaptive mode would have rejected); 0 when no closing step was needed"),
-    Variable::real_local("solver.inaccurate_steps", vr::INACCURATE_STEPS, "1", "",
-        "Real-time mode: closing steps with solver.accuracy_loss above 1 since initialisation"),
-];
+pub(crate) use crate::fmu::driver::SOLVER_VARIABLES;
 
 pub(crate) const START_STROKE: ParamSpec = ParamSpec {
     name: "start.x",

@@ -1,5 +1,8 @@
 //! Value references shared by every model that has the variable (stable: append, never renumber).
 
+/// The driver's: the integrator's mode and counters (23-26, 33-36).
+pub use crate::fmu::driver::vr::*;
+
 pub const U_REF: u32 = 0;
 pub const P1: u32 = 1;
 pub const P2: u32 = 2;
@@ -23,10 +26,6 @@ pub const PAYLOAD_Y: u32 = 19;
 pub const X_V: u32 = 20;
 pub const U_PCV: u32 = 21;
 pub const P_X: u32 = 22;
-pub const SOLVER_STEPS: u32 = 23;
-pub const SOLVER_REJECTED: u32 = 24;
-pub const SOLVER_RHS: u32 = 25;
-pub const SOLVER_JACOBIANS: u32 = 26;
 /// The circuit's event indicators ([`crate::models::circuit::event_indicators`]).
 pub const EVENT_U_REF: u32 = 27;
 pub const EVENT_DEAD_BAND_UPPER: u32 = 28;
@@ -34,12 +33,6 @@ pub const EVENT_DEAD_BAND_LOWER: u32 = 29;
 pub const X0: u32 = 30;
 pub const FLEXIBLE: u32 = 31;
 pub const START_P4: u32 = 32;
-/// The integrator of doStep ([`crate::models::stepping`]): mode, the real-time mode's accuracy
-/// indicator, its budget per communication step, its inaccurate steps.
-pub const SOLVER_MODE: u32 = 33;
-pub const ACCURACY_LOSS: u32 = 34;
-pub const RHS_BUDGET: u32 = 35;
-pub const INACCURATE_STEPS: u32 = 36;
 pub const TIP_DEFLECTION: u32 = 40;
 /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
 pub const SECTIONS: u32 = 41;

@@ -1,0 +1,209 @@
+//! The Co-Simulation driver: one for every model. A model states its ODE and state
+//! ([`Model::begin_step`]); the driver integrates it over the communication step with the stiff
+//! Radau IIA of [`crate::solver`] (adaptive, or real-time with a bounded cost per step), then
+//! lets the model act at the communication point ([`Model::communication_point`]: the TLM wave),
+//! writes the integrator's counters as outputs, and saves and restores the integrator with the
+//! model in FMU states. No model owns a solver.
+//!
+//! The one special case is a model whose equations have a closed-form solution over a step:
+//! the controller's first-order filter under a ramped input (eq. 6.2) is stepped exactly by the
+//! model itself ([`Step::Done`]), which no integrator beats; such a model has no ODE state and
+//! the driver no integrator for it.
+
+use super::model::{Log, Model, StepError};
+use super::variables::{Values, Variable};
+use crate::solver::{OdeSystem, Radau5, SolverStats};
+use std::ops::{Deref, DerefMut};
+
+/// The driver's variables' value references (stable: append, never renumber).
+pub mod vr {
+    pub const SOLVER_STEPS: u32 = 23;
+    pub const SOLVER_REJECTED: u32 = 24;
+    pub const SOLVER_RHS: u32 = 25;
+    pub const SOLVER_JACOBIANS: u32 = 26;
+    /// The integrator's mode, the real-time mode's accuracy indicator, its budget per
+    /// communication step, its inaccurate steps.
+    pub const SOLVER_MODE: u32 = 33;
+    pub const ACCURACY_LOSS: u32 = 34;
+    pub const RHS_BUDGET: u32 = 35;
+    pub const INACCURATE_STEPS: u32 = 36;
+}
+
+/// `solver.mode` of the real-time mode (0, the default, is the adaptive integrator).
+pub const REALTIME: i32 = 1;
+
+/// The integrator's mode and counters: the variables of every model the driver integrates.
+#[rustfmt::skip]
+pub const SOLVER_VARIABLES: [Variable; 8] = [
+    Variable::real_local("solver.steps", vr::SOLVER_STEPS, "1", "", "Accepted integrator steps since initialisation"),
+    Variable::real_local("solver.rejected_steps", vr::SOLVER_REJECTED, "1", "", "Rejected integrator steps"),
+    Variable::real_local("solver.rhs_evals", vr::SOLVER_RHS, "1", "", "Right-hand-side evaluations"),
+    Variable::real_local("solver.jacobian_evals", vr::SOLVER_JACOBIANS, "1", "", "Jacobian evaluations"),
+    Variable::int_param("solver.mode", vr::SOLVER_MODE, 0, (0, 1),
+        "Integrator of the Co-Simulation doStep (no effect in Model Exchange): 0 adaptive (error control with the \
+         experiment's tolerance, as many steps as that needs), 1 real-time (the same within solver.rhs_budget \
+         right-hand-side evaluations per communication step, a bounded cost: when the budget runs short, one closing \
+         step of bounded work reaches the communication point and its accuracy is reported in solver.accuracy_loss \
+         instead of a rejected step)"),
+    Variable::int_param("solver.rhs_budget", vr::RHS_BUDGET, 400, (100, 1_000_000),
+        "Real-time mode: right-hand-side evaluations (Jacobian columns included) per communication step, at most"),
+    Variable::real_local("solver.accuracy_loss", vr::ACCURACY_LOSS, "1", "",
+        "Real-time mode: local error estimate of the closing step of the last communication step, in units of the \
+         tolerance (above 1: a step the adaptive mode would have rejected); 0 when no closing step was needed"),
+    Variable::real_local("solver.inaccurate_steps", vr::INACCURATE_STEPS, "1", "",
+        "Real-time mode: closing steps with solver.accuracy_loss above 1 since initialisation"),
+];
+
+/// What a model asks of the driver at the start of a communication step.
+pub enum Step<'a, S> {
+    /// Integrate `ode` from `state` (the model's, advanced in place) over the step.
+    Integrate(&'a S, &'a mut [f64]),
+    /// The model advanced itself over the step in closed form.
+    Done,
+}
+
+/// The ODE of a model that steps in closed form: none.
+impl OdeSystem for () {
+    fn dim(&self) -> usize {
+        0
+    }
+
+    fn rhs(&self, _t: f64, _x: &[f64], _dx: &mut [f64]) {}
+}
+
+/// A model with the driver's integrator (none for a model without ODE state).
+#[derive(Debug, Clone)]
+pub struct Driven<M> {
+    model: M,
+    solver: Option<Radau5>,
+}
+
+impl<M> Deref for Driven<M> {
+    type Target = M;
+    fn deref(&self) -> &M {
+        &self.model
+    }
+}
+
+impl<M> DerefMut for Driven<M> {
+    fn deref_mut(&mut self) -> &mut M {
+        &mut self.model
+    }
+}
+
+impl<M: Model> Driven<M> {
+    /// `model` with a fresh integrator for its ODE state.
+    pub fn new(model: M) -> Self {
+        let n = model.state().len();
+        Driven { model, solver: (n > 0).then(|| Radau5::new(n)) }
+    }
+
+    /// Advances from `t` to `t + h`: inputs are `values` at `t`, changing with the given first
+    /// derivatives (one per table row; zero unless set) where the model interpolates inputs.
+    /// The relative tolerance is `tolerance`, the absolute ones `tolerance` times the model's
+    /// [`Model::scale`] (evaluated only when the tolerance changes). `solver.mode` picks the
+    /// integration: adaptive ([`Radau5::integrate`]: error control, steps rejected and repeated
+    /// as needed) or real-time ([`Radau5::integrate_bounded`]: the same within
+    /// `solver.rhs_budget` RHS evaluations, the accuracy of its closing step reported instead of
+    /// enforced). Neither allocates.
+    pub fn step(
+        &mut self,
+        values: &Values,
+        input_derivatives: &[f64],
+        (t, h, tolerance): (f64, f64, f64),
+        log: &mut dyn Log,
+    ) -> Result<(), StepError> {
+        let fail = |time, message: String| StepError { time, message };
+        match (self.model.begin_step(values, input_derivatives, t, h, log)?, &mut self.solver) {
+            (Step::Done, _) => return Ok(()),
+            (Step::Integrate(ode, state), Some(solver)) => {
+                solver.set_tolerance(tolerance, || M::scale(ode)).map_err(|e| fail(t, e.to_string()))?;
+                let before = *solver.stats();
+                let result = match values.integer(vr::SOLVER_MODE) {
+                    REALTIME => solver.integrate_bounded(ode, t, state, t + h, values.integer(vr::RHS_BUDGET) as u64),
+                    _ => solver.integrate(ode, t, state, t + h),
+                };
+                result.map_err(|e| fail(e.t, e.to_string()))?;
+                log_step(log, t + h, &before, solver.stats());
+            }
+            (Step::Integrate(..), None) => return Err(fail(t, "the model has no ODE state to integrate".into())),
+        }
+        self.model.communication_point(t + h);
+        Ok(())
+    }
+
+    /// Writes the model's outputs and locals, and the integrator's counters.
+    pub fn outputs(&self, values: &mut Values) {
+        self.model.outputs(values);
+        if let Some(solver) = &self.solver {
+            let stats = solver.stats();
+            values.set_real(vr::SOLVER_STEPS, stats.accepted_steps as f64);
+            values.set_real(vr::SOLVER_REJECTED, stats.rejected_steps as f64);
+            values.set_real(vr::SOLVER_RHS, stats.rhs_evals as f64);
+            values.set_real(vr::SOLVER_JACOBIANS, stats.jacobian_evals as f64);
+            values.set_real(vr::ACCURACY_LOSS, solver.accuracy_loss());
+            values.set_real(vr::INACCURATE_STEPS, stats.inaccurate_steps as f64);
+        }
+    }
+
+    /// The model and its integrator as numbers, for FMU state serialisation: the model's head
+    /// ([`Model::head`]), its ODE state, the integrator's state.
+    pub fn save(&self) -> Vec<f64> {
+        let solver = self.solver.as_ref().map(Radau5::save_state).unwrap_or_default();
+        [&self.model.head()[..], self.model.state(), &solver].concat()
+    }
+
+    /// Restores a model saved by [`Driven::save`] under the given variable values.
+    pub fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
+        let (head, state, saved_solver) = match saved.len() == M::HEAD {
+            true => (saved, &[][..], None),
+            false => split_saved(saved, M::HEAD).map(|(h, s, v)| (h, s, Some(v)))?,
+        };
+        let model = M::restore(values, head, state)?;
+        if model.state().len() != state.len() {
+            return Err(format!("{} numbers are no saved model state", saved.len()));
+        }
+        let solver = match saved_solver {
+            Some(v) => {
+                let mut solver = Radau5::new(state.len());
+                solver.load_state(v).map_err(|e| e.to_string())?;
+                Some(solver)
+            }
+            None => None,
+        };
+        Ok(Driven { model, solver })
+    }
+}
+
+/// A saved model's parts: head, state, integrator state.
+type Saved<'a> = (&'a [f64], &'a [f64], &'a [f64]);
+
+/// The parts of a model saved with `n_head` leading numbers: the state dimension n is the one
+/// for which head + n + the integrator's saved length add up to the total.
+fn split_saved(saved: &[f64], n_head: usize) -> Result<Saved<'_>, String> {
+    let rest = saved.len().checked_sub(n_head).ok_or("the saved model state is too short")?;
+    let n = (0..=rest)
+        .find(|&n| n + Radau5::saved_len(n) >= rest)
+        .filter(|&n| n + Radau5::saved_len(n) == rest)
+        .ok_or_else(|| format!("{} numbers are no saved model state", saved.len()))?;
+    let (head, rest) = saved.split_at(n_head);
+    let (state, solver) = rest.split_at(n);
+    Ok((head, state, solver))
+}
+
+/// Logs the integrator statistics of the step that ended at `t` (category `logSolver`).
+fn log_step(log: &mut dyn Log, t: f64, before: &SolverStats, after: &SolverStats) {
+    if !log.enabled("logSolver") {
+        return;
+    }
+    log.info(
+        "logSolver",
+        &format!(
+            "t = {t}: {} steps ({} rejected), {} RHS, {} Jacobians",
+            after.accepted_steps - before.accepted_steps,
+            after.rejected_steps - before.rejected_steps,
+            after.rhs_evals - before.rhs_evals,
+            after.jacobian_evals - before.jacobian_evals
+        ),
+    );
+}
