@@ -4,7 +4,7 @@
 
 use crate::chart::{chart, escape, Panel};
 use crate::in_process::{InProcess, Slave};
-use boomsim::control::FEEDBACK_SPECS;
+use boomsim::control::FEEDBACK_PARAMS;
 use boomsim::fmu::log::num;
 use boomsim::fmu::variables::Kind;
 use boomsim::fmu::Model;
@@ -49,14 +49,14 @@ impl Figures for PressureFeedbackController {
         let plotted = plot::<PressureFeedbackController>(title, 0.25, &[], step, &record, &[&[0], &[1]]);
         figure(plotted, |t, data| {
             let at = |time: f64| t.iter().position(|&x| x >= time - 1e-12).map_or(f64::NAN, |k| data[1][k]);
-            let tau = 1.0 / FEEDBACK_SPECS[1].default;
+            let tau = 1.0 / FEEDBACK_PARAMS[1].spec.default;
             format!(
                 "With the start values (K_f = {}, omega_f = {} rad/s, Q_rated = {} l/min), the compensation follows \
                  the high-pass filter of eq. 6.2: u_comp jumps to {} % when p rises by 1 bar and {} ms (1/omega_f) \
                  later is {} %, then decays to zero while p stays. Computed by this FMU's model when it was packed.",
-                num(FEEDBACK_SPECS[0].default),
-                num(FEEDBACK_SPECS[1].default),
-                num(FEEDBACK_SPECS[2].default * 60_000.0),
+                num(FEEDBACK_PARAMS[0].spec.default),
+                num(FEEDBACK_PARAMS[1].spec.default),
+                num(FEEDBACK_PARAMS[2].spec.default * 60_000.0),
                 num((at(T_STEP + 1e-3) * 1e4).round() / 100.0),
                 num((tau * 1e4).round() / 10.0),
                 num((at(T_STEP + 1e-3 + tau) * 1e4).round() / 100.0),

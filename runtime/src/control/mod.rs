@@ -2,4 +2,4 @@
 
 pub mod pressure_feedback;
 
-pub use pressure_feedback::{HighPassFeedback, FEEDBACK_SPECS};
+pub use pressure_feedback::{HighPassFeedback, FEEDBACK_PARAMS};

@@ -19,8 +19,8 @@
 //! `z' = a - omega_f z`, so `z(h) = z0 e^(-omega_f h) + (a/omega_f)(1 - e^(-omega_f h))`.
 //! Any partition of a piecewise-linear input therefore gives the same state up to rounding.
 
-use crate::params::ParamSpec;
-use crate::units::lpm;
+use crate::param;
+use crate::params::{build, Param};
 
 /// Parameters of the feedback, with the experiment-B defaults (Table 7.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,43 +33,24 @@ pub struct HighPassFeedback {
     pub q_rated: f64,
 }
 
-/// Parameter descriptions: name, default, unit, range and source.
-pub const FEEDBACK_SPECS: [ParamSpec; 3] = [
-    ParamSpec {
-        name: "K_f",
-        default: 1.24e-11,
-        unit: "m4.s2/kg",
-        display_unit: "",
-        min: 0.0,
-        max: 1e-8,
-        description: "Filter gain K_f of G_f(s) = K_f s/(s/omega_f + 1) (eq. 6.2)",
-        source: "Table 7.2, experiment B (corrected filter of section 6.2)",
-    },
-    ParamSpec {
-        name: "omega_f",
-        default: 35.8,
-        unit: "rad/s",
-        display_unit: "",
-        min: 1e-3,
-        max: 1e5,
-        description: "Filter corner frequency omega_f (eq. 6.2)",
-        source: "Table 7.2, experiment B",
-    },
-    ParamSpec {
-        name: "Q_rated",
-        default: 25.0 / 60_000.0,
-        unit: "m3/s",
-        display_unit: "l/min",
-        min: 1e-6,
-        max: 1.0,
-        description: "Valve flow per unit spool opening; turns the feedback flow into spool opening",
-        source: "Rated flow of the PVG32 linear flow spool, 25 l/min (section 2.2.1)",
-    },
+/// The feedback's parameters: name, default, unit, range, source and field.
+#[rustfmt::skip]
+pub const FEEDBACK_PARAMS: [Param<HighPassFeedback>; 3] = [
+    param!("K_f", k_f, 1.24e-11, "m4.s2/kg", "", [0.0, 1e-8],
+        "Filter gain K_f of G_f(s) = K_f s/(s/omega_f + 1) (eq. 6.2)",
+        "Table 7.2, experiment B (corrected filter of section 6.2)"),
+    param!("omega_f", omega_f, 35.8, "rad/s", "", [1e-3, 1e5],
+        "Filter corner frequency omega_f (eq. 6.2)", "Table 7.2, experiment B"),
+    param!("Q_rated", q_rated, 25.0 / 60_000.0, "m3/s", "l/min", [1e-6, 1.0],
+        "Valve flow per unit spool opening; turns the feedback flow into spool opening",
+        "Rated flow of the PVG32 linear flow spool, 25 l/min (section 2.2.1)"),
 ];
 
 impl Default for HighPassFeedback {
+    /// The defaults of [`FEEDBACK_PARAMS`].
     fn default() -> Self {
-        HighPassFeedback { k_f: FEEDBACK_SPECS[0].default, omega_f: FEEDBACK_SPECS[1].default, q_rated: lpm(25.0) }
+        let zero = HighPassFeedback { k_f: 0.0, omega_f: 0.0, q_rated: 0.0 };
+        build(zero, &FEEDBACK_PARAMS, |k| FEEDBACK_PARAMS[k].spec.default)
     }
 }
 

@@ -10,17 +10,13 @@ use super::friction::{Friction, FrictionModel};
 use super::line::{Fluid, Lines};
 use super::pcv::Pcv;
 use super::supply::Supply;
+use crate::param;
 use crate::params::ParamSpec;
 use crate::units::{BAR, CM3, LPM, MM};
 use std::f64::consts::FRAC_PI_4;
 
 /// One circuit parameter: its description and how to read and write it.
-#[derive(Debug, Clone, Copy)]
-pub struct Param {
-    pub spec: ParamSpec,
-    pub get: fn(&Circuit) -> f64,
-    pub set: fn(&mut Circuit, f64),
-}
+pub type Param = crate::params::Param<Circuit>;
 
 /// Why [`Circuit::set_param`] refused a value.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,26 +35,6 @@ impl std::fmt::Display for ParamError {
 }
 
 impl std::error::Error for ParamError {}
-
-macro_rules! param {
-    ($name:literal, $($field:ident).+, $default:expr, $unit:literal, $display:literal,
-     [$min:expr, $max:expr], $description:literal, $source:literal) => {
-        Param {
-            spec: ParamSpec {
-                name: $name,
-                default: $default,
-                unit: $unit,
-                display_unit: $display,
-                min: $min,
-                max: $max,
-                description: $description,
-                source: $source,
-            },
-            get: |c| c.$($field).+,
-            set: |c, v| c.$($field).+ = v,
-        }
-    };
-}
 
 /// The circuit parameters (SI). Cross-parameter constraints (e.g. `valve.x_db < valve.x_max`,
 /// `cylinder.d_rod < cylinder.d_piston`) are not part of the ranges.
@@ -325,6 +301,7 @@ pub const PARAMS: &[Param] = &[
             max: 2.0,
             description: "Friction model: 0 Bak (2.65), 1 Ottestad et al. (2.63), 2 fitted (5.4); rounded",
             source: "2.2.3, 5.1.2; Bak is the thesis' simulation model",
+            integer: true,
         },
         get: |c| c.friction.model.index() as f64,
         set: |c, v| {

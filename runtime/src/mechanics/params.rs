@@ -1,7 +1,8 @@
 //! Parameters of the boom, its payload and the cylinder's mechanical data (thesis nomenclature,
-//! section 2.1 and chapter 3.1), each described once in [`SPECS`].
+//! section 2.1 and chapter 3.1), each described once in [`BOOM_PARAMS`] and [`BEAM_PARAMS`].
 
-use crate::params::ParamSpec;
+use crate::param;
+use crate::params::{build, Param};
 
 /// The retracted pin-to-pin cylinder length, which the thesis does not give.
 ///
@@ -23,72 +24,57 @@ use crate::params::ParamSpec;
 ///   is flat in the stroke, so this confirms masses and geometry rather than the length itself.
 pub const L_RETRACTED_DEFAULT: f64 = 0.75;
 
-/// Positional constructor of a [`ParamSpec`], to keep [`SPECS`] one entry per parameter.
-#[allow(clippy::too_many_arguments)]
-const fn spec(
-    name: &'static str,
-    default: f64,
-    unit: &'static str,
-    display_unit: &'static str,
-    min: f64,
-    max: f64,
-    description: &'static str,
-    source: &'static str,
-) -> ParamSpec {
-    ParamSpec { name, default, unit, display_unit, min, max, description, source }
-}
-
 const NOMENCLATURE: &str = "thesis nomenclature, list of parameters; Fig. 2.1";
 
 /// Every boom, payload and cylinder-mechanics parameter (SI).
 #[rustfmt::skip]
-pub const SPECS: &[ParamSpec] = &[
-    spec("boom.b1", 0.050, "m", "mm", 0.0, 0.5,
+pub const BOOM_PARAMS: &[Param<BoomParams>] = &[
+    param!("boom.b1", (b[0]), 0.050, "m", "mm", [0.0, 0.5],
         "Joint centre to inner end of the lower beam", NOMENCLATURE),
-    spec("boom.b2", 0.076, "m", "mm", 0.0, 0.5,
+    param!("boom.b2", (b[1]), 0.076, "m", "mm", [0.0, 0.5],
         "End of the lower mounting bracket to its bolt hole", NOMENCLATURE),
-    spec("boom.b3", 0.058, "m", "mm", 0.0, 0.5,
+    param!("boom.b3", (b[2]), 0.058, "m", "mm", [0.0, 0.5],
         "Bottom of the lower mounting bracket to its bolt hole", NOMENCLATURE),
-    spec("boom.b4", 0.076, "m", "mm", 0.0, 0.5,
+    param!("boom.b4", (b[3]), 0.076, "m", "mm", [0.0, 0.5],
         "End of the upper mounting bracket to its bolt hole", NOMENCLATURE),
-    spec("boom.b5", 0.058, "m", "mm", 0.0, 0.5,
+    param!("boom.b5", (b[4]), 0.058, "m", "mm", [0.0, 0.5],
         "Bottom of the upper mounting bracket to its bolt hole", NOMENCLATURE),
-    spec("boom.b6", 0.075, "m", "mm", 0.0, 0.5,
+    param!("boom.b6", (b[5]), 0.075, "m", "mm", [0.0, 0.5],
         "Joint centre to the bottom of the upper beam (arm)", NOMENCLATURE),
-    spec("boom.b7", 0.080, "m", "mm", 0.0, 0.5,
+    param!("boom.b7", (b[6]), 0.080, "m", "mm", [0.0, 0.5],
         "Joint centre to the inner end of the upper beam (arm)", NOMENCLATURE),
-    spec("boom.b8", 1.115, "m", "mm", 0.1, 3.0,
+    param!("boom.b8", (b[7]), 1.115, "m", "mm", [0.1, 3.0],
         "Joint centre to the top of the lower beam", NOMENCLATURE),
-    spec("boom.l1", 0.600, "m", "mm", 0.0, 2.0,
+    param!("boom.l1", l1, 0.600, "m", "mm", [0.0, 2.0],
         "Inner end of the arm to the inner end of the upper cylinder bracket",
         "chapter 3.1 (the nomenclature lists 548 mm, a different rig setting)"),
-    spec("boom.l2", 0.300, "m", "mm", 0.0, 2.0,
+    param!("boom.l2", l2, 0.300, "m", "mm", [0.0, 2.0],
         "Inner end of the lower beam to the inner end of the lower cylinder bracket",
         "chapter 3.1 (the nomenclature lists 410 mm, a different rig setting)"),
-    spec("boom.l_arm", 3.680, "m", "mm", 0.5, 10.0,
+    param!("boom.l_arm", l_arm, 3.680, "m", "mm", [0.5, 10.0],
         "Length of the arm (upper beam)", NOMENCLATURE),
-    spec("boom.m_arm", 81.0, "kg", "", 1.0, 1000.0,
+    param!("boom.m_arm", m_arm, 81.0, "kg", "", [1.0, 1000.0],
         "Mass of the arm, uniform over its length", NOMENCLATURE),
-    spec("payload.m", 382.6, "kg", "", 0.0, 2000.0,
+    param!("payload.m", m_pl, 382.6, "kg", "", [0.0, 2000.0],
         "Payload mass (point mass, fixture and all plates)",
         "chapter 3.1, experiment I: 'all available weights'; the nomenclature's fixture 7.5 kg + \
          plates 4 x 76 kg + 16 kg sum to 327.5 kg only"),
-    spec("payload.x_inboard", 0.080, "m", "mm", 0.0, 3.0,
+    param!("payload.x_inboard", x_pl_inboard, 0.080, "m", "mm", [0.0, 3.0],
         "Payload mass centre inboard of the arm's outer end (l_pl = l_arm - x_inboard, eq. 2.8)",
         "chapter 3.1, experiment I"),
-    spec("payload.h", 0.070, "m", "mm", -0.5, 0.5,
+    param!("payload.h", h_pl, 0.070, "m", "mm", [-0.5, 0.5],
         "Payload mass centre above the arm's centre line (h_pl, eq. 2.8)",
         "chapter 3.1, experiment I"),
-    spec("cylinder.l_retracted", L_RETRACTED_DEFAULT, "m", "mm", 0.3, 3.0,
+    param!("cylinder.l_retracted", l_retracted, L_RETRACTED_DEFAULT, "m", "mm", [0.3, 3.0],
         "Pin-to-pin cylinder length when fully retracted (l_cyl = l_retracted + stroke position)",
         "not in the thesis: stroke + 250 mm build length, see mechanics::params::L_RETRACTED_DEFAULT"),
-    spec("cylinder.m_rod", 5.0, "kg", "", 0.0, 100.0,
+    param!("cylinder.m_rod", m_rod, 5.0, "kg", "", [0.0, 100.0],
         "Mass of the cylinder rod and piston, moving with the stroke", NOMENCLATURE),
-    spec("env.g", 9.807, "m/s2", "", 0.0, 30.0,
+    param!("env.g", g, 9.807, "m/s2", "", [0.0, 30.0],
         "Gravitational acceleration", NOMENCLATURE),
 ];
 
-/// The boom parameters as numbers (SI); names and ranges are in [`SPECS`].
+/// The boom parameters as numbers (SI); names and ranges are in [`BOOM_PARAMS`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoomParams {
     /// Bracket and joint dimensions b_1..b_8 (index 0 is b_1), Fig. 2.1.
@@ -106,31 +92,23 @@ pub struct BoomParams {
 }
 
 impl BoomParams {
-    /// Reads every parameter by its structured name from `value` (e.g. the FMU's parameter
-    /// values, already checked against the [`SPECS`] ranges).
-    pub fn from_lookup(value: impl Fn(&str) -> f64) -> Self {
-        Self {
-            b: [
-                value("boom.b1"),
-                value("boom.b2"),
-                value("boom.b3"),
-                value("boom.b4"),
-                value("boom.b5"),
-                value("boom.b6"),
-                value("boom.b7"),
-                value("boom.b8"),
-            ],
-            l1: value("boom.l1"),
-            l2: value("boom.l2"),
-            l_arm: value("boom.l_arm"),
-            m_arm: value("boom.m_arm"),
-            m_pl: value("payload.m"),
-            x_pl_inboard: value("payload.x_inboard"),
-            h_pl: value("payload.h"),
-            l_retracted: value("cylinder.l_retracted"),
-            m_rod: value("cylinder.m_rod"),
-            g: value("env.g"),
-        }
+    /// The parameters with `value(k)` for [`BOOM_PARAMS`]`[k]` (e.g. the FMU's parameter values,
+    /// already checked against their ranges).
+    pub fn from_values(value: impl Fn(usize) -> f64) -> Self {
+        let unset = BoomParams {
+            b: [0.0; 8],
+            l1: 0.0,
+            l2: 0.0,
+            l_arm: 0.0,
+            m_arm: 0.0,
+            m_pl: 0.0,
+            x_pl_inboard: 0.0,
+            h_pl: 0.0,
+            l_retracted: 0.0,
+            m_rod: 0.0,
+            g: 0.0,
+        };
+        build(unset, BOOM_PARAMS, value)
     }
 
     /// Length from the arm's inner end to the payload mass centre, l_pl of eq. (2.8).
@@ -140,40 +118,40 @@ impl BoomParams {
 }
 
 impl Default for BoomParams {
-    /// The defaults of [`SPECS`]: chapter 3.1 geometry (l1 = 0.6 m, l2 = 0.3 m) and payload.
+    /// The defaults of [`BOOM_PARAMS`]: chapter 3.1 geometry (l1 = 0.6 m, l2 = 0.3 m) and payload.
     fn default() -> Self {
-        Self::from_lookup(|name| default_of(SPECS, name))
+        Self::from_values(|k| BOOM_PARAMS[k].spec.default)
     }
 }
 
 /// Every parameter of the arm's cross-section and of the lumped flexible beam (thesis 2.1.3,
-/// 2.1.4, 3.1.2), SI. Kept apart from [`SPECS`] so that the rigid-boom FMU's variable table does
+/// 2.1.4, 3.1.2), SI. Kept apart from [`BOOM_PARAMS`] so that the rigid-boom FMU's variable table does
 /// not change; `boom.n2` and `boom.n3` are structural (integer) parameters.
 #[rustfmt::skip]
-pub const BEAM_SPECS: &[ParamSpec] = &[
-    spec("boom.w_arm", 0.100, "m", "mm", 0.02, 1.0,
+pub const BEAM_PARAMS: &[Param<BeamParams>] = &[
+    param!("boom.w_arm", w_arm, 0.100, "m", "mm", [0.02, 1.0],
         "Width of the arm's hollow rectangular section (eq. 2.26)",
         "not in the thesis: the analytic end deflection of 3.1.2 experiment I (22.29 mm, eq. 2.23-2.33) \
          needs 100.03 mm, i.e. the standard 150x100x6 rectangular hollow section"),
-    spec("boom.h_arm", 0.150, "m", "mm", 0.02, 1.0,
+    param!("boom.h_arm", h_arm, 0.150, "m", "mm", [0.02, 1.0],
         "Height of the arm's hollow rectangular section (eq. 2.26)", NOMENCLATURE),
-    spec("boom.t_arm", 0.006, "m", "mm", 0.001, 0.1,
+    param!("boom.t_arm", t_arm, 0.006, "m", "mm", [0.001, 0.1],
         "Wall thickness of the arm's hollow rectangular section (eq. 2.26)", NOMENCLATURE),
-    spec("boom.E", 210e9, "Pa", "MPa", 1e9, 1e12,
+    param!("boom.E", e, 210e9, "Pa", "MPa", [1e9, 1e12],
         "Young's modulus of the arm", NOMENCLATURE),
-    spec("boom.xi", 0.02, "1", "%", 0.0, 1.0,
+    param!("boom.xi", xi, 0.02, "1", "%", [0.0, 1.0],
         "Damping ratio of the lumped beam's torsional dampers (eq. 2.36-2.38)", "section 2.1.4, [3, p. 97]"),
-    spec("boom.x_mount", 0.590, "m", "mm", 0.01, 3.0,
+    param!("boom.x_mount", x_mount, 0.590, "m", "mm", [0.01, 3.0],
         "Joint B to the boundary between beam parts II and III at the upper cylinder mount",
         "section 3.1.2, Table 3.1 (the pin itself is at x1 = w1 cos(phi2), eq. 2.25)"),
-    spec("boom.n2", 4.0, "1", "", 0.0, 16.0,
+    param!(int "boom.n2", n2, 4.0, [0.0, 16.0],
         "Sections of beam part II, joint B to the cylinder mount (0: rigid)", "section 3.1.2, experiment III"),
-    spec("boom.n3", 5.0, "1", "", 1.0, 16.0,
+    param!(int "boom.n3", n3, 5.0, [1.0, 16.0],
         "Sections of beam part III, cylinder mount to the arm's end", "section 3.1.2, experiment II"),
 ];
 
 /// The cross-section and lumped-beam parameters as numbers (SI); names and ranges are in
-/// [`BEAM_SPECS`].
+/// [`BEAM_PARAMS`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BeamParams {
     pub w_arm: f64,
@@ -188,18 +166,10 @@ pub struct BeamParams {
 }
 
 impl BeamParams {
-    /// Reads every parameter of [`BEAM_SPECS`] by name; `n2`, `n3` are rounded.
-    pub fn from_lookup(value: impl Fn(&str) -> f64) -> Self {
-        Self {
-            w_arm: value("boom.w_arm"),
-            h_arm: value("boom.h_arm"),
-            t_arm: value("boom.t_arm"),
-            e: value("boom.E"),
-            xi: value("boom.xi"),
-            x_mount: value("boom.x_mount"),
-            n2: value("boom.n2").round() as usize,
-            n3: value("boom.n3").round() as usize,
-        }
+    /// The parameters with `value(k)` for [`BEAM_PARAMS`]`[k]`; `n2`, `n3` are rounded.
+    pub fn from_values(value: impl Fn(usize) -> f64) -> Self {
+        let unset = BeamParams { w_arm: 0.0, h_arm: 0.0, t_arm: 0.0, e: 0.0, xi: 0.0, x_mount: 0.0, n2: 0, n3: 0 };
+        build(unset, BEAM_PARAMS, value)
     }
 
     /// Second area moment of the hollow rectangle, eq. (2.26).
@@ -223,35 +193,31 @@ impl BeamParams {
 }
 
 impl Default for BeamParams {
-    /// The defaults of [`BEAM_SPECS`].
+    /// The defaults of [`BEAM_PARAMS`].
     fn default() -> Self {
-        Self::from_lookup(|name| default_of(BEAM_SPECS, name))
+        Self::from_values(|k| BEAM_PARAMS[k].spec.default)
     }
-}
-
-fn default_of(specs: &[ParamSpec], name: &str) -> f64 {
-    specs.iter().find(|s| s.name == name).unwrap_or_else(|| panic!("no ParamSpec named {name}")).default
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::cell::RefCell;
 
+    /// Every field is one parameter: set parameter k to k + 0.5 (a count rounds to k + 1), and
+    /// each reads back what was set, and no field is left at the zero it starts from.
     #[test]
-    fn specs_and_struct_name_the_same_parameters() {
-        let used = RefCell::new(Vec::new());
-        let record = |n: &str| {
-            used.borrow_mut().push(n.to_string());
-            1.0
-        };
-        BoomParams::from_lookup(record);
-        BeamParams::from_lookup(record);
-        let mut used = used.into_inner();
-        let mut named: Vec<String> = SPECS.iter().chain(BEAM_SPECS).map(|s| s.name.to_string()).collect();
-        used.sort();
-        named.sort();
-        assert_eq!(used, named);
+    fn every_field_is_one_parameter() {
+        fn check<T: std::fmt::Debug>(params: &[Param<T>], built: T) {
+            for (k, p) in params.iter().enumerate() {
+                let set = if p.spec.integer { (k as f64 + 0.5).round() } else { k as f64 + 0.5 };
+                assert_eq!((p.get)(&built), set, "{}", p.spec.name);
+            }
+            let shown = format!("{built:?}");
+            let zeros = shown.split(|c: char| !(c.is_ascii_digit() || c == '.')).filter(|t| *t == "0.0" || *t == "0");
+            assert_eq!(zeros.count(), 0, "a field no parameter sets: {shown}");
+        }
+        check(BOOM_PARAMS, BoomParams::from_values(|k| k as f64 + 0.5));
+        check(BEAM_PARAMS, BeamParams::from_values(|k| k as f64 + 0.5));
     }
 
     /// (2.26) for the 150x100x6 section by hand: (0.1 * 0.15^3 - 0.088 * 0.138^3) / 12
@@ -265,7 +231,7 @@ mod tests {
 
     #[test]
     fn specs_are_well_formed() {
-        for s in SPECS.iter().chain(BEAM_SPECS) {
+        for s in BOOM_PARAMS.iter().map(|p| &p.spec).chain(BEAM_PARAMS.iter().map(|p| &p.spec)) {
             let unit = crate::units::unit(s.unit).unwrap_or_else(|| panic!("{}: unit", s.name));
             assert!(
                 s.display_unit.is_empty() || unit.display.iter().any(|d| d.name == s.display_unit),

@@ -6,10 +6,9 @@ use super::vr;
 use crate::fmu::log::num;
 use crate::fmu::{Value, Values};
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
-use crate::mechanics::params::{BeamParams, BoomParams, BEAM_SPECS, SPECS as BOOM_SPECS};
+use crate::mechanics::params::{BeamParams, BoomParams, BEAM_PARAMS, BOOM_PARAMS};
 use crate::mechanics::rigid_boom::RigidBoom;
 use crate::mechanics::{BoomMechanics, Kinetics};
-use crate::params::ParamSpec;
 use crate::scalar::Scalar;
 
 /// Rows of [`Boom::output_rows`]: angle, rate, payload x and y, tip deflection, the section
@@ -19,7 +18,7 @@ pub(crate) const N_OUTPUT_ROWS: usize = 5 + 2 * MAX_SECTIONS;
 /// The parameter settings that change a boom model's equations: rigid, the default flexible
 /// arm (4 + 5 sections), and the most sections (16 + 16, every Model Exchange slot live).
 pub(crate) fn boom_configurations() -> Vec<Vec<(u32, Value)>> {
-    let beam = |name| vr::BEAM + BEAM_SPECS.iter().position(|s| s.name == name).expect("beam parameter") as u32;
+    let beam = |name| vr::BEAM + BEAM_PARAMS.iter().position(|p| p.spec.name == name).expect("beam parameter") as u32;
     vec![
         vec![(vr::FLEXIBLE, Value::Boolean(false))],
         vec![],
@@ -37,13 +36,9 @@ pub enum Boom {
 impl Boom {
     /// The boom of the parameter values (boom, beam, `boom.flexible`) for a cylinder `stroke`.
     pub(crate) fn from_values(values: &Values, stroke: f64) -> Result<Self, String> {
-        let lookup = |specs: &[ParamSpec], base: u32, name: &str| {
-            let k = specs.iter().position(|s| s.name == name).expect("parameter name");
-            param_value(values, base + k as u32, &specs[k])
-        };
-        let params = BoomParams::from_lookup(|n| lookup(BOOM_SPECS, vr::BOOM, n));
+        let params = BoomParams::from_values(|k| param_value(values, vr::BOOM + k as u32, &BOOM_PARAMS[k].spec));
         let boom = if values.boolean(vr::FLEXIBLE) {
-            let beam = BeamParams::from_lookup(|n| lookup(BEAM_SPECS, vr::BEAM, n));
+            let beam = BeamParams::from_values(|k| param_value(values, vr::BEAM + k as u32, &BEAM_PARAMS[k].spec));
             FlexibleBoom::new(&params, &beam, stroke).map(Boom::Flexible)
         } else {
             RigidBoom::new(&params, stroke).map(Boom::Rigid)

@@ -130,6 +130,7 @@ pub const Z_C: ParamSpec = ParamSpec {
     max: 1e9,
     description: "TLM characteristic impedance: line stiffness Z_c/h and mass Z_c h per communication step h",
     source: "sqrt(k_oil m_eff) at the start stroke (boomsim: port module); equal stiffness and mass errors omega h",
+    integer: false,
 };
 
 /// Wave damping: the emitted wave is `c_k+1 = alpha c_k + (1 - alpha) (F + Z_c v)`.
@@ -142,6 +143,7 @@ pub const ALPHA: ParamSpec = ParamSpec {
     max: 0.9,
     description: "TLM wave damping (low-pass factor of each emitted wave per step); > 0 damps the numerical line mode at half the communication frequency",
     source: "signal damping of TLM wave variables (Hopsan C-type components); see the README, Coupling your own mechanics",
+    integer: false,
 };
 
 impl Coupling {

@@ -10,7 +10,8 @@
 //! slope of p over the step) to second order in h.
 
 use super::port::Ramp;
-use crate::control::{HighPassFeedback, FEEDBACK_SPECS};
+use crate::control::{HighPassFeedback, FEEDBACK_PARAMS};
+use crate::params::build;
 use crate::fmu::instance::bounded_slope;
 use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
@@ -21,6 +22,7 @@ pub mod vr {
     pub const P: u32 = 1;
     pub const U: u32 = 2;
     pub const U_COMP: u32 = 3;
+    /// `K_F + k` is [`crate::control::FEEDBACK_PARAMS`]`[k]`.
     pub const K_F: u32 = 4;
     pub const OMEGA_F: u32 = 5;
     pub const Q_RATED: u32 = 6;
@@ -55,9 +57,9 @@ const VARIABLES: &[Variable] = &[
     Variable::real_output("u_comp", vr::U_COMP, "1", "%", "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)")
         .depends(&[vr::P])
         .initial_depends(&[]),
-    Variable::param(vr::K_F, FEEDBACK_SPECS[0]),
-    Variable::param(vr::OMEGA_F, FEEDBACK_SPECS[1]),
-    Variable::param(vr::Q_RATED, FEEDBACK_SPECS[2]).fixed(),
+    Variable::param(vr::K_F, FEEDBACK_PARAMS[0].spec),
+    Variable::param(vr::OMEGA_F, FEEDBACK_PARAMS[1].spec),
+    Variable::param(vr::Q_RATED, FEEDBACK_PARAMS[2].spec).fixed(),
     Variable::bool_param("enable", vr::ENABLE, true, "Feedback on; off gives u = u_ref (experiment U)"),
     Variable::param(
         vr::U_MIN,
@@ -70,6 +72,7 @@ const VARIABLES: &[Variable] = &[
             max: 1.0,
             description: "Lower limit of the spool command",
             source: "Full spool opening in the lowering direction (eq. 2.44)",
+            integer: false,
         },
     ),
     Variable::param(
@@ -83,6 +86,7 @@ const VARIABLES: &[Variable] = &[
             max: 1.0,
             description: "Upper limit of the spool command",
             source: "Full spool opening in the lifting direction (eq. 2.44)",
+            integer: false,
         },
     ),
     Variable::real_local(
@@ -237,11 +241,7 @@ impl Model for PressureFeedbackController {
         if u_min >= u_max {
             return Err(format!("u_min = {u_min} must be less than u_max = {u_max}"));
         }
-        self.feedback = HighPassFeedback {
-            k_f: values.real(vr::K_F),
-            omega_f: values.real(vr::OMEGA_F),
-            q_rated: values.real(vr::Q_RATED),
-        };
+        self.feedback = build(self.feedback, &FEEDBACK_PARAMS, |k| values.real(vr::K_F + k as u32));
         (self.enable, self.u_min, self.u_max) = (values.boolean(vr::ENABLE), u_min, u_max);
         Ok(())
     }

@@ -4,10 +4,10 @@
 
 use super::vr;
 use crate::fmu::{Values, Variable};
-use crate::hydraulics::params::Param;
+use crate::hydraulics::Circuit;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
-use crate::mechanics::params::{BEAM_SPECS, SPECS as BOOM_SPECS};
-use crate::params::ParamSpec;
+use crate::mechanics::params::{BEAM_PARAMS, BOOM_PARAMS};
+use crate::params::{Param, ParamSpec};
 
 /// A continuous Real output.
 pub(crate) const fn out(
@@ -74,6 +74,7 @@ pub(crate) const START_STROKE: ParamSpec = ParamSpec {
     max: 10.0,
     description: "Initial stroke; the load starts at rest, held by the closed CBV, pressures in equilibrium",
     source: "Start stroke of the experiments, 480 mm (sections 6.2, chapter 7)",
+    integer: false,
 };
 
 pub(crate) const START_P4: ParamSpec = ParamSpec {
@@ -85,6 +86,7 @@ pub(crate) const START_P4: ParamSpec = ParamSpec {
     max: 100e5,
     description: "Initial rod-side pressure (line 4), gauge, trapped by the closed spool; p3 carries the load on top of it (eq. 2.85). Above tank pressure it bleeds to tank through the spool's leakage (eq. 2.47), over about a minute",
     source: "0: tank pressure, the valve's leakage equilibrium; the thesis' simulations of section 6.2 start at p4 = 1 bar",
+    integer: false,
 };
 
 /// The trapped rod-side pressure of `start.p4`: `None` at 0 (tank pressure, the leakage
@@ -146,9 +148,6 @@ const SECTION_NAMES: [&str; MAX_SECTIONS] = [
     "boom.section[32].phi",
 ];
 
-/// Parameters that count or select (a model index, section counts): exposed as Integers.
-const SELECTORS: [&str; 3] = ["friction.model", "boom.n2", "boom.n3"];
-
 const fn str_eq(a: &str, b: &str) -> bool {
     let (a, b) = (a.as_bytes(), b.as_bytes());
     if a.len() != b.len() {
@@ -175,20 +174,9 @@ pub(crate) const fn param_index(name: &str) -> usize {
     k
 }
 
-const fn is_selector(name: &str) -> bool {
-    let mut i = 0;
-    while i < SELECTORS.len() {
-        if str_eq(name, SELECTORS[i]) {
-            return true;
-        }
-        i += 1;
-    }
-    false
-}
-
 /// The FMU variable of a physical parameter: fixed, an Integer where it counts or selects.
 const fn param(r: u32, p: ParamSpec) -> Variable {
-    if is_selector(p.name) {
+    if p.integer {
         Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
     } else {
         Variable::param(r, p).fixed()
@@ -197,7 +185,7 @@ const fn param(r: u32, p: ParamSpec) -> Variable {
 
 /// The value of parameter `p` with value reference `r`, as a number.
 pub(crate) fn param_value(values: &Values, r: u32, p: &ParamSpec) -> f64 {
-    if is_selector(p.name) {
+    if p.integer {
         values.integer(r) as f64
     } else {
         values.real(r)
@@ -226,18 +214,18 @@ impl<const N: usize> TableBuilder<N> {
         self
     }
 
-    /// Appends the parameters `specs`, value references `base + index`.
-    pub(crate) const fn params(mut self, base: u32, specs: &[ParamSpec]) -> Self {
+    /// Appends the parameters `params`, value references `base + index`.
+    pub(crate) const fn params<T>(mut self, base: u32, params: &[Param<T>]) -> Self {
         let mut k = 0;
-        while k < specs.len() {
-            self.rows[self.len] = param(base + k as u32, specs[k]);
+        while k < params.len() {
+            self.rows[self.len] = param(base + k as u32, params[k].spec);
             (self.len, k) = (self.len + 1, k + 1);
         }
         self
     }
 
     /// Appends the circuit parameters `params[from..to]` at their [`vr::HYDRAULICS`] references.
-    pub(crate) const fn hydraulics(mut self, params: &[Param], from: usize, to: usize) -> Self {
+    pub(crate) const fn hydraulics(mut self, params: &[Param<Circuit>], from: usize, to: usize) -> Self {
         let mut k = from;
         while k < to {
             self.rows[self.len] = param(vr::HYDRAULICS + k as u32, params[k].spec);
@@ -248,7 +236,7 @@ impl<const N: usize> TableBuilder<N> {
 
     /// Appends the boom and flexible-beam parameters.
     pub(crate) const fn boom_params(self) -> Self {
-        self.params(vr::BOOM, BOOM_SPECS).params(vr::BEAM, BEAM_SPECS)
+        self.params(vr::BOOM, BOOM_PARAMS).params(vr::BEAM, BEAM_PARAMS)
     }
 
     /// Appends the section-angle and section-rate outputs.
@@ -275,7 +263,7 @@ impl<const N: usize> TableBuilder<N> {
 }
 
 /// Number of boom parameters, flexible-beam parameters and section angles and rates (table rows).
-pub(crate) const N_BOOM_ROWS: usize = BOOM_SPECS.len() + BEAM_SPECS.len() + 2 * MAX_SECTIONS;
+pub(crate) const N_BOOM_ROWS: usize = BOOM_PARAMS.len() + BEAM_PARAMS.len() + 2 * MAX_SECTIONS;
 
 /// The section rates, outputs and Model Exchange states (structured names, 1-based).
 pub(crate) const SECTION_RATES: [Variable; MAX_SECTIONS] = [

@@ -43,7 +43,7 @@ pub const SECTION_RATES: u32 = 300;
 pub const DERIVATIVES: u32 = 400;
 /// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
 pub const HYDRAULICS: u32 = 100;
-/// Boom parameters: `BOOM + index` in [`crate::mechanics::params::SPECS`].
+/// Boom parameters: `BOOM + index` in [`crate::mechanics::params::BOOM_PARAMS`].
 pub const BOOM: u32 = 200;
-/// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_SPECS`].
+/// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_PARAMS`].
 pub const BEAM: u32 = 250;
