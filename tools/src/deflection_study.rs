@@ -11,7 +11,7 @@ use serde_json::json;
 use boomsim::mechanics::deflection::AnalyticDeflection;
 use boomsim::mechanics::flexible_boom::FlexibleBoom;
 use boomsim::mechanics::params::{BeamParams, BoomParams};
-use boomsim::mechanics::{BoomMechanics, MechanicsError};
+use boomsim::mechanics::{Mechanics, MechanicsError};
 use boomsim::units::DEG;
 
 /// Cylinder length of experiment I (m).

@@ -39,7 +39,7 @@
 //! section k's masses about its inner node in its own frame, g = dl_cyl/dq and
 //! kappa = d^2 l_cyl/dt^2 - g . q_ddot.
 //!
-//! [`BoomMechanics::accelerations`] does not assemble M: it solves the same equations in O(n)
+//! [`Mechanics::accelerations`] does not assemble M: it solves the same equations in O(n)
 //! by the articulated-body recursion of the planar chain (Featherstone's, with the joint
 //! constraint forces as unknowns), i.e. Gaussian elimination of the chain from its free end.
 //! Node j (section j's inner node) accelerates by a_j, a_0 = 0 at B; r_j = l_j (cos q_j, sin q_j)
@@ -80,7 +80,7 @@ use nalgebra::{DMatrix, DVector, Vector2};
 use super::kinematics::{law_of_cosines, Triangle};
 use super::params::{BeamParams, BoomParams};
 use super::rigid_boom::RigidBoom;
-use super::{BoomMechanics, Energy, Equilibrium, Kinetics, MechanicsError};
+use super::{Mechanics, Energy, Equilibrium, Kinetics, MechanicsError};
 use crate::scalar::Scalar;
 
 /// Most sections the chain may have: max(n2, 1) + n3.
@@ -534,7 +534,7 @@ impl<T: Scalar> Kinetics<T> for FlexibleBoom {
     }
 }
 
-impl BoomMechanics for FlexibleBoom {
+impl Mechanics for FlexibleBoom {
     fn dof(&self) -> usize {
         self.n
     }

@@ -7,7 +7,7 @@
 //! - [`deflection`]: the analytic static deflection (2.20-2.33);
 //! - [`flexible_boom`]: the lumped flexible beam (2.34-2.39, 3.1.2);
 //!
-//! [`BoomMechanics`] and [`Kinetics`] are what a hydraulic model needs from either boom.
+//! [`Mechanics`] and [`Kinetics`] are what a hydraulic model needs from either boom.
 
 pub mod deflection;
 pub mod flexible_boom;
@@ -31,7 +31,7 @@ pub trait Kinetics<T: Scalar> {
     fn stroke(&self, q: &[T]) -> T;
     /// Stroke rate dx/dt = (dl_cyl/dq) q_dot.
     fn stroke_rate(&self, q: &[T], qd: &[T]) -> T;
-    /// Writes q_ddot into `out` (length [`BoomMechanics::dof`]) under the cylinder force
+    /// Writes q_ddot into `out` (length [`Mechanics::dof`]) under the cylinder force
     /// `f_cyl(x, x_dot)`, called once with the stroke and stroke rate at (q, q_dot) (a hydraulic
     /// model evaluates its circuit there, so the geometry is computed once); allocation-free.
     fn accelerations(&self, q: &[T], qd: &[T], f_cyl: &mut dyn FnMut(T, T) -> T, out: &mut [T]);
@@ -40,7 +40,7 @@ pub trait Kinetics<T: Scalar> {
 }
 
 /// A boom driven by the cylinder: its kinetics in `f64`, its size, rest and energy.
-pub trait BoomMechanics: Kinetics<f64> {
+pub trait Mechanics: Kinetics<f64> {
     /// Number of generalised coordinates.
     fn dof(&self) -> usize;
     /// Rest configuration at stroke `x` and the cylinder force that holds it.

@@ -24,7 +24,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 use super::kinematics::BoomKinematics;
 use super::params::BoomParams;
-use super::{BoomMechanics, Energy, Equilibrium, Kinetics, MechanicsError};
+use super::{Mechanics, Energy, Equilibrium, Kinetics, MechanicsError};
 use crate::scalar::Scalar;
 
 /// The rigid boom driven by the cylinder stroke.
@@ -269,7 +269,7 @@ impl<T: Scalar> Kinetics<T> for RigidBoom {
     }
 }
 
-impl BoomMechanics for RigidBoom {
+impl Mechanics for RigidBoom {
     fn dof(&self) -> usize {
         1
     }

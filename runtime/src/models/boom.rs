@@ -8,7 +8,7 @@ use crate::fmu::{Value, Values};
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
 use crate::mechanics::params::{BeamParams, BoomParams, BEAM_PARAMS, BOOM_PARAMS};
 use crate::mechanics::rigid_boom::RigidBoom;
-use crate::mechanics::{BoomMechanics, Kinetics};
+use crate::mechanics::{Mechanics, Kinetics};
 use crate::scalar::Scalar;
 
 /// Rows of [`Boom::output_rows`]: angle, rate, payload x and y, tip deflection, the section
@@ -47,7 +47,7 @@ impl Boom {
     }
 
     /// The boom's mechanics.
-    pub fn mechanics(&self) -> &dyn BoomMechanics {
+    pub fn mechanics(&self) -> &dyn Mechanics {
         match self {
             Boom::Rigid(b) => b,
             Boom::Flexible(b) => b,
