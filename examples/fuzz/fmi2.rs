@@ -4,7 +4,6 @@
 use crate::callbacks::Callbacks;
 use crate::model_description::Description;
 use fmi::fmi2::binding;
-use crate::fmu_states::{FmuState, StateFunctions};
 pub use fmi::fmi2::binding::{
     fmi2CallbackFunctions as CallbackFunctions, fmi2CallbackLogger as Logger, fmi2Component as Component,
     fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2Error as ERROR, fmi2Status_fmi2OK as OK,
@@ -77,26 +76,5 @@ impl Library {
             fmi.fmi2FreeInstance(c);
         }
         Ok(Library { path: path.to_owned(), fmi, model })
-    }
-}
-
-impl StateFunctions for Fmi2 {
-    unsafe fn get(&self, c: Component, state: *mut FmuState) -> Status {
-        self.fmi2GetFMUstate(c, state)
-    }
-    unsafe fn set(&self, c: Component, state: FmuState) -> Status {
-        self.fmi2SetFMUstate(c, state)
-    }
-    unsafe fn free(&self, c: Component, state: *mut FmuState) -> Status {
-        self.fmi2FreeFMUstate(c, state)
-    }
-    unsafe fn size(&self, c: Component, state: FmuState, size: *mut usize) -> Status {
-        self.fmi2SerializedFMUstateSize(c, state, size)
-    }
-    unsafe fn serialize(&self, c: Component, state: FmuState, bytes: *mut u8, size: usize) -> Status {
-        self.fmi2SerializeFMUstate(c, state, bytes.cast(), size)
-    }
-    unsafe fn deserialize(&self, c: Component, bytes: *const u8, size: usize, state: *mut FmuState) -> Status {
-        self.fmi2DeSerializeFMUstate(c, bytes.cast(), size, state)
     }
 }

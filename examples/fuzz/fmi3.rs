@@ -1,7 +1,6 @@
 //! The FMI 3.0 C ABI as the standard's headers declare it (the bindings of the `fmi` crate), and
 //! the shared libraries under test through it (the same files as FMI 2.0's, other symbols).
 
-use crate::fmu_states::{FmuState, StateFunctions};
 use crate::model_description::Description;
 pub use fmi::fmi3::binding::{
     fmi3Instance as Instance, fmi3Status as Status, Fmi3Binding as Fmi3,
@@ -78,26 +77,5 @@ impl Library {
             fmi.fmi3FreeInstance(c);
         }
         Ok(Library { path: path.to_owned(), fmi, model })
-    }
-}
-
-impl StateFunctions for Fmi3 {
-    unsafe fn get(&self, c: Instance, state: *mut FmuState) -> Status {
-        self.fmi3GetFMUState(c, state)
-    }
-    unsafe fn set(&self, c: Instance, state: FmuState) -> Status {
-        self.fmi3SetFMUState(c, state)
-    }
-    unsafe fn free(&self, c: Instance, state: *mut FmuState) -> Status {
-        self.fmi3FreeFMUState(c, state)
-    }
-    unsafe fn size(&self, c: Instance, state: FmuState, size: *mut usize) -> Status {
-        self.fmi3SerializedFMUStateSize(c, state, size)
-    }
-    unsafe fn serialize(&self, c: Instance, state: FmuState, bytes: *mut u8, size: usize) -> Status {
-        self.fmi3SerializeFMUState(c, state, bytes, size)
-    }
-    unsafe fn deserialize(&self, c: Instance, bytes: *const u8, size: usize, state: *mut FmuState) -> Status {
-        self.fmi3DeserializeFMUState(c, bytes, size, state)
     }
 }
