@@ -43,7 +43,13 @@ macro_rules! state_functions {
             unsafe fn serialize(&self, c: *mut c_void, state: FmuState, bytes: *mut u8, size: usize) -> Status {
                 self.$serialize(c, state, bytes.cast(), size)
             }
-            unsafe fn deserialize(&self, c: *mut c_void, bytes: *const u8, size: usize, state: *mut FmuState) -> Status {
+            unsafe fn deserialize(
+                &self,
+                c: *mut c_void,
+                bytes: *const u8,
+                size: usize,
+                state: *mut FmuState,
+            ) -> Status {
                 self.$deserialize(c, bytes.cast(), size, state)
             }
         }

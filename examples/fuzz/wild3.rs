@@ -7,7 +7,7 @@
 //! larger than the arrays (`oversized`).
 
 use crate::model_description::{Description, Type, Variable, TYPES};
-use crate::ops::{Arr, Text};
+use crate::ops::Text;
 use crate::ops3::{Instantiation3, Interface3, Op3, OTHER_TYPES, REFUSED};
 use crate::oversized::Oversized;
 use crate::rng::Rng;
@@ -126,14 +126,12 @@ pub fn instantiation3(rng: &mut Rng, m: &Description) -> Instantiation3 {
     let mut spec = Instantiation3 {
         interface,
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
-        token: Text::new(&m.guid),
         resources: rng.pick(&[Text::Null, Text::new("file:///tmp/"), Text::new("")]).clone(),
         visible: rng.chance(0.5),
         logging_on: rng.chance(0.2),
-        event_mode_used: false,
         early_return_allowed: rng.chance(0.3),
-        required_intermediate: Arr::Items(Vec::new()),
         logger: !rng.chance(0.1),
+        ..Instantiation3::quiet(Text::new(&m.guid))
     };
     if rng.chance(0.15) {
         match rng.below(5) {
@@ -161,8 +159,9 @@ pub fn valid_instantiation(spec: &Instantiation3, m: &Description) -> Option<boo
     if !token_right {
         return Some(false);
     }
-    let name_ok = matches!(&spec.name, Text::Bytes(n) if !n.to_bytes().is_empty() && std::str::from_utf8(n.to_bytes()).is_ok());
-    let co_simulation_ok = spec.interface == Interface3::ModelExchange
-        || (!spec.event_mode_used && spec.required_intermediate.len() == 0);
+    let name_ok =
+        matches!(&spec.name, Text::Bytes(n) if !n.to_bytes().is_empty() && std::str::from_utf8(n.to_bytes()).is_ok());
+    let co_simulation_ok =
+        spec.interface == Interface3::ModelExchange || (!spec.event_mode_used && spec.required_intermediate.len() == 0);
     (name_ok && co_simulation_ok).then_some(true)
 }
