@@ -14,7 +14,7 @@ use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::wild::{
     any_vr, array, bad_guid, categories, maybe_null, variables_of, vrs, wild_count, wild_experiment, wild_integer,
-    wild_real, wild_state_call, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
+    wild_real, wild_state_call, wild_states, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
 };
 
 /// Any of the functions with any arguments (fmi3FreeInstance through a second instance).
@@ -66,13 +66,7 @@ pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
             _ => Op3::CompletedIntegratorStep { no_set_prior: rng.chance(0.5), null_flags: rng.chance(0.3) },
         },
         25 => Op3::SetTime { t: wild_real(rng, None) },
-        26 => {
-            let n = wild_count(rng, m.states);
-            let x: Vec<f64> = (0..n)
-                .map(|k| if rng.chance(0.7) { s.x.get(k).copied().unwrap_or(0.0) } else { wild_real(rng, None) })
-                .collect();
-            Op3::SetContinuousStates { x: maybe_null(rng, x) }
-        }
+        26 => Op3::SetContinuousStates { x: wild_states(rng, m, &s.x) },
         27 => match rng.below(3) {
             0 => Op3::GetContinuousStateDerivatives { n: wild_count(rng, m.states), null: rng.chance(0.1) },
             1 => Op3::GetContinuousStates { n: wild_count(rng, m.states), null: rng.chance(0.1) },
