@@ -2,17 +2,18 @@
 //! and the shared libraries under test.
 
 use crate::callbacks::Callbacks;
-use crate::model_description::Description;
+use crate::library::Binding;
+use crate::report::Report;
+use crate::session::Session;
 use fmi::fmi2::binding;
-use crate::fmu_states::{FmuState, StateFunctions};
 pub use fmi::fmi2::binding::{
     fmi2CallbackFunctions as CallbackFunctions, fmi2CallbackLogger as Logger, fmi2Component as Component,
     fmi2Status as Status, fmi2Status_fmi2Discard as DISCARD, fmi2Status_fmi2Error as ERROR, fmi2Status_fmi2OK as OK,
     fmi2Status_fmi2Warning as WARNING, Fmi2Binding as Fmi2,
 };
-use std::ffi::CString;
+use std::ffi::CStr;
 use std::os::raw::c_int;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::ptr::null;
 
 // fmi2Type and fmi2StatusKind values as the `c_int` the fuzzer passes (which may be invalid ones).
@@ -22,25 +23,23 @@ pub use fmi::fmi2::binding::fmi2EventInfo as EventInfo;
 pub const LAST_SUCCESSFUL_TIME: c_int = binding::fmi2StatusKind_fmi2LastSuccessfulTime as c_int;
 pub const TERMINATED: c_int = binding::fmi2StatusKind_fmi2Terminated as c_int;
 
-/// One FMU under test: its functions and its model description.
-pub struct Library {
-    pub path: PathBuf,
-    pub fmi: Fmi2,
-    pub model: Description,
-}
+/// One FMU under test through FMI 2.0.
+pub type Library = crate::library::Library<Fmi2>;
 
-impl Library {
-    /// Opens `lib<Id>.so` (or `<Id>.so`), checks that it exports the 25 common, 9
-    /// co-simulation and 10 model-exchange functions of FMI 2.0, reads `modelDescription/<Id>.xml` and instantiates
-    /// once with its GUID: a stale build would refuse every instantiation, and the fuzzer would
-    /// test nothing but error paths.
-    pub fn load(path: &Path) -> Result<Self, String> {
-        let identifier = crate::identifier(path)?;
-        let model = Description::read(&crate::repository().join(format!("modelDescription/{identifier}.xml")))?;
-        // SAFETY: an FMU library has no initialisers that could break this process; it stays loaded.
-        let fmi = unsafe { Fmi2::new(path) }.map_err(|e| format!("dlopen {e}"))?;
-        #[rustfmt::skip]
-        let missing = first_missing!(fmi:
+impl Binding for Fmi2 {
+    const FMI: u8 = 2;
+    const XML_FOLDER: &'static str = "";
+    const TOKEN: &'static str = "GUID";
+    type Session<'a> = Session<'a>;
+
+    unsafe fn open(path: &Path) -> Result<Self, String> {
+        Fmi2::new(path).map_err(|e| format!("dlopen {e}"))
+    }
+
+    /// Of the 25 common, 9 co-simulation and 10 model-exchange functions of FMI 2.0.
+    #[rustfmt::skip]
+    fn first_missing(&self) -> Option<&'static str> {
+        first_missing!(self:
             fmi2GetTypesPlatform fmi2GetVersion fmi2SetDebugLogging fmi2Instantiate fmi2FreeInstance
             fmi2SetupExperiment fmi2EnterInitializationMode fmi2ExitInitializationMode fmi2Terminate fmi2Reset
             fmi2GetReal fmi2GetInteger fmi2GetBoolean fmi2GetString fmi2SetReal fmi2SetInteger fmi2SetBoolean
@@ -50,53 +49,29 @@ impl Library {
             fmi2GetRealStatus fmi2GetIntegerStatus fmi2GetBooleanStatus fmi2GetStringStatus
             fmi2EnterEventMode fmi2NewDiscreteStates fmi2EnterContinuousTimeMode fmi2CompletedIntegratorStep
             fmi2SetTime fmi2SetContinuousStates fmi2GetDerivatives fmi2GetEventIndicators fmi2GetContinuousStates
-            fmi2GetNominalsOfContinuousStates);
-        if let Some(function) = missing {
-            return Err(format!("{}: {function} is not exported", path.display()));
-        }
-        let guid = CString::new(model.guid.as_str()).map_err(|e| e.to_string())?;
-        let callbacks = Callbacks { logger: true, memory: true }.functions();
-        // SAFETY: valid strings and callbacks that outlive the instance, freed once.
-        unsafe {
-            let c = fmi.fmi2Instantiate(
-                c"fuzz".as_ptr(),
-                binding::fmi2Type_fmi2CoSimulation,
-                guid.as_ptr(),
-                null(),
-                &callbacks,
-                0,
-                0,
-            );
-            if c.is_null() {
-                return Err(format!(
-                    "{} refuses the GUID {} of modelDescription/{identifier}.xml: a stale build? (cargo build --release)",
-                    path.display(),
-                    model.guid
-                ));
-            }
-            fmi.fmi2FreeInstance(c);
-        }
-        Ok(Library { path: path.to_owned(), fmi, model })
+            fmi2GetNominalsOfContinuousStates)
     }
-}
 
-impl StateFunctions for Fmi2 {
-    unsafe fn get(&self, c: Component, state: *mut FmuState) -> Status {
-        self.fmi2GetFMUstate(c, state)
+    /// A Co-Simulation instance with logger and memory callbacks.
+    /// Co-Simulation, with logger and memory callbacks.
+    unsafe fn instantiates(&self, guid: &CStr) -> bool {
+        let callbacks = Callbacks { logger: true, memory: true }.functions();
+        let c = self.fmi2Instantiate(
+            c"fuzz".as_ptr(),
+            binding::fmi2Type_fmi2CoSimulation,
+            guid.as_ptr(),
+            null(),
+            &callbacks,
+            0,
+            0,
+        );
+        if !c.is_null() {
+            self.fmi2FreeInstance(c);
+        }
+        !c.is_null()
     }
-    unsafe fn set(&self, c: Component, state: FmuState) -> Status {
-        self.fmi2SetFMUstate(c, state)
-    }
-    unsafe fn free(&self, c: Component, state: *mut FmuState) -> Status {
-        self.fmi2FreeFMUstate(c, state)
-    }
-    unsafe fn size(&self, c: Component, state: FmuState, size: *mut usize) -> Status {
-        self.fmi2SerializedFMUstateSize(c, state, size)
-    }
-    unsafe fn serialize(&self, c: Component, state: FmuState, bytes: *mut u8, size: usize) -> Status {
-        self.fmi2SerializeFMUstate(c, state, bytes.cast(), size)
-    }
-    unsafe fn deserialize(&self, c: Component, bytes: *const u8, size: usize, state: *mut FmuState) -> Status {
-        self.fmi2DeSerializeFMUstate(c, bytes.cast(), size, state)
+
+    fn session<'a>(library: &'a Library, report: &'a mut Report) -> Session<'a> {
+        Session::new(library, report)
     }
 }

@@ -2,6 +2,8 @@
 //! (fmi2GetFMUstate, fmi3GetFMUState, ...), and the FMU states of a sequence as the fuzzer keeps
 //! track of them, with the oracle's checks of the functions that make, restore and free them.
 
+use crate::fmi2::Fmi2;
+use crate::fmi3::Fmi3;
 use crate::ops::{Arr, Blob, Slot};
 use crate::view::View;
 use std::os::raw::{c_uint, c_void};
@@ -21,6 +23,43 @@ pub trait StateFunctions {
     unsafe fn serialize(&self, c: *mut c_void, state: FmuState, bytes: *mut u8, size: usize) -> Status;
     unsafe fn deserialize(&self, c: *mut c_void, bytes: *const u8, size: usize, state: *mut FmuState) -> Status;
 }
+
+/// Implements `StateFunctions` for a version's binding with its six functions, in the trait's order.
+macro_rules! state_functions {
+    ($binding:ty: $get:ident $set:ident $free:ident $size:ident $serialize:ident $deserialize:ident) => {
+        impl StateFunctions for $binding {
+            unsafe fn get(&self, c: *mut c_void, state: *mut FmuState) -> Status {
+                self.$get(c, state)
+            }
+            unsafe fn set(&self, c: *mut c_void, state: FmuState) -> Status {
+                self.$set(c, state)
+            }
+            unsafe fn free(&self, c: *mut c_void, state: *mut FmuState) -> Status {
+                self.$free(c, state)
+            }
+            unsafe fn size(&self, c: *mut c_void, state: FmuState, size: *mut usize) -> Status {
+                self.$size(c, state, size)
+            }
+            unsafe fn serialize(&self, c: *mut c_void, state: FmuState, bytes: *mut u8, size: usize) -> Status {
+                self.$serialize(c, state, bytes.cast(), size)
+            }
+            unsafe fn deserialize(
+                &self,
+                c: *mut c_void,
+                bytes: *const u8,
+                size: usize,
+                state: *mut FmuState,
+            ) -> Status {
+                self.$deserialize(c, bytes.cast(), size, state)
+            }
+        }
+    };
+}
+
+state_functions!(Fmi2: fmi2GetFMUstate fmi2SetFMUstate fmi2FreeFMUstate fmi2SerializedFMUstateSize
+    fmi2SerializeFMUstate fmi2DeSerializeFMUstate);
+state_functions!(Fmi3: fmi3GetFMUState fmi3SetFMUState fmi3FreeFMUState fmi3SerializedFMUStateSize
+    fmi3SerializeFMUState fmi3DeserializeFMUState);
 
 /// One FMU state call with its arguments (the instance is the session's, or NULL).
 #[derive(Debug)]

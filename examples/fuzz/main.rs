@@ -46,8 +46,8 @@
 //! lists one longer than the variables accepted; FMU states that serialize but do not
 //! deserialize: FMI 3.0 Terminated before initialisation, FMI 2.0 after a step that failed).
 //!
-//! - `fmi2`, `fmi3`: the C ABIs and the libraries under test; `model_description`: their XML;
-//! - `sequence`, `sequence3`: one sequence, of calls (`ops`, `ops3`) from the planners (with
+//! - `fmi2`, `fmi3`: the C ABIs; `library`: the libraries under test; `model_description`: their XML;
+//! - `sequence`: one sequence, of calls (`ops`, `ops3`) from the planners (with
 //!   `probes`) and the wild generators (with `oversized`), drawn with `rng`; `refused`: the FMI
 //!   3.0 functions the FMUs must refuse;
 //! - `session`, `session3`: make the calls and check the oracle, with `machine2`, `machine3`,
@@ -68,6 +68,7 @@ mod callbacks;
 mod fmi2;
 mod fmi3;
 mod fmu_states;
+mod library;
 mod machine2;
 mod machine3;
 mod model_description;
@@ -82,7 +83,6 @@ mod report;
 mod required;
 mod rng;
 mod sequence;
-mod sequence3;
 mod session;
 mod session3;
 mod view;

@@ -22,6 +22,24 @@ pub struct Instantiation3 {
     pub logger: bool,
 }
 
+impl Instantiation3 {
+    /// Co-Simulation named "fuzz" with `token`: no resources, logger or options.
+    pub fn quiet(token: Text) -> Self {
+        Instantiation3 {
+            interface: Interface3::CoSimulation,
+            name: Text::new("fuzz"),
+            token,
+            resources: Text::Null,
+            visible: false,
+            logging_on: false,
+            event_mode_used: false,
+            early_return_allowed: false,
+            required_intermediate: Arr::Items(Vec::new()),
+            logger: false,
+        }
+    }
+}
+
 /// Which fmi3Instantiate* function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interface3 {

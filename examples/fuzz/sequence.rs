@@ -1,28 +1,30 @@
 //! A sequence: one instantiation (mostly valid), 20 to 200 calls, mostly planned, some wild,
-//! and the frees; all of it drawn from the sequence's seed. This file runs either version's
-//! sequences (with the logger's account and the leak check) and holds FMI 2.0's;
-//! `sequence3` holds FMI 3.0's.
+//! and the frees; all of it drawn from the sequence's seed, for either version (its session's
+//! `Driven`), with the logger's account and the leak check.
 
 use crate::callbacks::{LogSink, LOG};
-use crate::fmi2::Library;
-use crate::ops::Op;
-use crate::planner::Planner;
+use crate::library::{Binding, Library};
 use crate::report::{Report, Subject};
 use crate::rng::Rng;
-use crate::session::{Session, Target};
-use crate::wild::{instantiation, wild};
+use crate::session::Target;
+use std::ffi::c_void;
 use std::path::Path;
 
 /// Calls between the instantiation and the frees.
-pub const CALLS: (usize, usize) = (20, 200);
+const CALLS: (usize, usize) = (20, 200);
 /// Calls when the instantiation returned NULL (all of them on the NULL instance).
-pub const CALLS_WITHOUT_INSTANCE: usize = 20;
+const CALLS_WITHOUT_INSTANCE: usize = 20;
 
 /// Runs a sequence with `drive`, adding to `report`; `Err` is the oracle violation (the calls are
 /// in the report). When the heap holds more after the sequence than before, it runs once more
 /// (a first use may allocate for good: buffers, thread-locals): a sequence that again leaves
 /// memory behind leaked it (an instance or FMU state not freed by FreeInstance).
-pub fn run_logged(fmi3: bool, seed: u64, report: &mut Report, drive: impl Fn(&mut Report) -> Result<(), String>) -> Result<(), String> {
+fn run_logged(
+    fmi3: bool,
+    seed: u64,
+    report: &mut Report,
+    drive: impl Fn(&mut Report) -> Result<(), String>,
+) -> Result<(), String> {
     report.fmi3 = fmi3;
     let mut leaked = 0;
     for _ in 0..2 {
@@ -48,7 +50,7 @@ fn heap_in_use() -> usize {
     info.uordblks + info.hblkhd
 }
 
-impl Subject for Library {
+impl<F: Binding> Subject for Library<F> {
     fn identifier(&self) -> &str {
         &self.model.identifier
     }
@@ -56,34 +58,55 @@ impl Subject for Library {
         &self.path
     }
     fn fmi(&self) -> u8 {
-        2
+        F::FMI
     }
     fn run_sequence(&self, seed: u64, report: &mut Report) -> Result<(), String> {
-        run_logged(false, seed, report, |report| drive(&mut Session::new(self, report), seed))
+        run_logged(F::FMI == 3, seed, report, |report| drive(&mut F::session(self, report), seed))
     }
+}
+
+/// A version's session as `drive` runs it: its calls, planner and wild generator.
+pub trait Driven {
+    type Op;
+    type Planner;
+    /// The main instance and the second one (NULL when there is none).
+    fn instances(&self) -> (*mut c_void, *mut c_void);
+    fn instantiation(&self, rng: &mut Rng) -> Self::Op;
+    fn planner(rng: &mut Rng) -> Self::Planner;
+    fn planned(&self, planner: &mut Self::Planner, rng: &mut Rng) -> Self::Op;
+    fn wild(&self, rng: &mut Rng) -> Self::Op;
+    fn takes_instance(op: &Self::Op) -> bool;
+    fn free_instance(instance: *mut c_void) -> Self::Op;
+    /// Makes one call and checks the oracle.
+    fn call(&mut self, op: Self::Op, target: Target) -> Result<(), String>;
 }
 
 /// The calls: instantiation, a mix of planned and wild calls (all wild without an instance, a
 /// few on a NULL instance), the frees.
-fn drive(s: &mut Session, seed: u64) -> Result<(), String> {
+fn drive<S: Driven>(s: &mut S, seed: u64) -> Result<(), String> {
     let mut rng = Rng::new(seed);
-    s.call(Op::Instantiate(instantiation(&mut rng, s.model)), Target::Main)?;
+    let instantiation = s.instantiation(&mut rng);
+    s.call(instantiation, Target::Main)?;
     let wildness = *rng.pick(&[0.02, 0.02, 0.05, 0.1, 0.3, 1.0]);
     let mut calls = rng.range(CALLS.0, CALLS.1);
-    if s.c.is_null() {
+    if s.instances().0.is_null() {
         calls = calls.min(CALLS_WITHOUT_INSTANCE);
     }
-    let mut planner = Planner::new(&mut rng);
+    let mut planner = S::planner(&mut rng);
     for _ in 0..calls {
-        let op = if s.c.is_null() || rng.chance(wildness) { wild(&mut rng, s) } else { planner.next(&mut rng, s) };
-        let null = op.takes_component() && (s.c.is_null() || rng.chance(0.01));
+        let op = if s.instances().0.is_null() || rng.chance(wildness) {
+            s.wild(&mut rng)
+        } else {
+            s.planned(&mut planner, &mut rng)
+        };
+        let null = S::takes_instance(&op) && (s.instances().0.is_null() || rng.chance(0.01));
         s.call(op, if null { Target::Null } else { Target::Main })?;
     }
-    let (second, main) = (s.second, s.c);
+    let (main, second) = s.instances();
     if !second.is_null() {
-        s.call(Op::FreeInstance { instance: second }, Target::Main)?;
+        s.call(S::free_instance(second), Target::Main)?;
     }
-    s.call(Op::FreeInstance { instance: main }, Target::Main)
+    s.call(S::free_instance(main), Target::Main)
 }
 
 /// Runs one sequence in this process, printing every call and log message; the exit status.

@@ -27,10 +27,14 @@ use crate::fmi2::{
 use crate::fmu_states::{FmuStates, StateCall, StateOutput};
 use crate::model_description::Description;
 use crate::ops::{Arr, Instantiation, Op, Slot, Text};
+use crate::planner::Planner;
 use crate::report::Report;
 use crate::required::{self, Derivative};
+use crate::rng::Rng;
+use crate::sequence::Driven;
 use crate::view::{Phase, View};
 use crate::watch::{Seen, Watch};
+use crate::wild::{instantiation, wild};
 use std::ffi::CStr;
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};
@@ -85,6 +89,35 @@ pub struct Session<'a> {
     watch: Watch,
     /// Simulated time so far (an upper bound).
     simulated: f64,
+}
+
+impl Driven for Session<'_> {
+    type Op = Op;
+    type Planner = Planner;
+    fn instances(&self) -> (Component, Component) {
+        (self.c, self.second)
+    }
+    fn instantiation(&self, rng: &mut Rng) -> Op {
+        Op::Instantiate(instantiation(rng, self.model))
+    }
+    fn planner(rng: &mut Rng) -> Planner {
+        Planner::new(rng)
+    }
+    fn planned(&self, planner: &mut Planner, rng: &mut Rng) -> Op {
+        planner.next(rng, self)
+    }
+    fn wild(&self, rng: &mut Rng) -> Op {
+        wild(rng, self)
+    }
+    fn takes_instance(op: &Op) -> bool {
+        op.takes_component()
+    }
+    fn free_instance(instance: Component) -> Op {
+        Op::FreeInstance { instance }
+    }
+    fn call(&mut self, op: Op, target: Target) -> Result<(), String> {
+        Session::call(self, op, target)
+    }
 }
 
 impl<'a> Session<'a> {

@@ -31,11 +31,15 @@ use crate::machine3::forbidden;
 use crate::model_description::Description;
 use crate::ops::{Arr, Slot, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
+use crate::planner3::Planner3;
 use crate::report::Report;
 use crate::required::{self, Derivative};
+use crate::rng::Rng;
+use crate::sequence::Driven;
 use crate::session::{out, Target};
 use crate::view::{Phase, View};
 use crate::watch::{Seen, Watch};
+use crate::wild3::{instantiation3, wild3};
 use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
@@ -90,6 +94,35 @@ pub struct Session3<'a> {
     logger: bool,
     discards_logged: bool,
     all_logged: bool,
+}
+
+impl Driven for Session3<'_> {
+    type Op = Op3;
+    type Planner = Planner3;
+    fn instances(&self) -> (Instance, Instance) {
+        (self.c, self.second)
+    }
+    fn instantiation(&self, rng: &mut Rng) -> Op3 {
+        Op3::Instantiate(instantiation3(rng, self.model))
+    }
+    fn planner(rng: &mut Rng) -> Planner3 {
+        Planner3::new(rng)
+    }
+    fn planned(&self, planner: &mut Planner3, rng: &mut Rng) -> Op3 {
+        planner.next(rng, self)
+    }
+    fn wild(&self, rng: &mut Rng) -> Op3 {
+        wild3(rng, self)
+    }
+    fn takes_instance(op: &Op3) -> bool {
+        op.takes_instance()
+    }
+    fn free_instance(instance: Instance) -> Op3 {
+        Op3::FreeInstance { instance }
+    }
+    fn call(&mut self, op: Op3, target: Target) -> Result<(), String> {
+        Session3::call(self, op, target)
+    }
 }
 
 impl<'a> Session3<'a> {
@@ -233,7 +266,7 @@ impl<'a> Session3<'a> {
                 let names = categories.map(Text::ptr);
                 status(f.fmi3SetDebugLogging(c, *logging_on, names.len(), names.ptr()))
             }
-            Op3::Instantiate(spec) => (None, Output::Instance(self.instantiate(spec))),
+            Op3::Instantiate(spec) => (None, Output::Instance(instantiate(self.fmi, spec))),
             Op3::FreeInstance { instance } => {
                 f.fmi3FreeInstance(*instance);
                 (None, Output::Nothing)
@@ -322,27 +355,6 @@ impl<'a> Session3<'a> {
             Op3::GetNumberOfContinuousStates { null } => count(*null, |p| f.fmi3GetNumberOfContinuousStates(c, p)),
             Op3::GetNumberOfEventIndicators { null } => count(*null, |p| f.fmi3GetNumberOfEventIndicators(c, p)),
             Op3::Oversized(o) => status(o.invoke3(f, c, self.model)),
-        }
-    }
-
-    /// fmi3InstantiateCoSimulation, fmi3InstantiateModelExchange or
-    /// fmi3InstantiateScheduledExecution.
-    unsafe fn instantiate(&mut self, s: &Instantiation3) -> Instance {
-        let f = self.fmi;
-        let log = if s.logger { Some(log_message as unsafe extern "C" fn(_, _, _, _)) } else { None };
-        let (name, token, resources) = (s.name.ptr(), s.token.ptr(), s.resources.ptr());
-        let env = environment();
-        match s.interface {
-            Interface3::CoSimulation => {
-                let r = &s.required_intermediate;
-                let (event, early) = (s.event_mode_used, s.early_return_allowed);
-                let (visible, on) = (s.visible, s.logging_on);
-                f.fmi3InstantiateCoSimulation(name, token, resources, visible, on, event, early, r.ptr(), r.len(), env, log, None)
-            }
-            Interface3::ModelExchange => f.fmi3InstantiateModelExchange(name, token, resources, s.visible, s.logging_on, env, log),
-            Interface3::ScheduledExecution => {
-                f.fmi3InstantiateScheduledExecution(name, token, resources, s.visible, s.logging_on, env, log, None, None, None)
-            }
         }
     }
 
@@ -561,4 +573,24 @@ fn expect_version(p: *const c_char) -> Result<(), String> {
         return Err(format!("fmi3GetVersion returned {text:?}, not \"3.0\""));
     }
     Ok(())
+}
+
+/// fmi3InstantiateCoSimulation, fmi3InstantiateModelExchange or
+/// fmi3InstantiateScheduledExecution.
+pub unsafe fn instantiate(f: &Fmi3, s: &Instantiation3) -> Instance {
+    let log = if s.logger { Some(log_message as unsafe extern "C" fn(_, _, _, _)) } else { None };
+    let (name, token, resources) = (s.name.ptr(), s.token.ptr(), s.resources.ptr());
+    let env = environment();
+    match s.interface {
+        Interface3::CoSimulation => {
+            let r = &s.required_intermediate;
+            let (event, early) = (s.event_mode_used, s.early_return_allowed);
+            let (visible, on) = (s.visible, s.logging_on);
+            f.fmi3InstantiateCoSimulation(name, token, resources, visible, on, event, early, r.ptr(), r.len(), env, log, None)
+        }
+        Interface3::ModelExchange => f.fmi3InstantiateModelExchange(name, token, resources, s.visible, s.logging_on, env, log),
+        Interface3::ScheduledExecution => {
+            f.fmi3InstantiateScheduledExecution(name, token, resources, s.visible, s.logging_on, env, log, None, None, None)
+        }
+    }
 }

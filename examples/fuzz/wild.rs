@@ -101,13 +101,7 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
             _ => Op::CompletedIntegratorStep { no_set_prior: wild_boolean(rng), null_flags: rng.chance(0.3) },
         },
         34 => Op::SetTime { t: wild_real(rng, None) },
-        35 => {
-            let n = wild_count(rng, m.states);
-            let x: Vec<f64> = (0..n)
-                .map(|k| if rng.chance(0.7) { s.x.get(k).copied().unwrap_or(0.0) } else { wild_real(rng, None) })
-                .collect();
-            Op::SetContinuousStates { x: maybe_null(rng, x) }
-        }
+        35 => Op::SetContinuousStates { x: wild_states(rng, m, &s.x) },
         36 => match rng.below(3) {
             0 => Op::GetDerivatives { n: wild_count(rng, m.states), null: rng.chance(0.1) },
             1 => Op::GetContinuousStates { n: wild_count(rng, m.states), null: rng.chance(0.1) },
@@ -115,6 +109,15 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
         },
         _ => Op::GetEventIndicators { n: wild_count(rng, m.event_indicators), null: rng.chance(0.1) },
     }
+}
+
+/// Continuous states to set: a wild count of them, mostly the last ones read (`x`), else wild
+/// numbers; now and then NULL.
+pub fn wild_states(rng: &mut Rng, m: &Description, x: &[f64]) -> Arr<f64> {
+    let n = wild_count(rng, m.states);
+    let x: Vec<f64> =
+        (0..n).map(|k| if rng.chance(0.7) { x.get(k).copied().unwrap_or(0.0) } else { wild_real(rng, None) }).collect();
+    maybe_null(rng, x)
 }
 
 /// A count announced for an array of `n`: mostly `n`, else 0, one off, or far off.

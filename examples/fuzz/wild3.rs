@@ -7,14 +7,14 @@
 //! larger than the arrays (`oversized`).
 
 use crate::model_description::{Description, Type, Variable, TYPES};
-use crate::ops::{Arr, Text};
+use crate::ops::Text;
 use crate::ops3::{Instantiation3, Interface3, Op3, OTHER_TYPES, REFUSED};
 use crate::oversized::Oversized;
 use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::wild::{
     any_vr, array, bad_guid, categories, maybe_null, variables_of, vrs, wild_count, wild_experiment, wild_integer,
-    wild_real, wild_state_call, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
+    wild_real, wild_state_call, wild_states, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
 };
 
 /// Any of the functions with any arguments (fmi3FreeInstance through a second instance).
@@ -66,13 +66,7 @@ pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
             _ => Op3::CompletedIntegratorStep { no_set_prior: rng.chance(0.5), null_flags: rng.chance(0.3) },
         },
         25 => Op3::SetTime { t: wild_real(rng, None) },
-        26 => {
-            let n = wild_count(rng, m.states);
-            let x: Vec<f64> = (0..n)
-                .map(|k| if rng.chance(0.7) { s.x.get(k).copied().unwrap_or(0.0) } else { wild_real(rng, None) })
-                .collect();
-            Op3::SetContinuousStates { x: maybe_null(rng, x) }
-        }
+        26 => Op3::SetContinuousStates { x: wild_states(rng, m, &s.x) },
         27 => match rng.below(3) {
             0 => Op3::GetContinuousStateDerivatives { n: wild_count(rng, m.states), null: rng.chance(0.1) },
             1 => Op3::GetContinuousStates { n: wild_count(rng, m.states), null: rng.chance(0.1) },
@@ -126,14 +120,12 @@ pub fn instantiation3(rng: &mut Rng, m: &Description) -> Instantiation3 {
     let mut spec = Instantiation3 {
         interface,
         name: Text::new(rng.pick::<&str>(&INSTANCE_NAMES)),
-        token: Text::new(&m.guid),
         resources: rng.pick(&[Text::Null, Text::new("file:///tmp/"), Text::new("")]).clone(),
         visible: rng.chance(0.5),
         logging_on: rng.chance(0.2),
-        event_mode_used: false,
         early_return_allowed: rng.chance(0.3),
-        required_intermediate: Arr::Items(Vec::new()),
         logger: !rng.chance(0.1),
+        ..Instantiation3::quiet(Text::new(&m.guid))
     };
     if rng.chance(0.15) {
         match rng.below(5) {
@@ -161,8 +153,9 @@ pub fn valid_instantiation(spec: &Instantiation3, m: &Description) -> Option<boo
     if !token_right {
         return Some(false);
     }
-    let name_ok = matches!(&spec.name, Text::Bytes(n) if !n.to_bytes().is_empty() && std::str::from_utf8(n.to_bytes()).is_ok());
-    let co_simulation_ok = spec.interface == Interface3::ModelExchange
-        || (!spec.event_mode_used && spec.required_intermediate.len() == 0);
+    let name_ok =
+        matches!(&spec.name, Text::Bytes(n) if !n.to_bytes().is_empty() && std::str::from_utf8(n.to_bytes()).is_ok());
+    let co_simulation_ok =
+        spec.interface == Interface3::ModelExchange || (!spec.event_mode_used && spec.required_intermediate.len() == 0);
     (name_ok && co_simulation_ok).then_some(true)
 }
