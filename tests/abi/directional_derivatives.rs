@@ -15,7 +15,7 @@ use boomsim::fmi2::api;
 use boomsim::fmu::structure::{probe, unknowns};
 use boomsim::fmi2::types::*;
 use boomsim_tools::xml::fmi2::dependencies;
-use boomsim::fmu::{Causality, Kind, Model, Value, Values};
+use boomsim::fmu::{Causality, Kind, Model, Seeds, Value, Values};
 use boomsim::models::vr;
 use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit};
 
@@ -68,7 +68,8 @@ fn check<M: Model>(setup: &[(u32, Value)], steps: usize, samples: usize) -> (usi
                 .iter()
                 .map(|&kn| {
                     let mut o = [0.0];
-                    model.directional_derivative(&values, &[(kn, 1.0)], &[*unknown], &mut o).unwrap();
+                    let seeds = Seeds { knowns: &[(kn, 1.0)], unknowns: &[*unknown], out: &mut o };
+                    model.directional_derivative(&values, seeds).unwrap();
                     o[0]
                 })
                 .collect();

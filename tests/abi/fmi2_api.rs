@@ -7,7 +7,7 @@ use boomsim::fmi2::api;
 use boomsim::fmu::driver::Step;
 use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
-use boomsim::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
+use boomsim::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, StepStart, Values, Variable};
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::PressureFeedbackController as Pfc;
 use crate::common::Slave;
@@ -260,9 +260,10 @@ impl Model for Faulty {
         values.set_real(1, if self.mode == 3.0 && self.t > 0.5 { f64::NAN } else { self.mode })
     }
     type Ode = ();
-    fn begin_step(&mut self, v: &Values, _: &[f64], t: f64, h: f64, _: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
+    fn begin_step(&mut self, step: &StepStart<'_>, _: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
+        let (t, h) = (step.t, step.h);
         self.t = t + h;
-        match v.real(0) as i32 {
+        match step.values.real(0) as i32 {
             1 if t + h >= 1.0 => panic!("model bug"),
             2 if t + h > 0.5 => Err(StepError { time: 0.5, message: "solver gave up".into() }),
             _ => Ok(Step::Done),

@@ -22,6 +22,16 @@ use std::sync::Mutex;
 const OK: fmi3Status = fmi3Status::OK;
 const ERR: fmi3Status = fmi3Status::Error;
 
+/// The arguments of fmi3GetDirectionalDerivative and fmi3GetAdjointDerivative.
+fn derivative(
+    unknown: (*const u32, usize),
+    known: (*const u32, usize),
+    seed: (*const f64, usize),
+    sensitivity: (*mut f64, usize),
+) -> api::Derivative {
+    api::Derivative { unknown, known, seed, sensitivity }
+}
+
 /// Messages received by the logger: (status, category, text).
 type Messages = Mutex<Vec<(fmi3Status, String, String)>>;
 
@@ -292,7 +302,8 @@ fn cases() -> Vec<Case> {
         Case {
             name: "fmi3GetDirectionalDerivative",
             call: |i| unsafe {
-                api::get_directional_derivative::<Pfc>(i.c, (&vr::U, 1), (&vr::P, 1), (&1.0, 1), (&mut 0.0, 1))
+                let d = derivative((&vr::U, 1), (&vr::P, 1), (&1.0, 1), (&mut 0.0, 1));
+                api::get_directional_derivative::<Pfc>(i.c, d)
             },
             cs: "",
             me: "",
@@ -455,7 +466,9 @@ fn misuse_answers_with_error_and_a_message_and_changes_nothing() {
         ("ME function", &|| unsafe { api::set_time::<Pfc>(i.c, 0.0) }, &["a ModelExchange function"]),
         (
             "adjoint",
-            &|| unsafe { api::get_adjoint_derivative::<Pfc>(i.c, (&vr::U, 1), (&vr::P, 1), (&1.0, 1), (&mut 0.0, 1)) },
+            &|| unsafe {
+                api::get_adjoint_derivative::<Pfc>(i.c, derivative((&vr::U, 1), (&vr::P, 1), (&1.0, 1), (&mut 0.0, 1)))
+            },
             &["providesAdjointDerivatives=\"false\""],
         ),
         (
@@ -624,14 +637,20 @@ fn model_exchange_matches_fmi2_and_the_adjoint_is_the_transpose() {
     unsafe {
         let u = (unknowns.as_ptr(), nu);
         let k = (knowns.as_ptr(), nk);
-        assert_eq!(api::get_directional_derivative::<C>(i.c, u, k, (w.as_ptr(), nk), (jw.as_mut_ptr(), nu)), OK);
-        assert_eq!(api::get_adjoint_derivative::<C>(i.c, u, k, (v.as_ptr(), nu), (jtv.as_mut_ptr(), nk)), OK);
+        let forward = derivative(u, k, (w.as_ptr(), nk), (jw.as_mut_ptr(), nu));
+        let status = api::get_directional_derivative::<C>(i.c, forward);
+        assert_eq!(status, OK);
+        let status = api::get_adjoint_derivative::<C>(i.c, derivative(u, k, (v.as_ptr(), nu), (jtv.as_mut_ptr(), nk)));
+        assert_eq!(status, OK);
         let mut short = [0.0; 1];
-        assert_eq!(api::get_adjoint_derivative::<C>(i.c, u, k, (v.as_ptr(), nu), (short.as_mut_ptr(), 1)), ERR);
+        let status = api::get_adjoint_derivative::<C>(i.c, derivative(u, k, (v.as_ptr(), nu), (short.as_mut_ptr(), 1)));
+        assert_eq!(status, ERR);
         assert!(i.last_error().contains("nSensitivity = 1"));
         // A message names the FMI 3.0 argument (fmi3FunctionTypes.h), not FMI 2.0's dvKnown.
         let nan = vec![f64::NAN; nk];
-        assert_eq!(api::get_directional_derivative::<C>(i.c, u, k, (nan.as_ptr(), nk), (jw.as_mut_ptr(), nu)), ERR);
+        let not_a_number = derivative(u, k, (nan.as_ptr(), nk), (jw.as_mut_ptr(), nu));
+        let status = api::get_directional_derivative::<C>(i.c, not_a_number);
+        assert_eq!(status, ERR);
         assert!(i.last_error().contains("seed of \""), "{}", i.last_error());
     }
     let a: f64 = v.iter().zip(&jw).map(|(v, x)| v * x).sum();
@@ -752,9 +771,15 @@ fn derivatives_in_initialization_mode() {
         unsafe {
             let p3 = (&plant::P3 as *const u32, 1);
             let known = (&start_p4 as *const u32, 1);
-            let dd = api::get_directional_derivative::<HydraulicBoom>(i.c, p3, known, (&1.0, 1), (&mut forward, 1));
+            let dd = api::get_directional_derivative::<HydraulicBoom>(
+                i.c,
+                derivative(p3, known, (&1.0, 1), (&mut forward, 1)),
+            );
             assert_eq!(dd, OK, "{}", i.last_error());
-            let ad = api::get_adjoint_derivative::<HydraulicBoom>(i.c, p3, known, (&1.0, 1), (&mut adjoint, 1));
+            let ad = api::get_adjoint_derivative::<HydraulicBoom>(
+                i.c,
+                derivative(p3, known, (&1.0, 1), (&mut adjoint, 1)),
+            );
             assert_eq!(ad, OK, "{}", i.last_error());
         }
         for d in [forward, adjoint] {

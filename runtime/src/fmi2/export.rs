@@ -23,189 +23,49 @@ macro_rules! export_fmu {
             pub extern "C" fn fmi2GetVersion() -> *const c_char {
                 api::get_version()
             }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetDebugLogging(
-                c: fmi2Component,
-                on: fmi2Boolean,
-                n: usize,
-                cats: *const fmi2String,
-            ) -> fmi2Status {
-                api::set_debug_logging::<M>(c, on, n, cats)
+            $crate::__forward! {
+                fmi2SetDebugLogging(c: fmi2Component, on: fmi2Boolean, n: usize,
+                    cats: *const fmi2String) -> fmi2Status => set_debug_logging;
+                fmi2Instantiate(name: fmi2String, fmu_type: c_int, guid: fmi2String, resources: fmi2String,
+                    functions: *const fmi2CallbackFunctions, visible: fmi2Boolean,
+                    logging_on: fmi2Boolean) -> fmi2Component => instantiate;
+                fmi2SetupExperiment(c: fmi2Component, tol_defined: fmi2Boolean, tol: f64, start: f64,
+                    stop_defined: fmi2Boolean, stop: f64) -> fmi2Status => setup_experiment;
+                fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status => enter_initialization_mode;
+                fmi2GetReal(c: fmi2Component, vr: *const u32, n: usize, v: *mut f64) -> fmi2Status => get_real;
+                fmi2GetInteger(c: fmi2Component, vr: *const u32, n: usize, v: *mut c_int) -> fmi2Status => get_integer;
+                fmi2GetBoolean(c: fmi2Component, vr: *const u32, n: usize, v: *mut c_int) -> fmi2Status => get_boolean;
+                fmi2GetString(c: fmi2Component, vr: *const u32, n: usize,
+                    v: *mut fmi2String) -> fmi2Status => get_string;
+                fmi2SetReal(c: fmi2Component, vr: *const u32, n: usize, v: *const f64) -> fmi2Status => set_real;
+                fmi2SetInteger(c: fmi2Component, vr: *const u32, n: usize,
+                    v: *const c_int) -> fmi2Status => set_integer;
+                fmi2SetBoolean(c: fmi2Component, vr: *const u32, n: usize,
+                    v: *const c_int) -> fmi2Status => set_boolean;
+                fmi2SetString(c: fmi2Component, vr: *const u32, n: usize,
+                    v: *const fmi2String) -> fmi2Status => set_string;
+                fmi2GetDirectionalDerivative(c: fmi2Component, unknown: *const u32, n_unknown: usize, known: *const u32,
+                    n_known: usize, dv_known: *const f64,
+                    dv_unknown: *mut f64) -> fmi2Status => get_directional_derivative;
+                fmi2SetRealInputDerivatives(c: fmi2Component, vr: *const u32, n: usize, order: *const c_int,
+                    v: *const f64) -> fmi2Status => set_real_input_derivatives;
+                fmi2DoStep(c: fmi2Component, t: f64, h: f64, no_prior: fmi2Boolean) -> fmi2Status => do_step;
+                fmi2CancelStep(c: fmi2Component) -> fmi2Status => cancel_step;
+                fmi2GetRealStatus(c: fmi2Component, kind: c_int, v: *mut f64) -> fmi2Status => get_real_status;
+                fmi2GetBooleanStatus(c: fmi2Component, kind: c_int,
+                    v: *mut fmi2Boolean) -> fmi2Status => get_boolean_status;
+                fmi2NewDiscreteStates(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status => new_discrete_states;
+                fmi2CompletedIntegratorStep(c: fmi2Component, no_prior: fmi2Boolean, enter_event_mode: *mut fmi2Boolean,
+                    terminate: *mut fmi2Boolean) -> fmi2Status => completed_integrator_step;
             }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2Instantiate(
-                name: fmi2String,
-                fmu_type: c_int,
-                guid: fmi2String,
-                resources: fmi2String,
-                functions: *const fmi2CallbackFunctions,
-                visible: fmi2Boolean,
-                logging_on: fmi2Boolean,
-            ) -> fmi2Component {
-                api::instantiate::<M>(name, fmu_type, guid, resources, functions, visible, logging_on)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-                api::free_instance::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetupExperiment(
-                c: fmi2Component,
-                tol_defined: fmi2Boolean,
-                tol: f64,
-                start: f64,
-                stop_defined: fmi2Boolean,
-                stop: f64,
-            ) -> fmi2Status {
-                api::setup_experiment::<M>(c, tol_defined, tol, start, stop_defined, stop)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-                api::enter_initialization_mode::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-                api::exit_initialization_mode::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-                api::terminate::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-                api::reset::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetReal(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut f64,
-            ) -> fmi2Status {
-                api::get_real::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetInteger(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut c_int,
-            ) -> fmi2Status {
-                api::get_integer::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetBoolean(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut c_int,
-            ) -> fmi2Status {
-                api::get_boolean::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetString(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut fmi2String,
-            ) -> fmi2Status {
-                api::get_string::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetReal(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const f64,
-            ) -> fmi2Status {
-                api::set_real::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetInteger(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const c_int,
-            ) -> fmi2Status {
-                api::set_integer::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetBoolean(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const c_int,
-            ) -> fmi2Status {
-                api::set_boolean::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetString(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const fmi2String,
-            ) -> fmi2Status {
-                api::set_string::<M>(c, vr, n, v)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
-                api::get_fmu_state::<M>(c, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, s: fmi2FMUstate) -> fmi2Status {
-                api::set_fmu_state::<M>(c, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2FreeFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
-                api::free_fmu_state::<M>(c, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
-                c: fmi2Component,
-                s: fmi2FMUstate,
-                size: *mut usize,
-            ) -> fmi2Status {
-                api::serialized_fmu_state_size::<M>(c, s, size)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SerializeFMUstate(
-                c: fmi2Component,
-                s: fmi2FMUstate,
-                b: *mut fmi2Byte,
-                size: usize,
-            ) -> fmi2Status {
-                api::serialize_fmu_state::<M>(c, s, b, size)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
-                c: fmi2Component,
-                b: *const fmi2Byte,
-                size: usize,
-                s: *mut fmi2FMUstate,
-            ) -> fmi2Status {
-                api::deserialize_fmu_state::<M>(c, b, size, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
-                c: fmi2Component,
-                unknown: *const u32,
-                n_unknown: usize,
-                known: *const u32,
-                n_known: usize,
-                dv_known: *const f64,
-                dv_unknown: *mut f64,
-            ) -> fmi2Status {
-                api::get_directional_derivative::<M>(c, unknown, n_unknown, known, n_known, dv_known, dv_unknown)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
-                c: fmi2Component,
-                vr: *const u32,
-                n: usize,
-                order: *const c_int,
-                v: *const f64,
-            ) -> fmi2Status {
-                api::set_real_input_derivatives::<M>(c, vr, n, order, v)
+            $crate::__common_functions! {
+                fmi2Component, fmi2FMUstate, fmi2Byte;
+                fmi2FreeInstance, fmi2ExitInitializationMode, fmi2Terminate, fmi2Reset;
+                fmi2EnterEventMode, fmi2EnterContinuousTimeMode, fmi2SetTime, fmi2SetContinuousStates,
+                fmi2GetContinuousStates, fmi2GetDerivatives => get_derivatives, fmi2GetEventIndicators,
+                fmi2GetNominalsOfContinuousStates;
+                fmi2GetFMUstate, fmi2SetFMUstate, fmi2FreeFMUstate, fmi2SerializedFMUstateSize, fmi2SerializeFMUstate,
+                fmi2DeSerializeFMUstate;
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
@@ -218,20 +78,8 @@ macro_rules! export_fmu {
                 api::get_real_output_derivatives::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, no_prior: fmi2Boolean) -> fmi2Status {
-                api::do_step::<M>(c, t, h, no_prior)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
-                api::cancel_step::<M>(c)
-            }
-            #[no_mangle]
             pub unsafe extern "C" fn fmi2GetStatus(c: fmi2Component, _kind: c_int, _v: *mut fmi2Status) -> fmi2Status {
                 api::get_status::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetRealStatus(c: fmi2Component, kind: c_int, v: *mut f64) -> fmi2Status {
-                api::get_real_status::<M>(c, kind, v)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2GetIntegerStatus(
@@ -242,69 +90,12 @@ macro_rules! export_fmu {
                 api::get_integer_status::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetBooleanStatus(
-                c: fmi2Component,
-                kind: c_int,
-                v: *mut fmi2Boolean,
-            ) -> fmi2Status {
-                api::get_boolean_status::<M>(c, kind, v)
-            }
-            #[no_mangle]
             pub unsafe extern "C" fn fmi2GetStringStatus(
                 c: fmi2Component,
                 _kind: c_int,
                 _v: *mut fmi2String,
             ) -> fmi2Status {
                 api::get_string_status::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-                api::enter_event_mode::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2NewDiscreteStates(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status {
-                api::new_discrete_states::<M>(c, info)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-                api::enter_continuous_time_mode::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
-                c: fmi2Component,
-                no_prior: fmi2Boolean,
-                enter_event_mode: *mut fmi2Boolean,
-                terminate: *mut fmi2Boolean,
-            ) -> fmi2Status {
-                api::completed_integrator_step::<M>(c, no_prior, enter_event_mode, terminate)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: f64) -> fmi2Status {
-                api::set_time::<M>(c, time)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetContinuousStates(c: fmi2Component, x: *const f64, nx: usize) -> fmi2Status {
-                api::set_continuous_states::<M>(c, x, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetDerivatives(c: fmi2Component, dx: *mut f64, nx: usize) -> fmi2Status {
-                api::get_derivatives::<M>(c, dx, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetEventIndicators(c: fmi2Component, z: *mut f64, ni: usize) -> fmi2Status {
-                api::get_event_indicators::<M>(c, z, ni)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetContinuousStates(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status {
-                api::get_continuous_states::<M>(c, x, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
-                c: fmi2Component,
-                x: *mut f64,
-                nx: usize,
-            ) -> fmi2Status {
-                api::get_nominals_of_continuous_states::<M>(c, x, nx)
             }
         }
     };

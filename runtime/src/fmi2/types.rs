@@ -1,16 +1,13 @@
 //! The C types of the FMI 2.0 API (fmi2TypesPlatform.h, fmi2FunctionTypes.h).
 #![allow(non_camel_case_types, non_snake_case)]
 
-use std::os::raw::{c_char, c_int, c_uint, c_void};
+use std::os::raw::{c_char, c_int, c_void};
 
 pub type fmi2Component = *mut c_void;
 pub type fmi2ComponentEnvironment = *mut c_void;
 pub type fmi2FMUstate = *mut c_void;
-pub type fmi2ValueReference = c_uint;
 pub type fmi2Real = f64;
-pub type fmi2Integer = c_int;
 pub type fmi2Boolean = c_int;
-pub type fmi2Char = c_char;
 pub type fmi2String = *const c_char;
 pub type fmi2Byte = c_char;
 

@@ -9,7 +9,7 @@ use super::types::*;
 use crate::fmu::calls::{self, call, slice, slice_mut, Call};
 use crate::fmu::guid::token;
 use crate::fmu::instance::Instance;
-use crate::fmu::log::Logger;
+use crate::fmu::log::{num, Logger};
 use crate::fmu::model::Model;
 use crate::fmu::variables::{BaseType, Value};
 use crate::fmu::version::Version;
@@ -373,42 +373,48 @@ fn derivative_counts(
     Ok(())
 }
 
+/// The arguments of fmi3GetDirectionalDerivative and fmi3GetAdjointDerivative: the unknowns'
+/// and the knowns' value references, the seeds and the sensitivities, each with its count.
+pub struct Derivative {
+    pub unknown: (*const u32, usize),
+    pub known: (*const u32, usize),
+    pub seed: (*const f64, usize),
+    pub sensitivity: (*mut f64, usize),
+}
+
 /// fmi3GetDirectionalDerivative: the sensitivities of the unknowns to the seeded knowns.
-pub unsafe fn get_directional_derivative<M: Model>(
-    c: fmi3Instance,
-    (unknowns, n_unknowns): (*const u32, usize),
-    (knowns, n_knowns): (*const u32, usize),
-    (seed, n_seed): (*const f64, usize),
-    (sensitivity, n_sensitivity): (*mut f64, usize),
-) -> fmi3Status {
+pub unsafe fn get_directional_derivative<M: Model>(c: fmi3Instance, d: Derivative) -> fmi3Status {
     let f = at("fmi3GetDirectionalDerivative", allowed::DERIVATIVES);
-    if let Err(e) = derivative_counts(n_seed, n_knowns, n_sensitivity, n_unknowns) {
+    if let Err(e) = derivative_counts(d.seed.1, d.known.1, d.sensitivity.1, d.unknown.1) {
         return call::<M>(c, f, |_| Err(e));
     }
-    calls::get_directional_derivative::<M>(c, f, (unknowns, n_unknowns), (knowns, n_knowns), seed, sensitivity)
+    calls::get_directional_derivative::<M>(c, f, d.unknown, d.known, d.seed.0, d.sensitivity.0)
 }
 
 /// fmi3GetAdjointDerivative: the seeds weight the unknowns, the sensitivities are per known
 /// (the transposed Jacobian), from the same exact forward-mode derivatives, one column per known.
-pub unsafe fn get_adjoint_derivative<M: Model>(
-    c: fmi3Instance,
-    (unknowns, n_unknowns): (*const u32, usize),
-    (knowns, n_knowns): (*const u32, usize),
-    (seed, n_seed): (*const f64, usize),
-    (sensitivity, n_sensitivity): (*mut f64, usize),
-) -> fmi3Status {
+pub unsafe fn get_adjoint_derivative<M: Model>(c: fmi3Instance, d: Derivative) -> fmi3Status {
     let f = at("fmi3GetAdjointDerivative", allowed::DERIVATIVES);
     if !M::DIRECTIONAL_DERIVATIVES {
         return calls::unsupported::<M>(c, f, "providesAdjointDerivatives=\"false\"");
     }
     call::<M>(c, f, |inst| {
-        derivative_counts(n_seed, n_unknowns, n_sensitivity, n_knowns)?;
+        derivative_counts(d.seed.1, d.unknown.1, d.sensitivity.1, d.known.1)?;
         let limit = calls::references::<M>(Version::Fmi3);
-        let unknowns = slice(unknowns, n_unknowns, limit, "unknowns")?;
-        let knowns = slice(knowns, n_knowns, limit, "knowns")?;
-        let seeds = slice(seed, n_seed, limit, "seed")?;
-        let out = slice_mut(sensitivity, n_sensitivity, limit, "sensitivity")?;
-        inst.adjoint_derivative(unknowns, knowns, seeds, out)?;
+        let unknowns = slice(d.unknown.0, d.unknown.1, limit, "unknowns")?;
+        let knowns = slice(d.known.0, d.known.1, limit, "knowns")?;
+        let seeds = slice(d.seed.0, d.seed.1, limit, "seed")?;
+        let out = slice_mut(d.sensitivity.0, d.sensitivity.1, limit, "sensitivity")?;
+        if let Some(i) = seeds.iter().position(|s| !s.is_finite()) {
+            return Err(format!("seed[{i}] = {} is not a finite number", num(seeds[i])));
+        }
+        // out[j] = sum over the unknowns i of seed[i] times d unknown_i / d known_j: one
+        // forward-mode column per known, its references checked as for the directional one.
+        let mut column = vec![0.0; unknowns.len()];
+        for (o, &known) in out.iter_mut().zip(knowns) {
+            inst.directional_derivative(unknowns, &[known], &[1.0], &mut column)?;
+            *o = column.iter().zip(seeds).map(|(c, s)| c * s).sum();
+        }
         Ok(fmi3Status::OK)
     })
 }

@@ -29,56 +29,38 @@ macro_rules! export_fmi3 {
             pub extern "C" fn fmi3GetVersion() -> *const c_char {
                 api::get_version()
             }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetDebugLogging(
-                c: fmi3Instance,
-                on: bool,
-                n: usize,
-                cats: *const fmi3String,
-            ) -> fmi3Status {
-                api::set_debug_logging::<M>(c, on, n, cats)
+            $crate::__fmi3_values! {
+                fmi3GetFloat64 => get_float64, fmi3SetFloat64 => set_float64: f64, f64;
+                fmi3GetInt32 => get_int32, fmi3SetInt32 => set_int32: i32, i32;
+                fmi3GetBoolean => get_boolean, fmi3SetBoolean => set_boolean: bool, u8;
+                fmi3GetString => get_string, fmi3SetString => set_string: fmi3String, fmi3String;
             }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3InstantiateModelExchange(
-                name: fmi3String,
-                token: fmi3String,
-                resources: fmi3String,
-                visible: bool,
-                logging_on: bool,
-                env: fmi3InstanceEnvironment,
-                log: fmi3LogMessageCallback,
-            ) -> fmi3Instance {
-                api::instantiate_model_exchange::<M>(name, token, resources, visible, logging_on, env, log)
+            $crate::__forward! {
+                fmi3SetDebugLogging(c: fmi3Instance, on: bool, n: usize,
+                    cats: *const fmi3String) -> fmi3Status => set_debug_logging;
+                fmi3InstantiateModelExchange(name: fmi3String, token: fmi3String, resources: fmi3String, visible: bool,
+                    logging_on: bool, env: fmi3InstanceEnvironment,
+                    log: fmi3LogMessageCallback) -> fmi3Instance => instantiate_model_exchange;
+                fmi3InstantiateCoSimulation(name: fmi3String, token: fmi3String, resources: fmi3String, visible: bool,
+                    logging_on: bool, event_mode_used: bool, early_return_allowed: bool, required: *const u32,
+                    n_required: usize, env: fmi3InstanceEnvironment, log: fmi3LogMessageCallback,
+                    intermediate: fmi3IntermediateUpdateCallback) -> fmi3Instance => instantiate_co_simulation;
+                fmi3EnterInitializationMode(c: fmi3Instance, tol_defined: bool, tol: f64, start: f64,
+                    stop_defined: bool, stop: f64) -> fmi3Status => enter_initialization_mode;
+                fmi3GetNumberOfEventIndicators(c: fmi3Instance,
+                    n: *mut usize) -> fmi3Status => get_number_of_event_indicators;
+                fmi3GetNumberOfContinuousStates(c: fmi3Instance,
+                    n: *mut usize) -> fmi3Status => get_number_of_continuous_states;
+                fmi3EnterStepMode(c: fmi3Instance) -> fmi3Status => enter_step_mode;
             }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
-                name: fmi3String,
-                token: fmi3String,
-                resources: fmi3String,
-                visible: bool,
-                logging_on: bool,
-                event_mode_used: bool,
-                early_return_allowed: bool,
-                required: *const u32,
-                n_required: usize,
-                env: fmi3InstanceEnvironment,
-                log: fmi3LogMessageCallback,
-                intermediate: fmi3IntermediateUpdateCallback,
-            ) -> fmi3Instance {
-                api::instantiate_co_simulation::<M>(
-                    name,
-                    token,
-                    resources,
-                    visible,
-                    logging_on,
-                    event_mode_used,
-                    early_return_allowed,
-                    required,
-                    n_required,
-                    env,
-                    log,
-                    intermediate,
-                )
+            $crate::__common_functions! {
+                fmi3Instance, fmi3FMUState, u8;
+                fmi3FreeInstance, fmi3ExitInitializationMode, fmi3Terminate, fmi3Reset;
+                fmi3EnterEventMode, fmi3EnterContinuousTimeMode, fmi3SetTime, fmi3SetContinuousStates,
+                fmi3GetContinuousStates, fmi3GetContinuousStateDerivatives => get_continuous_state_derivatives,
+                fmi3GetEventIndicators, fmi3GetNominalsOfContinuousStates;
+                fmi3GetFMUState, fmi3SetFMUState, fmi3FreeFMUState, fmi3SerializedFMUStateSize, fmi3SerializeFMUState,
+                fmi3DeserializeFMUState;
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
@@ -94,77 +76,6 @@ macro_rules! export_fmi3 {
                 _unlock: fmi3PreemptionCallback,
             ) -> fmi3Instance {
                 api::instantiate_scheduled_execution::<M>(name, logging_on, env, log)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3FreeInstance(c: fmi3Instance) {
-                api::free_instance::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3EnterInitializationMode(
-                c: fmi3Instance,
-                tol_defined: bool,
-                tol: f64,
-                start: f64,
-                stop_defined: bool,
-                stop: f64,
-            ) -> fmi3Status {
-                api::enter_initialization_mode::<M>(c, tol_defined, tol, start, stop_defined, stop)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3ExitInitializationMode(c: fmi3Instance) -> fmi3Status {
-                api::exit_initialization_mode::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3EnterEventMode(c: fmi3Instance) -> fmi3Status {
-                api::enter_event_mode::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3Terminate(c: fmi3Instance) -> fmi3Status {
-                api::terminate::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3Reset(c: fmi3Instance) -> fmi3Status {
-                api::reset::<M>(c)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetFloat64(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *mut f64,
-                nv: usize,
-            ) -> fmi3Status {
-                api::get_float64::<M>(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetInt32(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *mut i32,
-                nv: usize,
-            ) -> fmi3Status {
-                api::get_int32::<M>(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetBoolean(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *mut bool,
-                nv: usize,
-            ) -> fmi3Status {
-                api::get_boolean::<M>(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetString(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *mut fmi3String,
-                nv: usize,
-            ) -> fmi3Status {
-                api::get_string::<M>(c, vr, n, v, nv)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3GetBinary(
@@ -185,46 +96,6 @@ macro_rules! export_fmi3 {
                 _v: *mut fmi3Clock,
             ) -> fmi3Status {
                 api::other_type::<M>(c, "fmi3GetClock", false, vr, n, "Clock")
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetFloat64(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *const f64,
-                nv: usize,
-            ) -> fmi3Status {
-                api::set_float64::<M>(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetInt32(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *const i32,
-                nv: usize,
-            ) -> fmi3Status {
-                api::set_int32::<M>(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetBoolean(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *const u8,
-                nv: usize,
-            ) -> fmi3Status {
-                api::set_boolean::<M>(c, vr, n, v, nv)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetString(
-                c: fmi3Instance,
-                vr: *const u32,
-                n: usize,
-                v: *const fmi3String,
-                nv: usize,
-            ) -> fmi3Status {
-                api::set_string::<M>(c, vr, n, v, nv)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3SetBinary(
@@ -270,83 +141,9 @@ macro_rules! export_fmi3 {
             ) -> fmi3Status {
                 api::unsupported::<M>(c, "fmi3GetVariableDependencies", "providesPerElementDependencies=\"false\"")
             }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetFMUState(c: fmi3Instance, s: *mut fmi3FMUState) -> fmi3Status {
-                api::get_fmu_state::<M>(c, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetFMUState(c: fmi3Instance, s: fmi3FMUState) -> fmi3Status {
-                api::set_fmu_state::<M>(c, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3FreeFMUState(c: fmi3Instance, s: *mut fmi3FMUState) -> fmi3Status {
-                api::free_fmu_state::<M>(c, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
-                c: fmi3Instance,
-                s: fmi3FMUState,
-                size: *mut usize,
-            ) -> fmi3Status {
-                api::serialized_fmu_state_size::<M>(c, s, size)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SerializeFMUState(
-                c: fmi3Instance,
-                s: fmi3FMUState,
-                b: *mut u8,
-                size: usize,
-            ) -> fmi3Status {
-                api::serialize_fmu_state::<M>(c, s, b, size)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3DeserializeFMUState(
-                c: fmi3Instance,
-                b: *const u8,
-                size: usize,
-                s: *mut fmi3FMUState,
-            ) -> fmi3Status {
-                api::deserialize_fmu_state::<M>(c, b, size, s)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
-                c: fmi3Instance,
-                unknowns: *const u32,
-                n_unknowns: usize,
-                knowns: *const u32,
-                n_knowns: usize,
-                seed: *const f64,
-                n_seed: usize,
-                sensitivity: *mut f64,
-                n_sensitivity: usize,
-            ) -> fmi3Status {
-                api::get_directional_derivative::<M>(
-                    c,
-                    (unknowns, n_unknowns),
-                    (knowns, n_knowns),
-                    (seed, n_seed),
-                    (sensitivity, n_sensitivity),
-                )
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetAdjointDerivative(
-                c: fmi3Instance,
-                unknowns: *const u32,
-                n_unknowns: usize,
-                knowns: *const u32,
-                n_knowns: usize,
-                seed: *const f64,
-                n_seed: usize,
-                sensitivity: *mut f64,
-                n_sensitivity: usize,
-            ) -> fmi3Status {
-                api::get_adjoint_derivative::<M>(
-                    c,
-                    (unknowns, n_unknowns),
-                    (knowns, n_knowns),
-                    (seed, n_seed),
-                    (sensitivity, n_sensitivity),
-                )
+            $crate::__fmi3_derivatives! {
+                fmi3GetDirectionalDerivative => get_directional_derivative;
+                fmi3GetAdjointDerivative => get_adjoint_derivative;
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3EnterConfigurationMode(c: fmi3Instance) -> fmi3Status {
@@ -388,10 +185,6 @@ macro_rules! export_fmi3 {
                 )
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(c: fmi3Instance) -> fmi3Status {
-                api::enter_continuous_time_mode::<M>(c)
-            }
-            #[no_mangle]
             pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
                 c: fmi3Instance,
                 _no_prior: bool,
@@ -399,50 +192,6 @@ macro_rules! export_fmi3 {
                 terminate: *mut bool,
             ) -> fmi3Status {
                 api::completed_integrator_step::<M>(c, enter_event_mode, terminate)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetTime(c: fmi3Instance, time: f64) -> fmi3Status {
-                api::set_time::<M>(c, time)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3SetContinuousStates(c: fmi3Instance, x: *const f64, nx: usize) -> fmi3Status {
-                api::set_continuous_states::<M>(c, x, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(
-                c: fmi3Instance,
-                dx: *mut f64,
-                nx: usize,
-            ) -> fmi3Status {
-                api::get_continuous_state_derivatives::<M>(c, dx, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetEventIndicators(c: fmi3Instance, z: *mut f64, ni: usize) -> fmi3Status {
-                api::get_event_indicators::<M>(c, z, ni)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetContinuousStates(c: fmi3Instance, x: *mut f64, nx: usize) -> fmi3Status {
-                api::get_continuous_states::<M>(c, x, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(
-                c: fmi3Instance,
-                x: *mut f64,
-                nx: usize,
-            ) -> fmi3Status {
-                api::get_nominals_of_continuous_states::<M>(c, x, nx)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetNumberOfEventIndicators(c: fmi3Instance, n: *mut usize) -> fmi3Status {
-                api::get_number_of_event_indicators::<M>(c, n)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3GetNumberOfContinuousStates(c: fmi3Instance, n: *mut usize) -> fmi3Status {
-                api::get_number_of_continuous_states::<M>(c, n)
-            }
-            #[no_mangle]
-            pub unsafe extern "C" fn fmi3EnterStepMode(c: fmi3Instance) -> fmi3Status {
-                api::enter_step_mode::<M>(c)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3GetOutputDerivatives(
@@ -479,6 +228,19 @@ macro_rules! export_fmi3 {
     };
 }
 
+/// The get and set functions of the types the variables have (inside [`export_fmi3!`]): each
+/// entry `get => api_get, set => api_set: GetType, SetType;` (a Boolean is set as bytes).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __fmi3_values {
+    ($($get:ident => $api_get:ident, $set:ident => $api_set:ident: $gt:ty, $st:ty;)*) => {$(
+        $crate::__forward! {
+            $get(c: fmi3Instance, vr: *const u32, n: usize, v: *mut $gt, nv: usize) -> fmi3Status => $api_get;
+            $set(c: fmi3Instance, vr: *const u32, n: usize, v: *const $st, nv: usize) -> fmi3Status => $api_set;
+        }
+    )*};
+}
+
 /// The get and set functions of types no variable has (inside [`export_fmi3!`], where `api` and
 /// `M` are in scope): an error naming the variable and its type.
 #[doc(hidden)]
@@ -504,6 +266,31 @@ macro_rules! __fmi3_clock_functions {
         #[no_mangle]
         pub unsafe extern "C" fn $name(c: fmi3Instance, $(_: $arg),*) -> fmi3Status {
             api::unsupported::<M>(c, stringify!($name), "the FMU has no clocks")
+        }
+    )*};
+}
+
+/// fmi3GetDirectionalDerivative and fmi3GetAdjointDerivative (inside [`export_fmi3!`]): the
+/// same arguments, gathered in an [`api::Derivative`](crate::fmi3::api::Derivative).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __fmi3_derivatives {
+    ($($name:ident => $target:ident;)*) => {$(
+        #[no_mangle]
+        pub unsafe extern "C" fn $name(
+            c: fmi3Instance,
+            unknowns: *const u32,
+            n_unknowns: usize,
+            knowns: *const u32,
+            n_knowns: usize,
+            seed: *const f64,
+            n_seed: usize,
+            sensitivity: *mut f64,
+            n_sensitivity: usize,
+        ) -> fmi3Status {
+            let (unknown, known) = ((unknowns, n_unknowns), (knowns, n_knowns));
+            let (seed, sensitivity) = ((seed, n_seed), (sensitivity, n_sensitivity));
+            api::$target::<M>(c, api::Derivative { unknown, known, seed, sensitivity })
         }
     )*};
 }

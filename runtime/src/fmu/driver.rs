@@ -10,7 +10,7 @@
 //! model itself ([`Step::Done`]), which no integrator beats; such a model has no ODE state and
 //! the driver no integrator for it.
 
-use super::model::{Log, Model, StepError};
+use super::model::{Log, Model, StepError, StepStart};
 use super::variables::{Values, Variable};
 use crate::solver::{OdeSystem, Radau5, SolverStats};
 use std::ops::{Deref, DerefMut};
@@ -114,7 +114,8 @@ impl<M: Model> Driven<M> {
         log: &mut dyn Log,
     ) -> Result<(), StepError> {
         let fail = |time, message: String| StepError { time, message };
-        match (self.model.begin_step(values, input_derivatives, t, h, log)?, &mut self.solver) {
+        let start = StepStart { values, input_derivatives, t, h };
+        match (self.model.begin_step(&start, log)?, &mut self.solver) {
             (Step::Done, _) => return Ok(()),
             (Step::Integrate(ode, state), Some(solver)) => {
                 solver.set_tolerance(tolerance, || M::scale(ode)).map_err(|e| fail(t, e.to_string()))?;

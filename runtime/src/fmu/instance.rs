@@ -4,7 +4,7 @@
 use super::driver::Driven;
 use super::log::{num, Logger, Status};
 use super::machine::{Interface, Mode};
-use super::model::{initial_unknown, Log, Model};
+use super::model::{initial_unknown, Log, Model, Seeds};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
 use std::borrow::Cow;
@@ -424,7 +424,7 @@ impl<M: Model> Instance<M> {
         } else {
             let model = self.core.model.as_ref().ok_or("the model is not initialised")?;
             let knowns: Vec<(u32, f64)> = knowns.iter().copied().zip(seeds.iter().copied()).collect();
-            model.directional_derivative(&self.core.values, &knowns, unknowns, out)?;
+            model.directional_derivative(&self.core.values, Seeds { knowns: &knowns, unknowns, out: &mut *out })?;
         }
         if let Some(k) = out.iter().position(|x| !x.is_finite()) {
             return Err(format!(
@@ -475,28 +475,6 @@ impl<M: Model> Instance<M> {
             for ((o, a), b) in out.iter_mut().zip(hi).zip(lo) {
                 *o += seed * (a - b) / span;
             }
-        }
-        Ok(())
-    }
-
-    /// fmi3GetAdjointDerivative: `out[j]` = sum over the unknowns `i` of `seeds[i]` times the
-    /// partial derivative of unknown `i` by known `j` (the transposed Jacobian times the seeds),
-    /// one forward-mode column per known; the references are checked as for
-    /// [`Instance::directional_derivative`].
-    pub fn adjoint_derivative(
-        &mut self,
-        unknowns: &[u32],
-        knowns: &[u32],
-        seeds: &[f64],
-        out: &mut [f64],
-    ) -> Result<(), String> {
-        if let Some(i) = seeds.iter().position(|s| !s.is_finite()) {
-            return Err(format!("seed[{i}] = {} is not a finite number", num(seeds[i])));
-        }
-        let mut column = vec![0.0; unknowns.len()];
-        for (o, &known) in out.iter_mut().zip(knowns) {
-            self.directional_derivative(unknowns, &[known], &[1.0], &mut column)?;
-            *o = column.iter().zip(seeds).map(|(c, s)| c * s).sum();
         }
         Ok(())
     }

@@ -6,6 +6,7 @@
 
 pub mod calls;
 pub mod driver;
+mod forward;
 pub mod snapshot;
 pub mod guid;
 pub mod instance;
@@ -17,6 +18,6 @@ pub mod variables;
 pub mod version;
 
 pub use log::Status;
-pub use model::{ContinuousState, Log, Model, ModelInfo, StepError};
+pub use model::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart};
 pub use variables::{Causality, Initial, Kind, Value, Values, Variability, Variable};
 pub use version::Version;

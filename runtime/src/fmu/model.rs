@@ -55,6 +55,24 @@ pub struct StepError {
     pub message: String,
 }
 
+/// The start of a Co-Simulation step from `t` to `t + h`: the variable values at `t` and the
+/// first derivatives of the inputs (one per table row, zero unless set) where the model
+/// interpolates them.
+pub struct StepStart<'a> {
+    pub values: &'a Values,
+    pub input_derivatives: &'a [f64],
+    pub t: f64,
+    pub h: f64,
+}
+
+/// The arguments of a directional derivative: the knowns with their seeds, the unknowns, and
+/// where the unknowns' sensitivities go (one per unknown).
+pub struct Seeds<'a> {
+    pub knowns: &'a [(u32, f64)],
+    pub unknowns: &'a [u32],
+    pub out: &'a mut [f64],
+}
+
 /// What a model says while it steps, routed to a log category by the FMI layer.
 pub trait Log {
     /// Whether messages of a category are delivered (skip formatting them when not).
@@ -131,13 +149,7 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// output or a `der()` variable) the sum over the knowns (states and inputs, with their
     /// seeds) of its partial derivative times the seed, by exact forward-mode differentiation.
     /// The FMI layer has checked the references; `Err` names what the model cannot differentiate.
-    fn directional_derivative(
-        &self,
-        _values: &Values,
-        _knowns: &[(u32, f64)],
-        _unknowns: &[u32],
-        _out: &mut [f64],
-    ) -> Result<(), String> {
+    fn directional_derivative(&self, _values: &Values, _seeds: Seeds<'_>) -> Result<(), String> {
         Err("providesDirectionalDerivative=\"false\"".into())
     }
 
@@ -155,18 +167,9 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// `()` for a model that steps in closed form.
     type Ode: OdeSystem;
 
-    /// Co-Simulation, at the start of the step from `t` to `t + h`: takes the step's inputs
-    /// (`values` at `t`, changing with the given first derivatives, one per table row, zero
-    /// unless set, where the model interpolates inputs) and returns its ODE with its state for
-    /// the driver to integrate, or steps itself in closed form ([`Step::Done`]).
-    fn begin_step(
-        &mut self,
-        values: &Values,
-        input_derivatives: &[f64],
-        t: f64,
-        h: f64,
-        log: &mut dyn Log,
-    ) -> Result<Step<'_, Self::Ode>, StepError>;
+    /// Co-Simulation, at the start of a step: takes the step's inputs and returns its ODE with
+    /// its state for the driver to integrate, or steps itself in closed form ([`Step::Done`]).
+    fn begin_step(&mut self, step: &StepStart<'_>, log: &mut dyn Log) -> Result<Step<'_, Self::Ode>, StepError>;
 
     /// Typical magnitude of each state of `ode` (absolute tolerance = rtol x scale).
     fn scale(ode: &Self::Ode) -> Vec<f64>;

@@ -14,7 +14,7 @@ use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
 use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_VARIABLES, START_STROKE, TIP_DEFLECTION};
 use crate::fmu::driver::Step;
-use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
@@ -196,7 +196,7 @@ impl Model for BoomMechanics {
             "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
         interpolated_inputs: &[vr::F, vr::C_H],
         documentation: DOCUMENTATION,
-        ..super::plant::PLANT_INFO
+        ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &BOOM_STATES;
@@ -237,18 +237,12 @@ impl Model for BoomMechanics {
     /// the input cylinder.F, each carrying its seed: the derivatives and outputs carry the
     /// directional derivative, exact to round-off. The TLM port's wave is sampled at
     /// communication points: not provided.
-    fn directional_derivative(
-        &self,
-        values: &Values,
-        knowns: &[(u32, f64)],
-        unknowns: &[u32],
-        out: &mut [f64],
-    ) -> Result<(), String> {
+    fn directional_derivative(&self, values: &Values, seeds: Seeds<'_>) -> Result<(), String> {
         port::directional_derivative_check(self.sys.coupling)?;
         let mut x = [0.0; BOOM_STATES.len()];
         self.continuous_states(&mut x);
-        let x = super::exposed::seeded_states(&BOOM_STATES, &x, knowns);
-        let f = super::exposed::seeded(knowns, vr::F, values.real(vr::F));
+        let x = super::exposed::seeded_states(&BOOM_STATES, &x, seeds.knowns);
+        let f = super::exposed::seeded(seeds.knowns, vr::F, values.real(vr::F));
         let dof = self.sys.boom.mechanics().dof();
         let (mut q, mut qd) = ([Dual64::from(0.0); MAX_SECTIONS], [Dual64::from(0.0); MAX_SECTIONS]);
         let (q, qd) = (&mut q[..dof], &mut qd[..dof]);
@@ -266,7 +260,7 @@ impl Model for BoomMechanics {
         let boom = self.sys.boom.output_rows(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y]);
         let derivatives = BOOM_STATES.iter().zip(dx).map(|(s, d)| (s.derivative, d));
         let rows: Vec<(u32, Dual64)> = port.into_iter().chain(boom).chain(derivatives).collect();
-        super::exposed::pick_derivatives(&rows, unknowns, out)
+        super::exposed::pick_derivatives(&rows, seeds)
     }
 
     /// Starts at rest; the TLM wave starts at the holding force (both sides at rest).
@@ -295,15 +289,8 @@ impl Model for BoomMechanics {
 
     type Ode = PortedBoom;
 
-    fn begin_step(
-        &mut self,
-        values: &Values,
-        input_derivatives: &[f64],
-        t: f64,
-        _h: f64,
-        _log: &mut dyn Log,
-    ) -> Result<Step<'_, PortedBoom>, StepError> {
-        self.sys.input = Ramp::read(values, input_derivatives, self.input_vr(), t);
+    fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, PortedBoom>, StepError> {
+        self.sys.input = Ramp::read(step, self.input_vr());
         Ok(Step::Integrate(&self.sys, &mut self.state))
     }
 

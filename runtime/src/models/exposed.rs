@@ -8,7 +8,7 @@
 //! theta2 in every slot (its Co-Simulation solver keeps the stroke, see [`super::boom::Boom`]).
 
 use super::vr;
-use crate::fmu::{ContinuousState, Variable};
+use crate::fmu::{ContinuousState, Seeds, Variable};
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::scalar::Dual64;
 
@@ -160,9 +160,9 @@ pub(crate) fn seeded_states<const N: usize>(
     std::array::from_fn(|k| seeded(knowns, states[k].state, x[k]))
 }
 
-/// Writes the directional derivative of each of `unknowns` from the differentiated `rows`.
-pub(crate) fn pick_derivatives(rows: &[(u32, Dual64)], unknowns: &[u32], out: &mut [f64]) -> Result<(), String> {
-    for (o, &r) in out.iter_mut().zip(unknowns) {
+/// Writes the directional derivative of each of the unknowns from the differentiated `rows`.
+pub(crate) fn pick_derivatives(rows: &[(u32, Dual64)], seeds: Seeds<'_>) -> Result<(), String> {
+    for (o, &r) in seeds.out.iter_mut().zip(seeds.unknowns) {
         *o = rows
             .iter()
             .find(|row| row.0 == r)

@@ -17,7 +17,7 @@ use super::table::{
     START_STROKE, TIP_DEFLECTION, U_REF_INPUT,
 };
 use crate::fmu::driver::Step;
-use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
@@ -218,7 +218,7 @@ impl Model for HydraulicBoom {
             "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
         interpolated_inputs: &[vr::U_REF],
         documentation: DOCUMENTATION,
-        ..super::plant::PLANT_INFO
+        ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &PLANT_STATES;
@@ -261,17 +261,11 @@ impl Model for HydraulicBoom {
     /// The plant evaluated once in dual numbers from its Model Exchange states and the input,
     /// each carrying its seed: the derivatives and outputs carry the directional derivative,
     /// exact to round-off (padded state slots are copies the model does not read: zero).
-    fn directional_derivative(
-        &self,
-        values: &Values,
-        knowns: &[(u32, f64)],
-        unknowns: &[u32],
-        out: &mut [f64],
-    ) -> Result<(), String> {
+    fn directional_derivative(&self, values: &Values, seeds: Seeds<'_>) -> Result<(), String> {
         let mut x = [0.0; PLANT_STATES.len()];
         self.continuous_states(&mut x);
-        let x = super::exposed::seeded_states(&PLANT_STATES, &x, knowns);
-        let u_ref = super::exposed::seeded(knowns, vr::U_REF, values.real(vr::U_REF));
+        let x = super::exposed::seeded_states(&PLANT_STATES, &x, seeds.knowns);
+        let u_ref = super::exposed::seeded(seeds.knowns, vr::U_REF, values.real(vr::U_REF));
         let mut s = [Dual64::from(0.0); N_CIRCUIT + 2 * MAX_SECTIONS];
         let s = &mut s[..self.state.len()];
         s[..N_CIRCUIT].copy_from_slice(&x[..N_CIRCUIT]);
@@ -281,7 +275,7 @@ impl Model for HydraulicBoom {
         self.plant.me_rhs(u_ref, s, &mut dx);
         let derivatives = PLANT_STATES.iter().zip(dx).map(|(st, d)| (st.derivative, d));
         let rows: Vec<(u32, Dual64)> = self.plant.output_rows(u_ref, s).chain(derivatives).collect();
-        super::exposed::pick_derivatives(&rows, unknowns, out)
+        super::exposed::pick_derivatives(&rows, seeds)
     }
 
     fn outputs(&self, values: &mut Values) {
@@ -292,15 +286,8 @@ impl Model for HydraulicBoom {
 
     type Ode = Plant;
 
-    fn begin_step(
-        &mut self,
-        values: &Values,
-        input_derivatives: &[f64],
-        t: f64,
-        _h: f64,
-        _log: &mut dyn Log,
-    ) -> Result<Step<'_, Plant>, StepError> {
-        self.plant.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
+    fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, Plant>, StepError> {
+        self.plant.u_ref = Ramp::read(step, vr::U_REF);
         Ok(Step::Integrate(&self.plant, &mut self.state))
     }
 

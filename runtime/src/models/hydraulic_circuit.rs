@@ -18,7 +18,7 @@ use super::table::{
     out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_VARIABLES, START_P4, START_STROKE, U_REF_INPUT,
 };
 use crate::fmu::driver::Step;
-use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Value, Values, Variable};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::params::ParamSpec;
@@ -246,7 +246,7 @@ impl Model for HydraulicCircuit {
         // cylinder.x follows the integral of cylinder.v within a step: it has no slope of its own.
         interpolated_inputs: &[vr::U_REF, vr::X, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
-        ..super::plant::PLANT_INFO
+        ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
@@ -282,24 +282,18 @@ impl Model for HydraulicCircuit {
     /// The plain port's circuit evaluated once in dual numbers, each state and input carrying
     /// its seed: the derivatives and outputs carry the directional derivative, exact to
     /// round-off. The TLM port's outputs are sampled at communication points: not provided.
-    fn directional_derivative(
-        &self,
-        values: &Values,
-        knowns: &[(u32, f64)],
-        unknowns: &[u32],
-        out: &mut [f64],
-    ) -> Result<(), String> {
+    fn directional_derivative(&self, values: &Values, seeds: Seeds<'_>) -> Result<(), String> {
         port::directional_derivative_check(self.sys.coupling)?;
-        let seed = |r: u32, x: f64| super::exposed::seeded(knowns, r, x);
-        let c =
-            super::exposed::seeded_states(&CIRCUIT_STATES, self.state[..N_CIRCUIT].try_into().expect("circuit"), knowns);
+        let seed = |r: u32, x: f64| super::exposed::seeded(seeds.knowns, r, x);
+        let states: &[f64; N_CIRCUIT] = self.state[..N_CIRCUIT].try_into().expect("circuit");
+        let c = super::exposed::seeded_states(&CIRCUIT_STATES, states, seeds.knowns);
         let [u_ref, x, v] = [vr::U_REF, vr::X, vr::V].map(|r| seed(r, values.real(r)));
         let e = self.sys.circuit.evaluate(&c, u_ref, x, v);
         let port = [(vr::C_H, e.force), (port::vr::F, e.force), (vr::PORT_X, x), (vr::PORT_V, v)];
         let derivatives = CIRCUIT_STATES.iter().zip(e.dx).map(|(s, d)| (s.derivative, d));
         let rows: Vec<(u32, Dual64)> =
             super::circuit::circuit_rows(&c, &e).into_iter().chain(port).chain(derivatives).collect();
-        super::exposed::pick_derivatives(&rows, unknowns, out)
+        super::exposed::pick_derivatives(&rows, seeds)
     }
 
     /// The plain port's circuit at the stroke and velocity inputs.
@@ -327,19 +321,12 @@ impl Model for HydraulicCircuit {
 
     type Ode = PortedCircuit;
 
-    fn begin_step(
-        &mut self,
-        values: &Values,
-        input_derivatives: &[f64],
-        t: f64,
-        _h: f64,
-        _log: &mut dyn Log,
-    ) -> Result<Step<'_, PortedCircuit>, StepError> {
+    fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, PortedCircuit>, StepError> {
         let sys = &mut self.sys;
-        sys.u_ref = Ramp::read(values, input_derivatives, vr::U_REF, t);
-        sys.x0 = values.real(vr::X);
-        sys.v = Ramp::read(values, input_derivatives, vr::V, t);
-        sys.c_m = Ramp::read(values, input_derivatives, vr::C_M, t);
+        sys.u_ref = Ramp::read(step, vr::U_REF);
+        sys.x0 = step.values.real(vr::X);
+        sys.v = Ramp::read(step, vr::V);
+        sys.c_m = Ramp::read(step, vr::C_M);
         Ok(Step::Integrate(&self.sys, &mut self.state))
     }
 

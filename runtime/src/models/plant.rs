@@ -1,5 +1,6 @@
 //! What the plant models (HydraulicBoom, HydraulicCircuit, BoomMechanics) share beyond their
-//! variable rows: their [`ModelInfo`] defaults and the check of a start or restored state. The
+//! variable rows: the [`ModelInfo`] defaults (the controller's too) and the check of a start or
+//! restored state. The
 //! driver ([`crate::fmu::driver`]) integrates them.
 //!
 //! [`ModelInfo`]: crate::fmu::ModelInfo
@@ -17,9 +18,9 @@ pub(crate) fn checked_state(
     }
 }
 
-/// What the plant models (HydraulicBoom, HydraulicCircuit, BoomMechanics) share in their
-/// [`ModelInfo`]: the thesis' 15 s experiments at 1 ms, rtol 1e-6, the solver log category.
-pub(crate) const PLANT_INFO: crate::fmu::ModelInfo = crate::fmu::ModelInfo {
+/// What the models share in their [`ModelInfo`]: the thesis' 15 s experiments at 1 ms, rtol
+/// 1e-6, and the log category of the integrator (the plants'; the controller has its own).
+pub(crate) const MODEL_INFO: crate::fmu::ModelInfo = crate::fmu::ModelInfo {
     identifier: "",
     description: "",
     version: env!("CARGO_PKG_VERSION"),

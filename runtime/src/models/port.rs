@@ -17,7 +17,7 @@
 //!   series with the oil column and a mass `Z_c h` at the pin; `Z_c = sqrt(k_oil m_eff)` makes
 //!   both relative errors equal to omega h.
 
-use crate::fmu::{Value, Values, Variable};
+use crate::fmu::{StepStart, Value, Values, Variable};
 use crate::params::ParamSpec;
 
 /// Value references of the port (the same in both FMUs; 80-99, after the section angles 41-72).
@@ -177,10 +177,10 @@ pub struct Ramp {
 }
 
 impl Ramp {
-    /// Input `r` from `values` and its derivative, at the step start `t0`.
-    pub fn read(values: &Values, derivatives: &[f64], r: u32, t0: f64) -> Self {
-        let slope = values.position(r).map_or(0.0, |i| derivatives[i]);
-        Ramp { t0, y0: values.real(r), slope }
+    /// Input `r` and its derivative at the start of a step.
+    pub fn read(step: &StepStart<'_>, r: u32) -> Self {
+        let slope = step.values.position(r).map_or(0.0, |i| step.input_derivatives[i]);
+        Ramp { t0: step.t, y0: step.values.real(r), slope }
     }
 
     /// The value at `t`.

@@ -14,7 +14,7 @@ use crate::control::{HighPassFeedback, FEEDBACK_PARAMS};
 use crate::params::build;
 use crate::fmu::instance::bounded_slope;
 use crate::fmu::driver::Step;
-use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, Values, Variable};
+use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, StepStart, Values, Variable};
 
 /// Value references (stable across releases).
 pub mod vr {
@@ -192,8 +192,9 @@ impl PressureFeedbackController {
     /// or, if the master set none since the last step, the last ramp continued. An extrapolated
     /// ramp that would leave p's declared range within the step stops at the bound
     /// ([`bounded_slope`], as the FMI layer bounds a master's slope), re-anchored at `t`.
-    fn pressure_ramp(&self, values: &Values, input_derivatives: &[f64], t: f64, h: f64) -> Ramp {
-        let given = Ramp::read(values, input_derivatives, vr::P, t);
+    fn pressure_ramp(&self, step: &StepStart<'_>) -> Ramp {
+        let (t, h) = (step.t, step.h);
+        let given = Ramp::read(step, vr::P);
         let ramp = if !self.extrapolate || given.slope != 0.0 {
             return given;
         } else if !self.fresh {
@@ -218,14 +219,10 @@ impl Model for PressureFeedbackController {
     const INFO: ModelInfo = ModelInfo {
         identifier: "PressureFeedbackController",
         description: "High-pass filtered pressure feedback for a pressure-compensated valve with counterbalance valve (thesis section 6.1)",
-        version: env!("CARGO_PKG_VERSION"),
-        start_time: 0.0,
-        stop_time: 15.0,
-        step_size: 1e-3,
-        default_tolerance: 1e-6,
         log_categories: &[("logSaturation", "Spool command clamped at u_min or u_max")],
         interpolated_inputs: &[vr::U_REF, vr::P],
         documentation: DOCUMENTATION,
+        ..super::plant::MODEL_INFO
     };
 
     const VARIABLES: &'static [Variable] = VARIABLES;
@@ -276,15 +273,9 @@ impl Model for PressureFeedbackController {
 
     /// The filter x' = omega_f (p - x) over the step, exact for the pressure ramped with its
     /// slope ([`HighPassFeedback::advance`]): a closed form no integrator beats.
-    fn begin_step(
-        &mut self,
-        values: &Values,
-        input_derivatives: &[f64],
-        t: f64,
-        h: f64,
-        log: &mut dyn Log,
-    ) -> Result<Step<'_, ()>, StepError> {
-        let p = self.pressure_ramp(values, input_derivatives, t, h);
+    fn begin_step(&mut self, step: &StepStart<'_>, log: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
+        let (values, t, h) = (step.values, step.t, step.h);
+        let p = self.pressure_ramp(step);
         self.x = self.feedback.advance(self.x, p.at(t), p.slope, h);
         (self.p, self.sampled, self.fresh, self.t) = (p, true, false, t + h);
         let (_, u) = self.command(values, p.at(self.t));
