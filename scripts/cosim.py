@@ -215,36 +215,26 @@ class FmuFile:
             cls._cache[identifier, fmi] = FmuFile(identifier, fmi=fmi)
         return cls._cache[identifier, fmi]
 
+    def _instance(self, interface: str, name: str):
+        """An instantiated fmpy instance of `interface` ("CoSimulation" or "ModelExchange"),
+        FMI 3.0 ones behind the FMI 2.0 method names (class Fmi3)."""
+        from fmpy import fmi2, fmi3
+
+        kind = "Slave" if interface == "CoSimulation" else "Model"
+        cls = getattr(fmi3, f"FMU3{kind}") if self.fmi == 3 else getattr(fmi2, f"FMU2{kind}")
+        description = self.md.coSimulation if interface == "CoSimulation" else self.md.modelExchange
+        i = cls(guid=self.md.guid, unzipDirectory=self.dir,
+                modelIdentifier=description.modelIdentifier, instanceName=name)
+        i.instantiate()
+        return Fmi3(i) if self.fmi == 3 else i
+
     def slave(self, name: str):
-        if self.fmi == 3:
-            from fmpy.fmi3 import FMU3Slave
-
-            s = FMU3Slave(guid=self.md.guid, unzipDirectory=self.dir,
-                          modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-            s.instantiate()
-            return Fmi3(s)
-        from fmpy.fmi2 import FMU2Slave
-
-        s = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
-                      modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-        s.instantiate()
-        return s
+        """A Co-Simulation instance."""
+        return self._instance("CoSimulation", name)
 
     def model(self, name: str):
         """A Model Exchange instance."""
-        if self.fmi == 3:
-            from fmpy.fmi3 import FMU3Model
-
-            m = FMU3Model(guid=self.md.guid, unzipDirectory=self.dir,
-                          modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=name)
-            m.instantiate()
-            return Fmi3(m)
-        from fmpy.fmi2 import FMU2Model
-
-        m = FMU2Model(guid=self.md.guid, unzipDirectory=self.dir,
-                      modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=name)
-        m.instantiate()
-        return m
+        return self._instance("ModelExchange", name)
 
     def set(self, slave, name: str, value):
         v = self.vars[name]

@@ -107,23 +107,15 @@ def run_jacobi(step: float, slope_to_plant: bool) -> dict:
     return {"time": a[:, 0], "p3": a[:, 1], "x": a[:, 2], "v": a[:, 3], "u": a[:, 4], "Q3": a[:, 5], "cbv": a[:, 6]}
 
 
+#: The masters by how the plant gets u_ref's slope (None: Gauss-Seidel through cosim.run).
+MASTERS = {None: "Gauss-Seidel (cosim.run)", False: "Jacobi, u_ref held", True: "Jacobi, u_ref slope extrap."}
+#: key: (master, step, slope_to_plant). Per step the keys of the three masters; the extras
+#: (--sweep) are 0.5 and 2 ms, and a fine Gauss-Seidel run as a proxy of the continuous coupling.
 RUNS = {
-    # key: (master, step, slope_to_plant; None = Gauss-Seidel through cosim.run)
-    "a": ("Gauss-Seidel (cosim.run)", 1e-3, None),
-    "b": ("Jacobi, u_ref held", 1e-3, False),
-    "c": ("Jacobi, u_ref slope extrap.", 1e-3, True),
-    "a5": ("Gauss-Seidel (cosim.run)", 5e-3, None),
-    "d": ("Jacobi, u_ref held", 5e-3, False),
-    "e": ("Jacobi, u_ref slope extrap.", 5e-3, True),
-    # extras (--sweep): a fine Gauss-Seidel run as a proxy of the continuous coupling, 0.5/2 ms
-    "fine": ("Gauss-Seidel (cosim.run)", 1e-4, None),
-    "a05": ("Gauss-Seidel (cosim.run)", 5e-4, None),
-    "b05": ("Jacobi, u_ref held", 5e-4, False),
-    "c05": ("Jacobi, u_ref slope extrap.", 5e-4, True),
-    "a2": ("Gauss-Seidel (cosim.run)", 2e-3, None),
-    "b2": ("Jacobi, u_ref held", 2e-3, False),
-    "c2": ("Jacobi, u_ref slope extrap.", 2e-3, True),
-}
+    key: (MASTERS[slope], step, slope)
+    for step, keys in {1e-3: "a b c", 5e-3: "a5 d e", 5e-4: "a05 b05 c05", 2e-3: "a2 b2 c2"}.items()
+    for key, slope in zip(keys.split(), MASTERS)
+} | {"fine": (MASTERS[None], 1e-4, None)}
 MAIN_RUNS = ["a", "b", "c", "a5", "d", "e"]
 SWEEP_RUNS = ["fine", "a05", "b05", "c05", "a2", "b2", "c2"]
 #: project motion start (scripts/metrics.py): CBV outflow -Q3 above 10 % of the expected steady flow

@@ -119,21 +119,12 @@ class Fmu:
         return s
 
 
-@pytest.fixture(scope="session")
-def controller(tmp_path_factory):
-    return Fmu("PressureFeedbackController", tmp_path_factory)
+def _fmu_fixture(identifier):
+    """A session fixture: the FMU `identifier`, unpacked once."""
+    return pytest.fixture(scope="session")(lambda tmp_path_factory: Fmu(identifier, tmp_path_factory))
 
 
-@pytest.fixture(scope="session")
-def boom(tmp_path_factory):
-    return Fmu("HydraulicBoom", tmp_path_factory)
-
-
-@pytest.fixture(scope="session")
-def circuit(tmp_path_factory):
-    return Fmu("HydraulicCircuit", tmp_path_factory)
-
-
-@pytest.fixture(scope="session")
-def mechanics(tmp_path_factory):
-    return Fmu("BoomMechanics", tmp_path_factory)
+controller = _fmu_fixture("PressureFeedbackController")
+boom = _fmu_fixture("HydraulicBoom")
+circuit = _fmu_fixture("HydraulicCircuit")
+mechanics = _fmu_fixture("BoomMechanics")
