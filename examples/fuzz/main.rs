@@ -64,6 +64,7 @@ macro_rules! first_missing {
 }
 
 mod batch;
+mod bookkeeping;
 mod callbacks;
 mod fmi2;
 mod fmi3;

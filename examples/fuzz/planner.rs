@@ -2,35 +2,61 @@
 //! initialisation with values in range, steps of 0.1 to 10 ms, gets, FMU states, termination,
 //! reset; mostly with the rigid boom (`boom.flexible` = false); the probe paths of `probes`,
 //! derivatives in Initialization Mode and, in Co-Simulation, a step that clamps an interpolated
-//! input at its bound followed by an FMU state round trip.
+//! input at its bound followed by an FMU state round trip. `Planner` makes them for either
+//! version (`Planned`: its ops), with the phases of FMI 2.0 here and those of FMI 3.0 in `planner3`.
 
+use crate::bookkeeping::Bookkeeping;
 use crate::fmi2::{LAST_SUCCESSFUL_TIME, TERMINATED};
 use crate::fmu_states::{FmuStates, StateCall};
 use crate::model_description::{Description, Type, Variable};
 use crate::ops::{Arr, Op, Slot, Text};
 use crate::probes::{self, Probe, RoundTrip};
 use crate::rng::Rng;
+use crate::sequence::Call;
 use crate::session::Session;
-use crate::view::Phase;
+use crate::view::{Phase, View};
 use crate::wild::blob;
 use std::collections::VecDeque;
 use std::os::raw::c_int;
 use std::ptr::null_mut;
 
-/// Proposes the next legal call from where the instance is.
-pub struct Planner {
+/// Proposes the next legal call from where the instance is, for either version (`O`, its ops).
+pub struct Planner<O> {
     /// Calls planned ahead, each for the phase it is legal in (dropped when the phase changes).
-    queue: VecDeque<(Phase, Op)>,
-    /// The sequence's usual communication step size.
-    h: f64,
+    pub queue: VecDeque<(Phase, O)>,
+    /// The sequence's usual communication (or integration) step size.
+    pub h: f64,
     /// Set once initialisation failed or the instance broke: plans keep the parameters' start values.
-    tame: bool,
-    round_trip: RoundTrip,
+    pub tame: bool,
+    pub round_trip: RoundTrip,
     /// A state-by-reference probe waits for the states just read.
-    by_reference: bool,
+    pub by_reference: bool,
 }
 
-impl Planner {
+/// A version's ops as the planner makes them.
+pub trait Planned: Call + Sized {
+    const RESET: Self;
+    const TERMINATE: Self;
+    const EXIT_INITIALIZATION_MODE: Self;
+    /// A probe's call.
+    fn probe(p: Probe, m: &Description) -> Self;
+    /// A set of one to three variables of one type from `candidates` (indices), values in range.
+    fn set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Self>;
+    /// A get of the outputs, of a few Reals, or of every Real (`some_reals`).
+    fn get_reals(rng: &mut Rng, m: &Description) -> Self;
+    /// A derivative as `plausible_derivative` draws it (`initialization`: for Initialization Mode).
+    fn derivative(rng: &mut Rng, m: &Description, initialization: bool) -> Self;
+    fn debug_logging(logging_on: bool, categories: Vec<Text>) -> Self;
+    /// `boom.flexible` (`vr`) set to false.
+    fn rigid(vr: u32) -> Self;
+    /// The experiment's setup before the start values, where the version has one and it is not done.
+    fn setup(rng: &mut Rng, view: &View) -> Option<Self>;
+    fn enter_initialization_mode(rng: &mut Rng) -> Self;
+    /// The getters planned in Initialization Mode of a Model Exchange instance.
+    fn initialization_getters(rng: &mut Rng, m: &Description) -> Vec<Self>;
+}
+
+impl<O: Planned> Planner<O> {
     pub fn new(rng: &mut Rng) -> Self {
         Planner {
             queue: VecDeque::new(),
@@ -41,27 +67,121 @@ impl Planner {
         }
     }
 
-    pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
+    /// The call planned for the instance's phase; else, the plan dropped, the round trip's next.
+    pub fn queued(&mut self, s: &Bookkeeping) -> Option<O> {
         if self.queue.front().is_some_and(|(phase, _)| *phase == s.view.phase) {
-            return self.queue.pop_front().expect("a planned call").1;
+            return self.queue.pop_front().map(|(_, op)| op);
         }
         self.queue.clear();
-        if let Some(call) = self.round_trip.next(&s.states) {
-            return Op::State(call);
+        self.round_trip.next(&s.states).map(O::state)
+    }
+
+    /// Instantiated or in Initialization Mode: the first call of the initialisation's plan.
+    pub fn initialization(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
+        self.plan_initialization(rng, s);
+        self.queue.pop_front().map_or(O::RESET, |(_, op)| op)
+    }
+
+    /// Queues setup (FMI 2.0), start values, EnterInitializationMode (FMI 3.0: with the
+    /// experiment), more values and ExitInitializationMode (from where the instance is).
+    /// `boom.flexible` is set to false in most sequences: the flexible boom is slow.
+    fn plan_initialization(&mut self, rng: &mut Rng, s: &Bookkeeping) {
+        let m = s.model;
+        let tame = self.tame;
+        let sets = |rng: &mut Rng| if tame { 0 } else { rng.below(3) };
+        let mut plan = |phase: Phase, op: Option<O>| self.queue.extend(op.map(|op| (phase, op)));
+        if s.view.phase == Phase::Instantiated {
+            if rng.chance(0.2) {
+                let categories =
+                    (0..rng.below(3)).filter_map(|_| rng.choose(&m.categories)).map(|c| Text::new(c)).collect();
+                let logging_on = rng.chance(0.5);
+                plan(Phase::Instantiated, Some(O::debug_logging(logging_on, categories)));
+            }
+            plan(Phase::Instantiated, O::setup(rng, &s.view));
+            if let Some(vr) = m.flexible.filter(|_| rng.chance(0.85)) {
+                plan(Phase::Instantiated, Some(O::rigid(vr)));
+            }
+            for _ in 0..sets(rng) {
+                plan(Phase::Instantiated, O::set(rng, m, &m.init_settable));
+            }
+            plan(Phase::Instantiated, Some(O::enter_initialization_mode(rng)));
+        }
+        for _ in 0..sets(rng) {
+            plan(Phase::Initialization, O::set(rng, m, &m.init_settable));
+        }
+        if rng.chance(0.2) {
+            plan(Phase::Initialization, Some(O::get_reals(rng, m)));
+        }
+        if rng.chance(0.2) {
+            plan(Phase::Initialization, Some(O::derivative(rng, m, true)));
+        }
+        if s.me {
+            for op in O::initialization_getters(rng, m) {
+                plan(Phase::Initialization, Some(op));
+            }
+        }
+        plan(Phase::Initialization, Some(O::EXIT_INITIALIZATION_MODE));
+    }
+
+    /// Queues a probe's calls for `phase` and returns the first (`None` for an empty probe).
+    pub fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<O> {
+        self.queue.extend(probe.into_iter().map(|p| (phase, O::probe(p, m))));
+        self.queue.pop_front().map(|(_, op)| op)
+    }
+
+    /// Between steps, with `room` simulated seconds left: the end of the simulation and gets
+    /// once the budget or the stop time is reached (`Err`), else the step size: mostly the
+    /// sequence's, sometimes another of 0.1 to 10 ms.
+    pub fn step_size(&self, rng: &mut Rng, m: &Description, room: f64) -> Result<f64, O> {
+        if room < 1e-6 {
+            return Err(match rng.below(10) {
+                0..=5 => O::get_reals(rng, m),
+                6..=8 => O::TERMINATE,
+                _ => O::RESET,
+            });
+        }
+        Ok(if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) })
+    }
+
+    /// Model Exchange in Continuous-Time Mode: terminated (or reset) after 1 s, else the next
+    /// call of a probe, if one is drawn.
+    pub fn integration_probe(&mut self, rng: &mut Rng, s: &Bookkeeping) -> Option<O> {
+        if !(s.view.time < 1.0) {
+            return Some(if rng.chance(0.7) { O::TERMINATE } else { O::RESET });
+        }
+        let probe = probes::integrating(
+            rng,
+            s.model,
+            (&s.x, s.x_fresh),
+            (&s.view, self.h),
+            &mut self.by_reference,
+            &mut self.round_trip,
+        );
+        self.probe(Phase::ContinuousTime, probe, s.model)
+    }
+
+    /// The instance broke: from now on, plans keep the start values; a reset.
+    pub fn broken(&mut self) -> O {
+        self.tame = true;
+        O::RESET
+    }
+}
+
+impl Planner<Op> {
+    pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
+        if let Some(op) = self.queued(s) {
+            return op;
         }
         let m = s.model;
         let last_successful_time = Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false };
         match s.view.phase {
-            Phase::Instantiated | Phase::Initialization => {
-                self.plan_initialization(rng, s);
-                self.queue.pop_front().map_or(Op::Reset, |(_, op)| op)
-            }
+            Phase::Instantiated | Phase::Initialization => self.initialization(rng, s),
             Phase::StepComplete => self.stepping(rng, s),
             Phase::EventMode => match rng.below(12) {
                 0..=5 => Op::EnterContinuousTimeMode,
                 6 => Op::NewDiscreteStates { null_info: false },
-                7 => plausible_set(rng, m, &m.step_settable).unwrap_or(Op::EnterContinuousTimeMode),
-                8 => get_reals(rng, m),
+                7 => Op::set(rng, m, &m.step_settable).unwrap_or(Op::EnterContinuousTimeMode),
+                8 => Op::get_reals(rng, m),
                 9 => Op::GetContinuousStates { n: m.states, null: false },
                 10 => state_op(rng, s),
                 _ => Op::Terminate,
@@ -70,71 +190,19 @@ impl Planner {
             Phase::StepFailed => match rng.below(10) {
                 0..=2 => last_successful_time,
                 3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
-                4..=5 => get_reals(rng, m),
+                4..=5 => Op::get_reals(rng, m),
                 6 if !s.states.live.is_empty() => Op::State(StateCall::Set { state: rng.pick(&s.states.live).ptr }),
                 6..=8 => Op::Reset,
                 _ => Op::Terminate,
             },
             Phase::Terminated => match rng.below(4) {
-                0 => get_reals(rng, m),
+                0 => Op::get_reals(rng, m),
                 1 => state_op(rng, s),
                 _ => Op::Reset,
             },
             Phase::Unknown => last_successful_time,
-            Phase::Broken => {
-                self.tame = true;
-                Op::Reset
-            }
+            Phase::Broken => self.broken(),
         }
-    }
-
-    /// Queues setup, start values, fmi2EnterInitializationMode, more values and
-    /// fmi2ExitInitializationMode (from where the instance is). `boom.flexible` is set to false
-    /// in most sequences: the flexible boom is slow.
-    fn plan_initialization(&mut self, rng: &mut Rng, s: &Session) {
-        let m = s.model;
-        let tame = self.tame;
-        let sets = |rng: &mut Rng| if tame { 0 } else { rng.below(3) };
-        let mut plan = |phase: Phase, op: Option<Op>| self.queue.extend(op.map(|op| (phase, op)));
-        if s.view.phase == Phase::Instantiated {
-            if rng.chance(0.2) {
-                let categories =
-                    (0..rng.below(3)).filter_map(|_| rng.choose(&m.categories)).map(|c| Text::new(c)).collect();
-                let logging_on = c_int::from(rng.chance(0.5));
-                plan(Phase::Instantiated, Some(Op::SetDebugLogging { logging_on, categories: Arr::Items(categories) }));
-            }
-            if !s.view.set_up {
-                plan(Phase::Instantiated, Some(plausible_setup(rng)));
-            }
-            if let Some(vr) = m.flexible.filter(|_| rng.chance(0.85)) {
-                let values = Arr::Items(vec![0]);
-                plan(Phase::Instantiated, Some(Op::SetBoolean { vr: Arr::Items(vec![vr]), values }));
-            }
-            for _ in 0..sets(rng) {
-                plan(Phase::Instantiated, plausible_set(rng, m, &m.init_settable));
-            }
-            plan(Phase::Instantiated, Some(Op::EnterInitializationMode));
-        }
-        for _ in 0..sets(rng) {
-            plan(Phase::Initialization, plausible_set(rng, m, &m.init_settable));
-        }
-        if rng.chance(0.2) {
-            plan(Phase::Initialization, Some(get_reals(rng, m)));
-        }
-        if rng.chance(0.2) {
-            plan(Phase::Initialization, Some(directional_derivative(plausible_derivative(rng, m, true))));
-        }
-        if s.me && rng.chance(0.3) {
-            plan(Phase::Initialization, Some(Op::GetDerivatives { n: m.states, null: false }));
-            plan(Phase::Initialization, Some(Op::GetNominalsOfContinuousStates { n: m.states, null: false }));
-        }
-        plan(Phase::Initialization, Some(Op::ExitInitializationMode));
-    }
-
-    /// Queues a probe's calls for `phase` and returns the first (`None` for an empty probe).
-    fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<Op> {
-        self.queue.extend(probe.into_iter().map(|p| (phase, probe_op(p, m))));
-        self.queue.pop_front().map(|(_, op)| op)
     }
 
     /// Co-Simulation: an input near a bound, a slope that drives it across within the step, the
@@ -163,19 +231,15 @@ impl Planner {
     fn stepping(&mut self, rng: &mut Rng, s: &Session) -> Op {
         let m = s.model;
         let room = s.view.room(s.budget());
-        if room < 1e-6 {
-            return match rng.below(10) {
-                0..=5 => get_reals(rng, m),
-                6..=8 => Op::Terminate,
-                _ => Op::Reset,
-            };
-        }
-        let h = if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) };
+        let h = match self.step_size(rng, m, room) {
+            Ok(h) => h,
+            Err(op) => return op,
+        };
         match rng.below(100) {
             0..=44 => Op::DoStep { t: s.view.time, h: h.min(room), no_set_prior: c_int::from(rng.chance(0.9)) },
-            45..=59 => plausible_set(rng, m, &m.step_settable).unwrap_or_else(|| get_reals(rng, m)),
-            60..=64 => plausible_slopes(rng, m).unwrap_or_else(|| get_reals(rng, m)),
-            65..=82 => get_reals(rng, m),
+            45..=59 => Op::set(rng, m, &m.step_settable).unwrap_or_else(|| Op::get_reals(rng, m)),
+            60..=64 => plausible_slopes(rng, m).unwrap_or_else(|| Op::get_reals(rng, m)),
+            65..=82 => Op::get_reals(rng, m),
             83..=84 if rng.chance(0.5) => {
                 Op::GetInteger { vr: Arr::Items(m.of_type(Type::Integer).to_vec()), null_values: false }
             }
@@ -185,38 +249,24 @@ impl Planner {
                 self.round_trip.start();
                 state_op(rng, s)
             }
-            90..=91 => self.clamp(rng, s, h.min(room)).unwrap_or_else(|| get_reals(rng, m)),
+            90..=91 => self.clamp(rng, s, h.min(room)).unwrap_or_else(|| Op::get_reals(rng, m)),
             92..=94 => {
                 let probe = probes::spool(rng, m, &s.view, h.min(room));
                 self.probe(Phase::StepComplete, probe, m).unwrap_or_else(|| state_op(rng, s))
             }
             95..=96 => state_op(rng, s),
-            97 => directional_derivative(plausible_derivative(rng, m, false)),
+            97 => Op::derivative(rng, m, false),
             98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
             _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
         }
     }
-}
 
-impl Planner {
     /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
     /// the sequence's step, states near the last ones read, derivatives, event indicators,
     /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
     fn integrating(&mut self, rng: &mut Rng, s: &Session) -> Op {
         let m = s.model;
-        if !(s.view.time < 1.0) {
-            return if rng.chance(0.7) { Op::Terminate } else { Op::Reset };
-        }
-        let phase = Phase::ContinuousTime;
-        let probe = probes::integrating(
-            rng,
-            m,
-            (&s.x, s.x_fresh),
-            (&s.view, self.h),
-            &mut self.by_reference,
-            &mut self.round_trip,
-        );
-        if let Some(op) = self.probe(phase, probe, m) {
+        if let Some(op) = self.integration_probe(rng, s) {
             return op;
         }
         match rng.below(100) {
@@ -229,12 +279,12 @@ impl Planner {
             35..=59 => Op::GetDerivatives { n: m.states, null: false },
             60..=64 => Op::GetEventIndicators { n: m.event_indicators, null: false },
             65..=69 => Op::CompletedIntegratorStep { no_set_prior: c_int::from(rng.chance(0.9)), null_flags: false },
-            70..=77 => plausible_set(rng, m, &m.real_inputs).unwrap_or_else(|| get_reals(rng, m)),
-            78..=86 => get_reals(rng, m),
+            70..=77 => Op::set(rng, m, &m.real_inputs).unwrap_or_else(|| Op::get_reals(rng, m)),
+            78..=86 => Op::get_reals(rng, m),
             87..=89 => Op::EnterEventMode,
             90..=94 => state_op(rng, s),
             95..=96 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
-            97 => directional_derivative(plausible_derivative(rng, m, false)),
+            97 => Op::derivative(rng, m, false),
             _ => Op::GetContinuousStates { n: m.states, null: false },
         }
     }
@@ -260,30 +310,95 @@ pub fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
     }
 }
 
-fn state_op(rng: &mut Rng, s: &Session) -> Op {
-    Op::State(state_call(rng, &s.states))
+/// An FMU state call of an importer (`state_call`) as the version's op.
+pub fn state_op<O: Call>(rng: &mut Rng, s: &Bookkeeping) -> O {
+    O::state(state_call(rng, &s.states))
 }
 
-/// A probe's call as an FMI 2.0 op.
-fn probe_op(p: Probe, m: &Description) -> Op {
-    match p {
-        Probe::Read(vr) => Op::GetReal { vr: Arr::Items(vr), null_values: false },
-        Probe::Set(vr, values) => Op::SetReal { vr: Arr::Items(vr), values: Arr::Items(values) },
-        Probe::DoStep { t, h } => Op::DoStep { t, h, no_set_prior: 1 },
-        Probe::GetContinuousStates => Op::GetContinuousStates { n: m.states, null: false },
-        Probe::GetEventIndicators => Op::GetEventIndicators { n: m.event_indicators, null: false },
-        Probe::SetTime(t) => Op::SetTime { t },
-        Probe::SetContinuousStates(x) => Op::SetContinuousStates { x: Arr::Items(x) },
+/// FMI 2.0's ops as the planner makes them.
+impl Planned for Op {
+    const RESET: Op = Op::Reset;
+    const TERMINATE: Op = Op::Terminate;
+    const EXIT_INITIALIZATION_MODE: Op = Op::ExitInitializationMode;
+
+    fn probe(p: Probe, m: &Description) -> Op {
+        match p {
+            Probe::Read(vr) => Op::GetReal { vr: Arr::Items(vr), null_values: false },
+            Probe::Set(vr, values) => Op::SetReal { vr: Arr::Items(vr), values: Arr::Items(values) },
+            Probe::DoStep { t, h } => Op::DoStep { t, h, no_set_prior: 1 },
+            Probe::GetContinuousStates => Op::GetContinuousStates { n: m.states, null: false },
+            Probe::GetEventIndicators => Op::GetEventIndicators { n: m.event_indicators, null: false },
+            Probe::SetTime(t) => Op::SetTime { t },
+            Probe::SetContinuousStates(x) => Op::SetContinuousStates { x: Arr::Items(x) },
+        }
     }
-}
 
-/// fmi2GetDirectionalDerivative with these unknowns, knowns and seeds.
-fn directional_derivative((unknowns, knowns, dv_known): (Vec<u32>, Vec<u32>, Vec<f64>)) -> Op {
-    Op::GetDirectionalDerivative {
-        unknowns: Arr::Items(unknowns),
-        knowns: Arr::Items(knowns),
-        dv_known: Arr::Items(dv_known),
-        null_dv_unknown: false,
+    /// fmi2Set<type>.
+    fn set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Op> {
+        let (ty, vr, values) = plausible_values(rng, m, candidates)?;
+        let vr = Arr::Items(vr);
+        let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
+        Some(match ty {
+            Type::Real => Op::SetReal { vr, values: Arr::Items(values.clone()) },
+            Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
+            Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
+            Type::String => {
+                Op::SetString { vr, values: Arr::Items(values.iter().map(|_| Text::new("fuzz")).collect()) }
+            }
+        })
+    }
+
+    fn get_reals(rng: &mut Rng, m: &Description) -> Op {
+        Op::GetReal { vr: Arr::Items(some_reals(rng, m)), null_values: false }
+    }
+
+    /// fmi2GetDirectionalDerivative.
+    fn derivative(rng: &mut Rng, m: &Description, initialization: bool) -> Op {
+        let (unknowns, knowns, dv_known) = plausible_derivative(rng, m, initialization);
+        Op::GetDirectionalDerivative {
+            unknowns: Arr::Items(unknowns),
+            knowns: Arr::Items(knowns),
+            dv_known: Arr::Items(dv_known),
+            null_dv_unknown: false,
+        }
+    }
+
+    fn debug_logging(logging_on: bool, categories: Vec<Text>) -> Op {
+        Op::SetDebugLogging { logging_on: c_int::from(logging_on), categories: Arr::Items(categories) }
+    }
+
+    fn rigid(vr: u32) -> Op {
+        Op::SetBoolean { vr: Arr::Items(vec![vr]), values: Arr::Items(vec![0]) }
+    }
+
+    /// fmi2SetupExperiment as an importer calls it (see `plausible_experiment`).
+    fn setup(rng: &mut Rng, view: &View) -> Option<Op> {
+        if view.set_up {
+            return None;
+        }
+        let e = plausible_experiment(rng);
+        Some(Op::SetupExperiment {
+            tolerance_defined: c_int::from(e.tolerance_defined),
+            tolerance: e.tolerance,
+            start: e.start,
+            stop_defined: c_int::from(e.stop_defined),
+            stop: e.stop,
+        })
+    }
+
+    fn enter_initialization_mode(_: &mut Rng) -> Op {
+        Op::EnterInitializationMode
+    }
+
+    /// Now and then, the derivatives and the nominals of the states.
+    fn initialization_getters(rng: &mut Rng, m: &Description) -> Vec<Op> {
+        if !rng.chance(0.3) {
+            return Vec::new();
+        }
+        vec![
+            Op::GetDerivatives { n: m.states, null: false },
+            Op::GetNominalsOfContinuousStates { n: m.states, null: false },
+        ]
     }
 }
 
@@ -301,19 +416,6 @@ pub fn plausible_derivative(rng: &mut Rng, m: &Description, initialization: bool
     (unknowns, knowns, seeds)
 }
 
-/// fmi2Set of one to three variables of one type from `candidates` (indices), with values in range.
-fn plausible_set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Op> {
-    let (ty, vr, values) = plausible_values(rng, m, candidates)?;
-    let vr = Arr::Items(vr);
-    let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
-    Some(match ty {
-        Type::Real => Op::SetReal { vr, values: Arr::Items(values.clone()) },
-        Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
-        Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
-        Type::String => Op::SetString { vr, values: Arr::Items(values.iter().map(|_| Text::new("fuzz")).collect()) },
-    })
-}
-
 /// One to three variables of one type from `candidates` (indices) with values in range (as
 /// f64: Integer rounded, Boolean 0 or 1; none for String): the type, references and values.
 pub fn plausible_values(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<(Type, Vec<u32>, Vec<f64>)> {
@@ -327,11 +429,6 @@ pub fn plausible_values(rng: &mut Rng, m: &Description, candidates: &[usize]) ->
     }
     let values = vars.iter().map(|v| v.plausible(rng)).collect();
     Some((first.ty, vars.iter().map(|v| v.vr).collect(), values))
-}
-
-/// fmi2GetReal of the outputs, of a few Reals, or of every Real.
-fn get_reals(rng: &mut Rng, m: &Description) -> Op {
-    Op::GetReal { vr: Arr::Items(some_reals(rng, m)), null_values: false }
 }
 
 /// The outputs, a few Reals, or every Real.
@@ -363,18 +460,6 @@ fn plausible_slopes(rng: &mut Rng, m: &Description) -> Option<Op> {
         orders: Arr::Items(vec![1; vars.len()]),
         values: Arr::Items(values),
     })
-}
-
-/// fmi2SetupExperiment as an importer calls it (see `plausible_experiment`).
-fn plausible_setup(rng: &mut Rng) -> Op {
-    let e = plausible_experiment(rng);
-    Op::SetupExperiment {
-        tolerance_defined: c_int::from(e.tolerance_defined),
-        tolerance: e.tolerance,
-        start: e.start,
-        stop_defined: c_int::from(e.stop_defined),
-        stop: e.stop,
-    }
 }
 
 /// The experiment of fmi2SetupExperiment and fmi3EnterInitializationMode.
