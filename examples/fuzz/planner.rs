@@ -17,8 +17,12 @@ use crate::session::Session;
 use crate::view::{Phase, View};
 use crate::wild::blob;
 use std::collections::VecDeque;
+use std::ops::Deref;
 use std::os::raw::c_int;
 use std::ptr::null_mut;
+
+/// fmi2GetRealStatus(fmi2LastSuccessfulTime).
+const LAST_SUCCESSFUL_TIME_STATUS: Op = Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false };
 
 /// Proposes the next legal call from where the instance is, for either version (`O`, its ops).
 pub struct Planner<O> {
@@ -33,11 +37,28 @@ pub struct Planner<O> {
     pub by_reference: bool,
 }
 
+/// The plans of a version's own (`S`: its session, `O`: its ops).
+pub trait Phases<S, O> {
+    /// Between steps (Co-Simulation).
+    fn stepping(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// In Continuous-Time Mode (Model Exchange).
+    fn integrating(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// After a step that failed.
+    fn step_failed(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// Where the fuzzer does not know the instance's phase.
+    fn unknown(&mut self, rng: &mut Rng, s: &S) -> O;
+}
+
 /// A version's ops as the planner makes them.
 pub trait Planned: Call + Sized {
     const RESET: Self;
     const TERMINATE: Self;
     const EXIT_INITIALIZATION_MODE: Self;
+    const ENTER_CONTINUOUS_TIME_MODE: Self;
+    /// fmi2NewDiscreteStates, fmi3UpdateDiscreteStates.
+    const UPDATE_DISCRETE_STATES: Self;
+    /// A get of all the continuous states.
+    fn get_continuous_states(m: &Description) -> Self;
     /// A probe's call.
     fn probe(p: Probe, m: &Description) -> Self;
     /// A set of one to three variables of one type from `candidates` (indices), values in range.
@@ -160,51 +181,45 @@ impl<O: Planned> Planner<O> {
         self.probe(Phase::ContinuousTime, probe, s.model)
     }
 
-    /// The instance broke: from now on, plans keep the start values; a reset.
-    pub fn broken(&mut self) -> O {
-        self.tame = true;
-        O::RESET
-    }
-}
-
-impl Planner<Op> {
-    pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
+    /// The next call: the plan's, else one drawn for the instance's phase.
+    pub fn next<'a, S: Deref<Target = Bookkeeping<'a>>>(&mut self, rng: &mut Rng, s: &S) -> O
+    where
+        Self: Phases<S, O>,
+    {
         if let Some(op) = self.queued(s) {
             return op;
         }
         let m = s.model;
-        let last_successful_time = Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false };
         match s.view.phase {
             Phase::Instantiated | Phase::Initialization => self.initialization(rng, s),
             Phase::StepComplete => self.stepping(rng, s),
             Phase::EventMode => match rng.below(12) {
-                0..=5 => Op::EnterContinuousTimeMode,
-                6 => Op::NewDiscreteStates { null_info: false },
-                7 => Op::set(rng, m, &m.step_settable).unwrap_or(Op::EnterContinuousTimeMode),
-                8 => Op::get_reals(rng, m),
-                9 => Op::GetContinuousStates { n: m.states, null: false },
+                0..=5 => O::ENTER_CONTINUOUS_TIME_MODE,
+                6 => O::UPDATE_DISCRETE_STATES,
+                7 => O::set(rng, m, &m.step_settable).unwrap_or(O::ENTER_CONTINUOUS_TIME_MODE),
+                8 => O::get_reals(rng, m),
+                9 => O::get_continuous_states(m),
                 10 => state_op(rng, s),
-                _ => Op::Terminate,
+                _ => O::TERMINATE,
             },
             Phase::ContinuousTime => self.integrating(rng, s),
-            Phase::StepFailed => match rng.below(10) {
-                0..=2 => last_successful_time,
-                3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
-                4..=5 => Op::get_reals(rng, m),
-                6 if !s.states.live.is_empty() => Op::State(StateCall::Set { state: rng.pick(&s.states.live).ptr }),
-                6..=8 => Op::Reset,
-                _ => Op::Terminate,
-            },
+            Phase::StepFailed => self.step_failed(rng, s),
             Phase::Terminated => match rng.below(4) {
-                0 => Op::get_reals(rng, m),
+                0 => O::get_reals(rng, m),
                 1 => state_op(rng, s),
-                _ => Op::Reset,
+                _ => O::RESET,
             },
-            Phase::Unknown => last_successful_time,
-            Phase::Broken => self.broken(),
+            Phase::Unknown => self.unknown(rng, s),
+            Phase::Broken => {
+                // From now on, plans keep the start values.
+                self.tame = true;
+                O::RESET
+            }
         }
     }
+}
 
+impl Planner<Op> {
     /// Co-Simulation: an input near a bound, a slope that drives it across within the step, the
     /// step (where the FMU clamps the interpolated input), then an FMU state round trip.
     fn clamp(&mut self, rng: &mut Rng, s: &Session, h: f64) -> Option<Op> {
@@ -225,7 +240,9 @@ impl Planner<Op> {
         self.round_trip.start();
         self.queue.pop_front().map(|(_, op)| op)
     }
+}
 
+impl Phases<Session<'_>, Op> for Planner<Op> {
     /// Between steps: mostly steps, input changes and gets, some FMU state handling; once the
     /// budget or the stop time is reached, gets and the end of the simulation.
     fn stepping(&mut self, rng: &mut Rng, s: &Session) -> Op {
@@ -256,7 +273,7 @@ impl Planner<Op> {
             }
             95..=96 => state_op(rng, s),
             97 => Op::derivative(rng, m, false),
-            98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
+            98 => LAST_SUCCESSFUL_TIME_STATUS,
             _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
         }
     }
@@ -287,6 +304,23 @@ impl Planner<Op> {
             97 => Op::derivative(rng, m, false),
             _ => Op::GetContinuousStates { n: m.states, null: false },
         }
+    }
+
+    /// fmi2GetRealStatus(fmi2LastSuccessfulTime), whether it terminated, gets, a restore, the end.
+    fn step_failed(&mut self, rng: &mut Rng, s: &Session) -> Op {
+        match rng.below(10) {
+            0..=2 => LAST_SUCCESSFUL_TIME_STATUS,
+            3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
+            4..=5 => Op::get_reals(rng, s.model),
+            6 if !s.states.live.is_empty() => Op::State(StateCall::Set { state: rng.pick(&s.states.live).ptr }),
+            6..=8 => Op::Reset,
+            _ => Op::Terminate,
+        }
+    }
+
+    /// fmi2GetRealStatus(fmi2LastSuccessfulTime), which tells whether a step was done.
+    fn unknown(&mut self, _: &mut Rng, _: &Session) -> Op {
+        LAST_SUCCESSFUL_TIME_STATUS
     }
 }
 
@@ -320,6 +354,12 @@ impl Planned for Op {
     const RESET: Op = Op::Reset;
     const TERMINATE: Op = Op::Terminate;
     const EXIT_INITIALIZATION_MODE: Op = Op::ExitInitializationMode;
+    const ENTER_CONTINUOUS_TIME_MODE: Op = Op::EnterContinuousTimeMode;
+    const UPDATE_DISCRETE_STATES: Op = Op::NewDiscreteStates { null_info: false };
+
+    fn get_continuous_states(m: &Description) -> Op {
+        Op::GetContinuousStates { n: m.states, null: false }
+    }
 
     fn probe(p: Probe, m: &Description) -> Op {
         match p {

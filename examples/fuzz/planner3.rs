@@ -8,47 +8,27 @@ use crate::model_description::{Description, Type};
 use crate::ops::{Arr, Text};
 use crate::ops3::Op3;
 use crate::planner::{plausible_derivative, plausible_experiment, plausible_values, some_reals, state_op};
-use crate::planner::{Planned, Planner};
+use crate::planner::{Phases, Planned, Planner};
 use crate::probes::{self, Probe};
 use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::fmu_states::StateCall;
 use crate::view::{Phase, View};
 
-impl Planner<Op3> {
-    pub fn next(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
-        if let Some(op) = self.queued(s) {
-            return op;
+impl Phases<Session3<'_>, Op3> for Planner<Op3> {
+    /// Gets, a restored FMU state, a reset, the end.
+    fn step_failed(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
+        match rng.below(10) {
+            0..=3 => Op3::get_reals(rng, s.model),
+            4 => restore(rng, s).unwrap_or(Op3::Reset),
+            5..=7 => Op3::Reset,
+            _ => Op3::Terminate,
         }
-        let m = s.model;
-        let restore = |rng: &mut Rng| rng.choose(&s.states.live).map(|l| Op3::State(StateCall::Set { state: l.ptr }));
-        match s.view.phase {
-            Phase::Instantiated | Phase::Initialization => self.initialization(rng, s),
-            Phase::StepComplete => self.stepping(rng, s),
-            Phase::EventMode => match rng.below(12) {
-                0..=5 => Op3::EnterContinuousTimeMode,
-                6 => Op3::UpdateDiscreteStates { null_flags: false },
-                7 => Op3::set(rng, m, &m.step_settable).unwrap_or(Op3::EnterContinuousTimeMode),
-                8 => Op3::get_reals(rng, m),
-                9 => Op3::GetContinuousStates { n: m.states, null: false },
-                10 => state_op(rng, s),
-                _ => Op3::Terminate,
-            },
-            Phase::ContinuousTime => self.integrating(rng, s),
-            Phase::StepFailed => match rng.below(10) {
-                0..=3 => Op3::get_reals(rng, m),
-                4 => restore(rng).unwrap_or(Op3::Reset),
-                5..=7 => Op3::Reset,
-                _ => Op3::Terminate,
-            },
-            Phase::Terminated => match rng.below(4) {
-                0 => Op3::get_reals(rng, m),
-                1 => state_op(rng, s),
-                _ => Op3::Reset,
-            },
-            Phase::Unknown => restore(rng).filter(|_| rng.chance(0.5)).unwrap_or(Op3::Reset),
-            Phase::Broken => self.broken(),
-        }
+    }
+
+    /// Now and then a restored FMU state, else a reset.
+    fn unknown(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
+        restore(rng, s).filter(|_| rng.chance(0.5)).unwrap_or(Op3::Reset)
     }
 
     /// In Step Mode: mostly steps, input changes and gets, some FMU state handling; once the
@@ -116,11 +96,22 @@ impl Planner<Op3> {
     }
 }
 
+/// fmi3SetFMUState of a live FMU state, if there is one.
+fn restore(rng: &mut Rng, s: &Session3) -> Option<Op3> {
+    rng.choose(&s.states.live).map(|l| Op3::State(StateCall::Set { state: l.ptr }))
+}
+
 /// FMI 3.0's ops as the planner makes them.
 impl Planned for Op3 {
     const RESET: Op3 = Op3::Reset;
     const TERMINATE: Op3 = Op3::Terminate;
     const EXIT_INITIALIZATION_MODE: Op3 = Op3::ExitInitializationMode;
+    const ENTER_CONTINUOUS_TIME_MODE: Op3 = Op3::EnterContinuousTimeMode;
+    const UPDATE_DISCRETE_STATES: Op3 = Op3::UpdateDiscreteStates { null_flags: false };
+
+    fn get_continuous_states(m: &Description) -> Op3 {
+        Op3::GetContinuousStates { n: m.states, null: false }
+    }
 
     fn probe(p: Probe, m: &Description) -> Op3 {
         match p {

@@ -101,6 +101,45 @@ pub trait Driven {
     }
 }
 
+/// Makes a version's session `$session` (its `Bookkeeping` in the field `b`, its own `call`)
+/// `Driven`, with `$op` its ops and `$instantiation` and `$wild` its generators.
+macro_rules! driven {
+    ($session:ident, $op:ident, $instantiation:path, $wild:path) => {
+        impl<'a> std::ops::Deref for $session<'a> {
+            type Target = crate::bookkeeping::Bookkeeping<'a>;
+            fn deref(&self) -> &Self::Target {
+                &self.b
+            }
+        }
+
+        impl std::ops::DerefMut for $session<'_> {
+            fn deref_mut(&mut self) -> &mut Self::Target {
+                &mut self.b
+            }
+        }
+
+        impl crate::sequence::Driven for $session<'_> {
+            type Op = $op;
+            fn instances(&self) -> (*mut std::ffi::c_void, *mut std::ffi::c_void) {
+                (self.c, self.second)
+            }
+            fn instantiation(&self, rng: &mut crate::rng::Rng) -> $op {
+                $op::Instantiate($instantiation(rng, self.model))
+            }
+            fn planned(&self, planner: &mut crate::planner::Planner<$op>, rng: &mut crate::rng::Rng) -> $op {
+                planner.next(rng, self)
+            }
+            fn wild(&self, rng: &mut crate::rng::Rng) -> $op {
+                $wild(rng, self)
+            }
+            fn call(&mut self, op: $op, target: crate::bookkeeping::Target) -> Result<(), String> {
+                $session::call(self, op, target)
+            }
+        }
+    };
+}
+pub(crate) use driven;
+
 /// The calls: instantiation, a mix of planned and wild calls (all wild without an instance, a
 /// few on a NULL instance), the frees.
 fn drive<S: Driven>(s: &mut S, seed: u64) -> Result<(), String> {

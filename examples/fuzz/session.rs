@@ -27,16 +27,13 @@ use crate::fmi2::{
 };
 use crate::fmu_states::{FmuStates, StateOutput};
 use crate::ops::{Arr, Instantiation, Op, Text};
-use crate::planner::Planner;
 use crate::report::Report;
 use crate::required::{self, Derivative};
-use crate::rng::Rng;
-use crate::sequence::Driven;
+use crate::sequence::{driven, Driven};
 use crate::view::{Phase, View};
 use crate::watch::Seen;
 use crate::wild::{instantiation, wild};
 use std::ffi::CStr;
-use std::ops::{Deref, DerefMut};
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};
 
@@ -61,37 +58,7 @@ pub struct Session<'a> {
     callbacks: Vec<Box<CallbackFunctions>>,
 }
 
-impl<'a> Deref for Session<'a> {
-    type Target = Bookkeeping<'a>;
-    fn deref(&self) -> &Bookkeeping<'a> {
-        &self.b
-    }
-}
-
-impl DerefMut for Session<'_> {
-    fn deref_mut(&mut self) -> &mut Self::Target {
-        &mut self.b
-    }
-}
-
-impl Driven for Session<'_> {
-    type Op = Op;
-    fn instances(&self) -> (Component, Component) {
-        (self.c, self.second)
-    }
-    fn instantiation(&self, rng: &mut Rng) -> Op {
-        Op::Instantiate(instantiation(rng, self.model))
-    }
-    fn planned(&self, planner: &mut Planner<Op>, rng: &mut Rng) -> Op {
-        planner.next(rng, self)
-    }
-    fn wild(&self, rng: &mut Rng) -> Op {
-        wild(rng, self)
-    }
-    fn call(&mut self, op: Op, target: Target) -> Result<(), String> {
-        Session::call(self, op, target)
-    }
-}
+driven!(Session, Op, instantiation, wild);
 
 impl<'a> Session<'a> {
     pub fn new(library: &'a Library, report: &'a mut Report) -> Self {

@@ -32,17 +32,14 @@ use crate::machine3::forbidden;
 use crate::model_description::Description;
 use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
-use crate::planner::Planner;
 use crate::report::Report;
 use crate::required::{self, Derivative};
-use crate::rng::Rng;
-use crate::sequence::{Call, Driven};
+use crate::sequence::{driven, Call, Driven};
 use crate::session::out;
 use crate::view::{Phase, View};
 use crate::watch::Seen;
 use crate::wild3::{instantiation3, wild3};
 use std::ffi::CStr;
-use std::ops::{Deref, DerefMut};
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
 
@@ -79,37 +76,7 @@ pub struct Session3<'a> {
     all_logged: bool,
 }
 
-impl<'a> Deref for Session3<'a> {
-    type Target = Bookkeeping<'a>;
-    fn deref(&self) -> &Bookkeeping<'a> {
-        &self.b
-    }
-}
-
-impl DerefMut for Session3<'_> {
-    fn deref_mut(&mut self) -> &mut Self::Target {
-        &mut self.b
-    }
-}
-
-impl Driven for Session3<'_> {
-    type Op = Op3;
-    fn instances(&self) -> (Instance, Instance) {
-        (self.c, self.second)
-    }
-    fn instantiation(&self, rng: &mut Rng) -> Op3 {
-        Op3::Instantiate(instantiation3(rng, self.model))
-    }
-    fn planned(&self, planner: &mut Planner<Op3>, rng: &mut Rng) -> Op3 {
-        planner.next(rng, self)
-    }
-    fn wild(&self, rng: &mut Rng) -> Op3 {
-        wild3(rng, self)
-    }
-    fn call(&mut self, op: Op3, target: Target) -> Result<(), String> {
-        Session3::call(self, op, target)
-    }
-}
+driven!(Session3, Op3, instantiation3, wild3);
 
 impl<'a> Session3<'a> {
     pub fn new(library: &'a Library, report: &'a mut Report) -> Self {
