@@ -57,9 +57,10 @@ pub trait Planned: Call + Sized {
     const ENTER_CONTINUOUS_TIME_MODE: Self;
     /// fmi2NewDiscreteStates, fmi3UpdateDiscreteStates.
     const UPDATE_DISCRETE_STATES: Self;
-    /// A get of all the continuous states.
-    fn get_continuous_states(m: &Description) -> Self;
-    /// A probe's call.
+    /// fmi2GetDerivatives, fmi3GetContinuousStateDerivatives.
+    fn get_derivatives(m: &Description) -> Self;
+    fn completed_integrator_step(no_set_prior: bool) -> Self;
+    /// A probe's call (or one like it).
     fn probe(p: Probe, m: &Description) -> Self;
     /// A set of one to three variables of one type from `candidates` (indices), values in range.
     fn set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Self>;
@@ -164,21 +165,39 @@ impl<O: Planned> Planner<O> {
         Ok(if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) })
     }
 
-    /// Model Exchange in Continuous-Time Mode: terminated (or reset) after 1 s, else the next
-    /// call of a probe, if one is drawn.
-    pub fn integration_probe(&mut self, rng: &mut Rng, s: &Bookkeeping) -> Option<O> {
+    /// Model Exchange in Continuous-Time Mode, as an integrator drives it (`Ok`): terminated (or
+    /// reset) after 1 s, a probe's call, time forward by up to the sequence's step, states near
+    /// the last ones read, derivatives, event indicators, completed steps, continuous inputs;
+    /// else (`Err`) a roll from 78 to 99 for the version's other calls.
+    pub fn integrator(&mut self, rng: &mut Rng, s: &Bookkeeping) -> Result<O, usize> {
+        let m = s.model;
         if !(s.view.time < 1.0) {
-            return Some(if rng.chance(0.7) { O::TERMINATE } else { O::RESET });
+            return Ok(if rng.chance(0.7) { O::TERMINATE } else { O::RESET });
         }
         let probe = probes::integrating(
             rng,
-            s.model,
+            m,
             (&s.x, s.x_fresh),
             (&s.view, self.h),
             &mut self.by_reference,
             &mut self.round_trip,
         );
-        self.probe(Phase::ContinuousTime, probe, s.model)
+        if let Some(op) = self.probe(Phase::ContinuousTime, probe, m) {
+            return Ok(op);
+        }
+        Ok(match rng.below(100) {
+            0..=19 => O::probe(Probe::SetTime(s.view.time + self.h * rng.uniform(0.0, 1.0)), m),
+            20..=34 if s.x.len() == m.states => {
+                let x = s.x.iter().map(|x| x + (1e-6 + 1e-4 * x.abs()) * rng.uniform(-1.0, 1.0)).collect();
+                O::probe(Probe::SetContinuousStates(x), m)
+            }
+            20..=34 => O::probe(Probe::GetContinuousStates, m),
+            35..=59 => O::get_derivatives(m),
+            60..=64 => O::probe(Probe::GetEventIndicators, m),
+            65..=69 => O::completed_integrator_step(rng.chance(0.9)),
+            70..=77 => O::set(rng, m, &m.real_inputs).unwrap_or_else(|| O::get_reals(rng, m)),
+            roll => return Err(roll),
+        })
     }
 
     /// The next call: the plan's, else one drawn for the instance's phase.
@@ -198,7 +217,7 @@ impl<O: Planned> Planner<O> {
                 6 => O::UPDATE_DISCRETE_STATES,
                 7 => O::set(rng, m, &m.step_settable).unwrap_or(O::ENTER_CONTINUOUS_TIME_MODE),
                 8 => O::get_reals(rng, m),
-                9 => O::get_continuous_states(m),
+                9 => O::probe(Probe::GetContinuousStates, m),
                 10 => state_op(rng, s),
                 _ => O::TERMINATE,
             },
@@ -278,31 +297,18 @@ impl Phases<Session<'_>, Op> for Planner<Op> {
         }
     }
 
-    /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
-    /// the sequence's step, states near the last ones read, derivatives, event indicators,
-    /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
+    /// Model Exchange in Continuous-Time Mode: the integrator's calls (`Planner::integrator`),
+    /// gets, an event now and then, FMU states, nominals, a derivative.
     fn integrating(&mut self, rng: &mut Rng, s: &Session) -> Op {
         let m = s.model;
-        if let Some(op) = self.integration_probe(rng, s) {
-            return op;
-        }
-        match rng.below(100) {
-            0..=19 => Op::SetTime { t: s.view.time + self.h * rng.uniform(0.0, 1.0) },
-            20..=34 if s.x.len() == m.states => {
-                let x = s.x.iter().map(|x| x + (1e-6 + 1e-4 * x.abs()) * rng.uniform(-1.0, 1.0)).collect();
-                Op::SetContinuousStates { x: Arr::Items(x) }
-            }
-            20..=34 => Op::GetContinuousStates { n: m.states, null: false },
-            35..=59 => Op::GetDerivatives { n: m.states, null: false },
-            60..=64 => Op::GetEventIndicators { n: m.event_indicators, null: false },
-            65..=69 => Op::CompletedIntegratorStep { no_set_prior: c_int::from(rng.chance(0.9)), null_flags: false },
-            70..=77 => Op::set(rng, m, &m.real_inputs).unwrap_or_else(|| Op::get_reals(rng, m)),
-            78..=86 => Op::get_reals(rng, m),
-            87..=89 => Op::EnterEventMode,
-            90..=94 => state_op(rng, s),
-            95..=96 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
-            97 => Op::derivative(rng, m, false),
-            _ => Op::GetContinuousStates { n: m.states, null: false },
+        match self.integrator(rng, s) {
+            Ok(op) => op,
+            Err(78..=86) => Op::get_reals(rng, m),
+            Err(87..=89) => Op::EnterEventMode,
+            Err(90..=94) => state_op(rng, s),
+            Err(95..=96) => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
+            Err(97) => Op::derivative(rng, m, false),
+            Err(_) => Op::GetContinuousStates { n: m.states, null: false },
         }
     }
 
@@ -357,8 +363,12 @@ impl Planned for Op {
     const ENTER_CONTINUOUS_TIME_MODE: Op = Op::EnterContinuousTimeMode;
     const UPDATE_DISCRETE_STATES: Op = Op::NewDiscreteStates { null_info: false };
 
-    fn get_continuous_states(m: &Description) -> Op {
-        Op::GetContinuousStates { n: m.states, null: false }
+    fn get_derivatives(m: &Description) -> Op {
+        Op::GetDerivatives { n: m.states, null: false }
+    }
+
+    fn completed_integrator_step(no_set_prior: bool) -> Op {
+        Op::CompletedIntegratorStep { no_set_prior: c_int::from(no_set_prior), null_flags: false }
     }
 
     fn probe(p: Probe, m: &Description) -> Op {

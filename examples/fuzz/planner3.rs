@@ -65,33 +65,20 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
         }
     }
 
-    /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
-    /// the sequence's step, states near the last ones read, derivatives, event indicators,
-    /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
+    /// Model Exchange in Continuous-Time Mode: the integrator's calls (`Planner::integrator`),
+    /// gets, an event now and then, FMU states, nominals, the numbers of states and event indicators, derivatives.
     fn integrating(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
         let m = s.model;
-        if let Some(op) = self.integration_probe(rng, s) {
-            return op;
-        }
-        match rng.below(100) {
-            0..=19 => Op3::SetTime { t: s.view.time + self.h * rng.uniform(0.0, 1.0) },
-            20..=34 if s.x.len() == m.states => {
-                let x = s.x.iter().map(|x| x + (1e-6 + 1e-4 * x.abs()) * rng.uniform(-1.0, 1.0)).collect();
-                Op3::SetContinuousStates { x: Arr::Items(x) }
-            }
-            20..=34 => Op3::GetContinuousStates { n: m.states, null: false },
-            35..=59 => Op3::GetContinuousStateDerivatives { n: m.states, null: false },
-            60..=64 => Op3::GetEventIndicators { n: m.event_indicators, null: false },
-            65..=69 => Op3::CompletedIntegratorStep { no_set_prior: rng.chance(0.9), null_flags: false },
-            70..=77 => Op3::set(rng, m, &m.real_inputs).unwrap_or_else(|| Op3::get_reals(rng, m)),
-            78..=84 => Op3::get_reals(rng, m),
-            85..=87 => Op3::EnterEventMode,
-            88..=92 => state_op(rng, s),
-            93 => Op3::GetNominalsOfContinuousStates { n: m.states, null: false },
-            94 => Op3::GetNumberOfContinuousStates { null: false },
-            95 => Op3::GetNumberOfEventIndicators { null: false },
-            96..=97 => Op3::derivative(rng, m, false),
-            _ => Op3::GetContinuousStates { n: m.states, null: false },
+        match self.integrator(rng, s) {
+            Ok(op) => op,
+            Err(78..=84) => Op3::get_reals(rng, m),
+            Err(85..=87) => Op3::EnterEventMode,
+            Err(88..=92) => state_op(rng, s),
+            Err(93) => Op3::GetNominalsOfContinuousStates { n: m.states, null: false },
+            Err(94) => Op3::GetNumberOfContinuousStates { null: false },
+            Err(95) => Op3::GetNumberOfEventIndicators { null: false },
+            Err(96..=97) => Op3::derivative(rng, m, false),
+            Err(_) => Op3::GetContinuousStates { n: m.states, null: false },
         }
     }
 }
@@ -109,8 +96,12 @@ impl Planned for Op3 {
     const ENTER_CONTINUOUS_TIME_MODE: Op3 = Op3::EnterContinuousTimeMode;
     const UPDATE_DISCRETE_STATES: Op3 = Op3::UpdateDiscreteStates { null_flags: false };
 
-    fn get_continuous_states(m: &Description) -> Op3 {
-        Op3::GetContinuousStates { n: m.states, null: false }
+    fn get_derivatives(m: &Description) -> Op3 {
+        Op3::GetContinuousStateDerivatives { n: m.states, null: false }
+    }
+
+    fn completed_integrator_step(no_set_prior: bool) -> Op3 {
+        Op3::CompletedIntegratorStep { no_set_prior, null_flags: false }
     }
 
     fn probe(p: Probe, m: &Description) -> Op3 {
