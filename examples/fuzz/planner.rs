@@ -152,8 +152,8 @@ impl<O: Planned> Planner<O> {
     }
 
     /// Between steps, with `room` simulated seconds left: the end of the simulation and gets
-    /// once the budget or the stop time is reached (`Err`), else the step size: mostly the
-    /// sequence's, sometimes another of 0.1 to 10 ms.
+    /// once the budget or the stop time is reached (`Err`), else the step size, at most `room`:
+    /// mostly the sequence's, sometimes another of 0.1 to 10 ms.
     pub fn step_size(&self, rng: &mut Rng, m: &Description, room: f64) -> Result<f64, O> {
         if room < 1e-6 {
             return Err(match rng.below(10) {
@@ -162,7 +162,19 @@ impl<O: Planned> Planner<O> {
                 _ => O::RESET,
             });
         }
-        Ok(if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) })
+        Ok(if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) }.min(room))
+    }
+
+    /// An FMU state call that starts a round trip.
+    pub fn round_trip(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
+        self.round_trip.start();
+        state_op(rng, s)
+    }
+
+    /// The first call of the spool probe with a step of `h` (`None` for a model without it).
+    pub fn spool(&mut self, rng: &mut Rng, s: &Bookkeeping, h: f64) -> Option<O> {
+        let probe = probes::spool(rng, s.model, &s.view, h);
+        self.probe(Phase::StepComplete, probe, s.model)
     }
 
     /// Model Exchange in Continuous-Time Mode, as an integrator drives it (`Ok`): terminated (or
@@ -266,13 +278,12 @@ impl Phases<Session<'_>, Op> for Planner<Op> {
     /// budget or the stop time is reached, gets and the end of the simulation.
     fn stepping(&mut self, rng: &mut Rng, s: &Session) -> Op {
         let m = s.model;
-        let room = s.view.room(s.budget());
-        let h = match self.step_size(rng, m, room) {
+        let h = match self.step_size(rng, m, s.view.room(s.budget())) {
             Ok(h) => h,
             Err(op) => return op,
         };
         match rng.below(100) {
-            0..=44 => Op::DoStep { t: s.view.time, h: h.min(room), no_set_prior: c_int::from(rng.chance(0.9)) },
+            0..=44 => Op::DoStep { t: s.view.time, h, no_set_prior: c_int::from(rng.chance(0.9)) },
             45..=59 => Op::set(rng, m, &m.step_settable).unwrap_or_else(|| Op::get_reals(rng, m)),
             60..=64 => plausible_slopes(rng, m).unwrap_or_else(|| Op::get_reals(rng, m)),
             65..=82 => Op::get_reals(rng, m),
@@ -281,15 +292,9 @@ impl Phases<Session<'_>, Op> for Planner<Op> {
             }
             83..=84 => Op::GetBoolean { vr: Arr::Items(m.of_type(Type::Boolean).to_vec()), null_values: false },
             85..=88 => state_op(rng, s),
-            89 => {
-                self.round_trip.start();
-                state_op(rng, s)
-            }
-            90..=91 => self.clamp(rng, s, h.min(room)).unwrap_or_else(|| Op::get_reals(rng, m)),
-            92..=94 => {
-                let probe = probes::spool(rng, m, &s.view, h.min(room));
-                self.probe(Phase::StepComplete, probe, m).unwrap_or_else(|| state_op(rng, s))
-            }
+            89 => self.round_trip(rng, s),
+            90..=91 => self.clamp(rng, s, h).unwrap_or_else(|| Op::get_reals(rng, m)),
+            92..=94 => self.spool(rng, s, h).unwrap_or_else(|| state_op(rng, s)),
             95..=96 => state_op(rng, s),
             97 => Op::derivative(rng, m, false),
             98 => LAST_SUCCESSFUL_TIME_STATUS,

@@ -9,11 +9,11 @@ use crate::ops::{Arr, Text};
 use crate::ops3::Op3;
 use crate::planner::{plausible_derivative, plausible_experiment, plausible_values, some_reals, state_op};
 use crate::planner::{Phases, Planned, Planner};
-use crate::probes::{self, Probe};
+use crate::probes::Probe;
 use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::fmu_states::StateCall;
-use crate::view::{Phase, View};
+use crate::view::View;
 
 impl Phases<Session3<'_>, Op3> for Planner<Op3> {
     /// Gets, a restored FMU state, a reset, the end.
@@ -45,7 +45,7 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
             Err(op) => return op,
         };
         match rng.below(100) {
-            0..=44 => Op3::DoStep { t: s.view.time, h: h.min(room), no_set_prior: rng.chance(0.9), null_outputs: false },
+            0..=44 => Op3::DoStep { t: s.view.time, h, no_set_prior: rng.chance(0.9), null_outputs: false },
             45..=62 => Op3::set(rng, m, &m.step_settable).unwrap_or_else(|| Op3::get_reals(rng, m)),
             63..=80 => Op3::get_reals(rng, m),
             81..=84 => {
@@ -53,14 +53,8 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
                 get_all(m, ty)
             }
             85..=89 => state_op(rng, s),
-            90 => {
-                self.round_trip.start();
-                state_op(rng, s)
-            }
-            91..=94 => {
-                let probe = probes::spool(rng, m, &s.view, h.min(room));
-                self.probe(Phase::StepComplete, probe, m).unwrap_or_else(|| Op3::get_reals(rng, m))
-            }
+            90 => self.round_trip(rng, s),
+            91..=94 => self.spool(rng, s, h).unwrap_or_else(|| Op3::get_reals(rng, m)),
             _ => Op3::derivative(rng, m, false),
         }
     }
