@@ -421,11 +421,11 @@ fn same_len<A, B>(a: &Arr<A>, b: &Arr<B>) -> usize {
 }
 
 /// Checks a string a function returned.
-fn expect_text(p: *const c_char, expected: &str, function: &str) -> Result<(), String> {
+pub fn expect_text(p: *const c_char, expected: &str, function: &str) -> Result<(), String> {
     if p.is_null() {
         return Err(format!("{function} returned NULL"));
     }
-    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string (FMI 2.0, 2.1.4).
+    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string (FMI 2.0, 2.1.4; so in FMI 3.0).
     let text = unsafe { CStr::from_ptr(p) };
     if text.to_bytes() != expected.as_bytes() {
         return Err(format!("{function} returned {text:?}, not {expected:?}"));

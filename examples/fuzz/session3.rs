@@ -35,11 +35,10 @@ use crate::ops3::{Instantiation3, Interface3, Op3};
 use crate::report::Report;
 use crate::required::{self, Derivative};
 use crate::sequence::{driven, Call, Driven};
-use crate::session::out;
+use crate::session::{expect_text, out};
 use crate::view::{Phase, View};
 use crate::watch::Seen;
 use crate::wild3::{instantiation3, wild3};
-use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
 
@@ -288,7 +287,7 @@ impl<'a> Session3<'a> {
     fn observe(&mut self, op: Op3, status: Option<Status>, ok: bool, output: Output, errors: u64) -> Result<(), String> {
         let phase = self.view.phase;
         match (op, output) {
-            (Op3::GetVersion, Output::Text(p)) => expect_version(p)?,
+            (Op3::GetVersion, Output::Text(p)) => expect_text(p, "3.0", "fmi3GetVersion")?,
             (Op3::Instantiate(spec), Output::Instance(c)) => self.instantiated(&spec, c, errors)?,
             (Op3::FreeInstance { instance }, _) => self.freed(instance),
             (Op3::DoStep { t, h, .. }, Output::Step(flags, last)) => self.stepped(t, h, status, flags, last)?,
@@ -471,18 +470,6 @@ fn expect_count(n: usize, expected: usize, function: &str, element: &str) -> Res
         return Ok(());
     }
     Err(format!("{function} returned {n}, but the model description has {expected} {element} elements"))
-}
-
-fn expect_version(p: *const c_char) -> Result<(), String> {
-    if p.is_null() {
-        return Err("fmi3GetVersion returned NULL".into());
-    }
-    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string.
-    let text = unsafe { CStr::from_ptr(p) };
-    if text.to_bytes() != b"3.0" {
-        return Err(format!("fmi3GetVersion returned {text:?}, not \"3.0\""));
-    }
-    Ok(())
 }
 
 /// fmi3InstantiateCoSimulation, fmi3InstantiateModelExchange or
