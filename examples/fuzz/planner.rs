@@ -27,14 +27,14 @@ const LAST_SUCCESSFUL_TIME_STATUS: Op = Op::GetRealStatus { kind: LAST_SUCCESSFU
 /// Proposes the next legal call from where the instance is, for either version (`O`, its ops).
 pub struct Planner<O> {
     /// Calls planned ahead, each for the phase it is legal in (dropped when the phase changes).
-    pub queue: VecDeque<(Phase, O)>,
+    queue: VecDeque<(Phase, O)>,
     /// The sequence's usual communication (or integration) step size.
-    pub h: f64,
+    h: f64,
     /// Set once initialisation failed or the instance broke: plans keep the parameters' start values.
-    pub tame: bool,
-    pub round_trip: RoundTrip,
+    tame: bool,
+    round_trip: RoundTrip,
     /// A state-by-reference probe waits for the states just read.
-    pub by_reference: bool,
+    by_reference: bool,
 }
 
 /// The plans of a version's own (`S`: its session, `O`: its ops).
@@ -90,7 +90,7 @@ impl<O: Planned> Planner<O> {
     }
 
     /// The call planned for the instance's phase; else, the plan dropped, the round trip's next.
-    pub fn queued(&mut self, s: &Bookkeeping) -> Option<O> {
+    fn queued(&mut self, s: &Bookkeeping) -> Option<O> {
         if self.queue.front().is_some_and(|(phase, _)| *phase == s.view.phase) {
             return self.queue.pop_front().map(|(_, op)| op);
         }
@@ -99,7 +99,7 @@ impl<O: Planned> Planner<O> {
     }
 
     /// Instantiated or in Initialization Mode: the first call of the initialisation's plan.
-    pub fn initialization(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
+    fn initialization(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
         self.plan_initialization(rng, s);
         self.queue.pop_front().map_or(O::RESET, |(_, op)| op)
     }
@@ -146,7 +146,7 @@ impl<O: Planned> Planner<O> {
     }
 
     /// Queues a probe's calls for `phase` and returns the first (`None` for an empty probe).
-    pub fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<O> {
+    fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<O> {
         self.queue.extend(probe.into_iter().map(|p| (phase, O::probe(p, m))));
         self.queue.pop_front().map(|(_, op)| op)
     }
@@ -166,7 +166,7 @@ impl<O: Planned> Planner<O> {
     }
 
     /// An FMU state call that starts a round trip.
-    pub fn round_trip(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
+    pub fn start_round_trip(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
         self.round_trip.start();
         state_op(rng, s)
     }
@@ -292,7 +292,7 @@ impl Phases<Session<'_>, Op> for Planner<Op> {
             }
             83..=84 => Op::GetBoolean { vr: Arr::Items(m.of_type(Type::Boolean).to_vec()), null_values: false },
             85..=88 => state_op(rng, s),
-            89 => self.round_trip(rng, s),
+            89 => self.start_round_trip(rng, s),
             90..=91 => self.clamp(rng, s, h).unwrap_or_else(|| Op::get_reals(rng, m)),
             92..=94 => self.spool(rng, s, h).unwrap_or_else(|| state_op(rng, s)),
             95..=96 => state_op(rng, s),
@@ -337,7 +337,7 @@ impl Phases<Session<'_>, Op> for Planner<Op> {
 
 /// An FMU state call of an importer: get a new one, overwrite, restore, serialize (size first),
 /// deserialize intact bytes (or, now and then, damaged ones), free.
-pub fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
+fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
     let live = rng.choose(&states.live);
     match (rng.below(8), live) {
         (1, Some(l)) => StateCall::Get { state: Slot::Holding(l.ptr) },

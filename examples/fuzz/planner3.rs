@@ -53,7 +53,7 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
                 get_all(m, ty)
             }
             85..=89 => state_op(rng, s),
-            90 => self.round_trip(rng, s),
+            90 => self.start_round_trip(rng, s),
             91..=94 => self.spool(rng, s, h).unwrap_or_else(|| Op3::get_reals(rng, m)),
             _ => Op3::derivative(rng, m, false),
         }
