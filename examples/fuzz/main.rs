@@ -77,6 +77,7 @@ mod ops;
 mod ops3;
 mod oversized;
 mod planner;
+mod planner2;
 mod planner3;
 mod probes;
 mod refused;

@@ -1,8 +1,9 @@
-//! The FMI 3.0 calls of a well-behaved importer, as `planner` makes FMI 2.0's (the same plans
-//! and value generators): initialisation with values in range, steps of 0.1 to 10 ms or, for
-//! Model Exchange, an integrator's calls, gets, FMU states, termination, reset; mostly with the
-//! rigid boom (`boom.flexible` = false); the probe paths of `probes`, derivatives in
-//! Initialization Mode, and a smaller step retried after fmi3Discard.
+//! The FMI 3.0 calls of a well-behaved importer, as `planner` plans them for either version (the
+//! same plans and value generators): initialisation with values in range, steps of 0.1 to 10 ms
+//! or, for Model Exchange, an integrator's calls, gets, FMU states, termination, reset; mostly
+//! with the rigid boom (`boom.flexible` = false); the probe paths of `probes`, derivatives in
+//! Initialization Mode, and a smaller step retried after fmi3Discard. Here: its ops
+//! (`Planned`) and its own plans (`Phases`).
 
 use crate::model_description::{Description, Type};
 use crate::ops::{Arr, Text};
