@@ -64,6 +64,7 @@ macro_rules! first_missing {
 }
 
 mod batch;
+mod bookkeeping;
 mod callbacks;
 mod fmi2;
 mod fmi3;
@@ -76,6 +77,7 @@ mod ops;
 mod ops3;
 mod oversized;
 mod planner;
+mod planner2;
 mod planner3;
 mod probes;
 mod refused;

@@ -3,6 +3,7 @@
 use crate::callbacks::Callbacks;
 use crate::fmi2::Component;
 use crate::fmu_states::{FmuState, StateCall};
+use crate::sequence::Call;
 use crate::view::View;
 use std::ffi::CString;
 use std::fmt::{self, Debug};
@@ -261,9 +262,14 @@ pub enum Op {
     Oversized(crate::oversized::Oversized),
 }
 
-impl Op {
-    /// Whether the function takes the instance as its first argument.
-    pub fn takes_component(&self) -> bool {
+impl Call for Op {
+    fn takes_instance(&self) -> bool {
         !matches!(self, Op::GetTypesPlatform | Op::GetVersion | Op::Instantiate(_) | Op::FreeInstance { .. })
+    }
+    fn free_instance(instance: Component) -> Op {
+        Op::FreeInstance { instance }
+    }
+    fn state(call: StateCall) -> Op {
+        Op::State(call)
     }
 }

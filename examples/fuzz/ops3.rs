@@ -4,6 +4,7 @@
 use crate::fmu_states::StateCall;
 use crate::ops::{Arr, Text};
 use crate::planner::Experiment;
+use crate::sequence::Call;
 use std::os::raw::c_void;
 
 /// The instantiation functions' arguments; `logger` false passes a NULL logMessage.
@@ -124,11 +125,19 @@ pub enum Op3 {
     Oversized(crate::oversized::Oversized),
 }
 
-impl Op3 {
-    /// Whether the function takes the instance as its first argument.
-    pub fn takes_instance(&self) -> bool {
+impl Call for Op3 {
+    fn takes_instance(&self) -> bool {
         !matches!(self, Op3::GetVersion | Op3::Instantiate(_) | Op3::FreeInstance { .. })
     }
+    fn free_instance(instance: *mut c_void) -> Op3 {
+        Op3::FreeInstance { instance }
+    }
+    fn state(call: StateCall) -> Op3 {
+        Op3::State(call)
+    }
+}
+
+impl Op3 {
 
     /// The call for the trace: the FMI 3.0 name and the arguments.
     pub fn describe(&self) -> String {

@@ -2,26 +2,28 @@
 //! initialisation with values in range, steps of 0.1 to 10 ms, gets, FMU states, termination,
 //! reset; mostly with the rigid boom (`boom.flexible` = false); the probe paths of `probes`,
 //! derivatives in Initialization Mode and, in Co-Simulation, a step that clamps an interpolated
-//! input at its bound followed by an FMU state round trip.
+//! input at its bound followed by an FMU state round trip. `Planner` plans them for either
+//! version: its ops (`Planned`) and its own plans (`Phases`) are in `planner2` and `planner3`;
+//! here are the plans and value generators the versions share.
 
-use crate::fmi2::{LAST_SUCCESSFUL_TIME, TERMINATED};
+use crate::bookkeeping::Bookkeeping;
 use crate::fmu_states::{FmuStates, StateCall};
-use crate::model_description::{Description, Type, Variable};
-use crate::ops::{Arr, Op, Slot, Text};
+use crate::model_description::{Description, Type};
+use crate::ops::{Slot, Text};
 use crate::probes::{self, Probe, RoundTrip};
 use crate::rng::Rng;
-use crate::session::Session;
-use crate::view::Phase;
+use crate::sequence::Call;
+use crate::view::{Phase, View};
 use crate::wild::blob;
 use std::collections::VecDeque;
-use std::os::raw::c_int;
+use std::ops::Deref;
 use std::ptr::null_mut;
 
-/// Proposes the next legal call from where the instance is.
-pub struct Planner {
+/// Proposes the next legal call from where the instance is, for either version (`O`, its ops).
+pub struct Planner<O> {
     /// Calls planned ahead, each for the phase it is legal in (dropped when the phase changes).
-    queue: VecDeque<(Phase, Op)>,
-    /// The sequence's usual communication step size.
+    queue: VecDeque<(Phase, O)>,
+    /// The sequence's usual communication (or integration) step size.
     h: f64,
     /// Set once initialisation failed or the instance broke: plans keep the parameters' start values.
     tame: bool,
@@ -30,7 +32,48 @@ pub struct Planner {
     by_reference: bool,
 }
 
-impl Planner {
+/// The plans of a version's own (`S`: its session, `O`: its ops).
+pub trait Phases<S, O> {
+    /// Between steps (Co-Simulation).
+    fn stepping(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// In Continuous-Time Mode (Model Exchange).
+    fn integrating(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// After a step that failed.
+    fn step_failed(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// Where the fuzzer does not know the instance's phase.
+    fn unknown(&mut self, rng: &mut Rng, s: &S) -> O;
+}
+
+/// A version's ops as the planner makes them.
+pub trait Planned: Call + Sized {
+    const RESET: Self;
+    const TERMINATE: Self;
+    const EXIT_INITIALIZATION_MODE: Self;
+    const ENTER_CONTINUOUS_TIME_MODE: Self;
+    /// fmi2NewDiscreteStates, fmi3UpdateDiscreteStates.
+    const UPDATE_DISCRETE_STATES: Self;
+    /// fmi2GetDerivatives, fmi3GetContinuousStateDerivatives.
+    fn get_derivatives(m: &Description) -> Self;
+    fn completed_integrator_step(no_set_prior: bool) -> Self;
+    /// A probe's call (or one like it).
+    fn probe(p: Probe, m: &Description) -> Self;
+    /// A set of one to three variables of one type from `candidates` (indices), values in range.
+    fn set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Self>;
+    /// A get of the outputs, of a few Reals, or of every Real (`some_reals`).
+    fn get_reals(rng: &mut Rng, m: &Description) -> Self;
+    /// A derivative as `plausible_derivative` draws it (`initialization`: for Initialization Mode).
+    fn derivative(rng: &mut Rng, m: &Description, initialization: bool) -> Self;
+    fn debug_logging(logging_on: bool, categories: Vec<Text>) -> Self;
+    /// `boom.flexible` (`vr`) set to false.
+    fn rigid(vr: u32) -> Self;
+    /// The experiment's setup before the start values, where the version has one and it is not done.
+    fn setup(rng: &mut Rng, view: &View) -> Option<Self>;
+    fn enter_initialization_mode(rng: &mut Rng) -> Self;
+    /// The getters planned in Initialization Mode of a Model Exchange instance.
+    fn initialization_getters(rng: &mut Rng, m: &Description) -> Vec<Self>;
+}
+
+impl<O: Planned> Planner<O> {
     pub fn new(rng: &mut Rng) -> Self {
         Planner {
             queue: VecDeque::new(),
@@ -41,173 +84,110 @@ impl Planner {
         }
     }
 
-    pub fn next(&mut self, rng: &mut Rng, s: &Session) -> Op {
+    /// The call planned for the instance's phase; else, the plan dropped, the round trip's next.
+    fn queued(&mut self, s: &Bookkeeping) -> Option<O> {
         if self.queue.front().is_some_and(|(phase, _)| *phase == s.view.phase) {
-            return self.queue.pop_front().expect("a planned call").1;
+            return self.queue.pop_front().map(|(_, op)| op);
         }
         self.queue.clear();
-        if let Some(call) = self.round_trip.next(&s.states) {
-            return Op::State(call);
-        }
-        let m = s.model;
-        let last_successful_time = Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false };
-        match s.view.phase {
-            Phase::Instantiated | Phase::Initialization => {
-                self.plan_initialization(rng, s);
-                self.queue.pop_front().map_or(Op::Reset, |(_, op)| op)
-            }
-            Phase::StepComplete => self.stepping(rng, s),
-            Phase::EventMode => match rng.below(12) {
-                0..=5 => Op::EnterContinuousTimeMode,
-                6 => Op::NewDiscreteStates { null_info: false },
-                7 => plausible_set(rng, m, &m.step_settable).unwrap_or(Op::EnterContinuousTimeMode),
-                8 => get_reals(rng, m),
-                9 => Op::GetContinuousStates { n: m.states, null: false },
-                10 => state_op(rng, s),
-                _ => Op::Terminate,
-            },
-            Phase::ContinuousTime => self.integrating(rng, s),
-            Phase::StepFailed => match rng.below(10) {
-                0..=2 => last_successful_time,
-                3 => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
-                4..=5 => get_reals(rng, m),
-                6 if !s.states.live.is_empty() => Op::State(StateCall::Set { state: rng.pick(&s.states.live).ptr }),
-                6..=8 => Op::Reset,
-                _ => Op::Terminate,
-            },
-            Phase::Terminated => match rng.below(4) {
-                0 => get_reals(rng, m),
-                1 => state_op(rng, s),
-                _ => Op::Reset,
-            },
-            Phase::Unknown => last_successful_time,
-            Phase::Broken => {
-                self.tame = true;
-                Op::Reset
-            }
-        }
+        self.round_trip.next(&s.states).map(O::state)
     }
 
-    /// Queues setup, start values, fmi2EnterInitializationMode, more values and
-    /// fmi2ExitInitializationMode (from where the instance is). `boom.flexible` is set to false
-    /// in most sequences: the flexible boom is slow.
-    fn plan_initialization(&mut self, rng: &mut Rng, s: &Session) {
+    /// Instantiated or in Initialization Mode: the first call of the initialisation's plan.
+    fn initialization(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
+        self.plan_initialization(rng, s);
+        self.queue.pop_front().map_or(O::RESET, |(_, op)| op)
+    }
+
+    /// Queues setup (FMI 2.0), start values, EnterInitializationMode (FMI 3.0: with the
+    /// experiment), more values and ExitInitializationMode (from where the instance is).
+    /// `boom.flexible` is set to false in most sequences: the flexible boom is slow.
+    fn plan_initialization(&mut self, rng: &mut Rng, s: &Bookkeeping) {
         let m = s.model;
         let tame = self.tame;
         let sets = |rng: &mut Rng| if tame { 0 } else { rng.below(3) };
-        let mut plan = |phase: Phase, op: Option<Op>| self.queue.extend(op.map(|op| (phase, op)));
+        let mut plan = |phase: Phase, op: Option<O>| self.queue.extend(op.map(|op| (phase, op)));
         if s.view.phase == Phase::Instantiated {
             if rng.chance(0.2) {
                 let categories =
                     (0..rng.below(3)).filter_map(|_| rng.choose(&m.categories)).map(|c| Text::new(c)).collect();
-                let logging_on = c_int::from(rng.chance(0.5));
-                plan(Phase::Instantiated, Some(Op::SetDebugLogging { logging_on, categories: Arr::Items(categories) }));
+                let logging_on = rng.chance(0.5);
+                plan(Phase::Instantiated, Some(O::debug_logging(logging_on, categories)));
             }
-            if !s.view.set_up {
-                plan(Phase::Instantiated, Some(plausible_setup(rng)));
-            }
+            plan(Phase::Instantiated, O::setup(rng, &s.view));
             if let Some(vr) = m.flexible.filter(|_| rng.chance(0.85)) {
-                let values = Arr::Items(vec![0]);
-                plan(Phase::Instantiated, Some(Op::SetBoolean { vr: Arr::Items(vec![vr]), values }));
+                plan(Phase::Instantiated, Some(O::rigid(vr)));
             }
             for _ in 0..sets(rng) {
-                plan(Phase::Instantiated, plausible_set(rng, m, &m.init_settable));
+                plan(Phase::Instantiated, O::set(rng, m, &m.init_settable));
             }
-            plan(Phase::Instantiated, Some(Op::EnterInitializationMode));
+            plan(Phase::Instantiated, Some(O::enter_initialization_mode(rng)));
         }
         for _ in 0..sets(rng) {
-            plan(Phase::Initialization, plausible_set(rng, m, &m.init_settable));
+            plan(Phase::Initialization, O::set(rng, m, &m.init_settable));
         }
         if rng.chance(0.2) {
-            plan(Phase::Initialization, Some(get_reals(rng, m)));
+            plan(Phase::Initialization, Some(O::get_reals(rng, m)));
         }
         if rng.chance(0.2) {
-            plan(Phase::Initialization, Some(directional_derivative(plausible_derivative(rng, m, true))));
+            plan(Phase::Initialization, Some(O::derivative(rng, m, true)));
         }
-        if s.me && rng.chance(0.3) {
-            plan(Phase::Initialization, Some(Op::GetDerivatives { n: m.states, null: false }));
-            plan(Phase::Initialization, Some(Op::GetNominalsOfContinuousStates { n: m.states, null: false }));
+        if s.me {
+            for op in O::initialization_getters(rng, m) {
+                plan(Phase::Initialization, Some(op));
+            }
         }
-        plan(Phase::Initialization, Some(Op::ExitInitializationMode));
+        plan(Phase::Initialization, Some(O::EXIT_INITIALIZATION_MODE));
     }
 
     /// Queues a probe's calls for `phase` and returns the first (`None` for an empty probe).
-    fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<Op> {
-        self.queue.extend(probe.into_iter().map(|p| (phase, probe_op(p, m))));
+    fn probe(&mut self, phase: Phase, probe: Vec<Probe>, m: &Description) -> Option<O> {
+        self.queue.extend(probe.into_iter().map(|p| (phase, O::probe(p, m))));
         self.queue.pop_front().map(|(_, op)| op)
     }
 
-    /// Co-Simulation: an input near a bound, a slope that drives it across within the step, the
-    /// step (where the FMU clamps the interpolated input), then an FMU state round trip.
-    fn clamp(&mut self, rng: &mut Rng, s: &Session, h: f64) -> Option<Op> {
-        let m = s.model;
-        let v = &m.variables[*rng.choose(&m.real_inputs)?];
-        if !(v.min.is_finite() && v.max.is_finite() && v.max > v.min) {
-            return None;
+    /// Between steps, with `room` simulated seconds left: the end of the simulation and gets
+    /// once the budget or the stop time is reached (`Err`), else the step size, at most `room`:
+    /// mostly the sequence's, sometimes another of 0.1 to 10 ms.
+    pub fn step_size(&self, rng: &mut Rng, m: &Description, room: f64) -> Result<f64, O> {
+        if room < 1e-6 {
+            return Err(match rng.below(10) {
+                0..=5 => O::get_reals(rng, m),
+                6..=8 => O::TERMINATE,
+                _ => O::RESET,
+            });
         }
-        let (span, up) = (v.max - v.min, rng.chance(0.5));
-        let (start, slope) = if up { (v.max - 0.02 * span, span / h) } else { (v.min + 0.02 * span, -span / h) };
-        let slope = slope * rng.uniform(0.5, 5.0);
-        let vr = Arr::Items(vec![v.vr]);
-        let phase = Phase::StepComplete;
-        self.queue.push_back((phase, Op::SetReal { vr: vr.clone(), values: Arr::Items(vec![start]) }));
-        let slopes = Op::SetRealInputDerivatives { vr, orders: Arr::Items(vec![1]), values: Arr::Items(vec![slope]) };
-        self.queue.push_back((phase, slopes));
-        self.queue.push_back((phase, Op::DoStep { t: s.view.time, h, no_set_prior: 1 }));
+        Ok(if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) }.min(room))
+    }
+
+    /// Queues `ops` for `phase`, an FMU state round trip after them, and returns the first.
+    pub fn plan_with_round_trip(&mut self, phase: Phase, ops: Vec<O>) -> Option<O> {
+        self.queue.extend(ops.into_iter().map(|op| (phase, op)));
         self.round_trip.start();
         self.queue.pop_front().map(|(_, op)| op)
     }
 
-    /// Between steps: mostly steps, input changes and gets, some FMU state handling; once the
-    /// budget or the stop time is reached, gets and the end of the simulation.
-    fn stepping(&mut self, rng: &mut Rng, s: &Session) -> Op {
-        let m = s.model;
-        let room = s.view.room(s.budget());
-        if room < 1e-6 {
-            return match rng.below(10) {
-                0..=5 => get_reals(rng, m),
-                6..=8 => Op::Terminate,
-                _ => Op::Reset,
-            };
-        }
-        let h = if rng.chance(0.8) { self.h } else { rng.log_uniform(1e-4, 1e-2) };
-        match rng.below(100) {
-            0..=44 => Op::DoStep { t: s.view.time, h: h.min(room), no_set_prior: c_int::from(rng.chance(0.9)) },
-            45..=59 => plausible_set(rng, m, &m.step_settable).unwrap_or_else(|| get_reals(rng, m)),
-            60..=64 => plausible_slopes(rng, m).unwrap_or_else(|| get_reals(rng, m)),
-            65..=82 => get_reals(rng, m),
-            83..=84 if rng.chance(0.5) => {
-                Op::GetInteger { vr: Arr::Items(m.of_type(Type::Integer).to_vec()), null_values: false }
-            }
-            83..=84 => Op::GetBoolean { vr: Arr::Items(m.of_type(Type::Boolean).to_vec()), null_values: false },
-            85..=88 => state_op(rng, s),
-            89 => {
-                self.round_trip.start();
-                state_op(rng, s)
-            }
-            90..=91 => self.clamp(rng, s, h.min(room)).unwrap_or_else(|| get_reals(rng, m)),
-            92..=94 => {
-                let probe = probes::spool(rng, m, &s.view, h.min(room));
-                self.probe(Phase::StepComplete, probe, m).unwrap_or_else(|| state_op(rng, s))
-            }
-            95..=96 => state_op(rng, s),
-            97 => directional_derivative(plausible_derivative(rng, m, false)),
-            98 => Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, null_value: false },
-            _ => Op::GetBooleanStatus { kind: TERMINATED, null_value: false },
-        }
+    /// An FMU state call that starts a round trip.
+    pub fn start_round_trip(&mut self, rng: &mut Rng, s: &Bookkeeping) -> O {
+        self.round_trip.start();
+        state_op(rng, s)
     }
-}
 
-impl Planner {
-    /// Model Exchange in Continuous-Time Mode, as an integrator drives it: time forward by up to
-    /// the sequence's step, states near the last ones read, derivatives, event indicators,
-    /// completed steps, continuous inputs, an event now and then; terminated after 1 s.
-    fn integrating(&mut self, rng: &mut Rng, s: &Session) -> Op {
+    /// The first call of the spool probe with a step of `h` (`None` for a model without it).
+    pub fn spool(&mut self, rng: &mut Rng, s: &Bookkeeping, h: f64) -> Option<O> {
+        let probe = probes::spool(rng, s.model, &s.view, h);
+        self.probe(Phase::StepComplete, probe, s.model)
+    }
+
+    /// Model Exchange in Continuous-Time Mode, as an integrator drives it (`Ok`): terminated (or
+    /// reset) after 1 s, a probe's call, time forward by up to the sequence's step, states near
+    /// the last ones read, derivatives, event indicators, completed steps, continuous inputs;
+    /// else (`Err`) a roll from 78 to 99 for the version's other calls.
+    pub fn integrator(&mut self, rng: &mut Rng, s: &Bookkeeping) -> Result<O, usize> {
         let m = s.model;
         if !(s.view.time < 1.0) {
-            return if rng.chance(0.7) { Op::Terminate } else { Op::Reset };
+            return Ok(if rng.chance(0.7) { O::TERMINATE } else { O::RESET });
         }
-        let phase = Phase::ContinuousTime;
         let probe = probes::integrating(
             rng,
             m,
@@ -216,33 +196,65 @@ impl Planner {
             &mut self.by_reference,
             &mut self.round_trip,
         );
-        if let Some(op) = self.probe(phase, probe, m) {
-            return op;
+        if let Some(op) = self.probe(Phase::ContinuousTime, probe, m) {
+            return Ok(op);
         }
-        match rng.below(100) {
-            0..=19 => Op::SetTime { t: s.view.time + self.h * rng.uniform(0.0, 1.0) },
+        Ok(match rng.below(100) {
+            0..=19 => O::probe(Probe::SetTime(s.view.time + self.h * rng.uniform(0.0, 1.0)), m),
             20..=34 if s.x.len() == m.states => {
                 let x = s.x.iter().map(|x| x + (1e-6 + 1e-4 * x.abs()) * rng.uniform(-1.0, 1.0)).collect();
-                Op::SetContinuousStates { x: Arr::Items(x) }
+                O::probe(Probe::SetContinuousStates(x), m)
             }
-            20..=34 => Op::GetContinuousStates { n: m.states, null: false },
-            35..=59 => Op::GetDerivatives { n: m.states, null: false },
-            60..=64 => Op::GetEventIndicators { n: m.event_indicators, null: false },
-            65..=69 => Op::CompletedIntegratorStep { no_set_prior: c_int::from(rng.chance(0.9)), null_flags: false },
-            70..=77 => plausible_set(rng, m, &m.real_inputs).unwrap_or_else(|| get_reals(rng, m)),
-            78..=86 => get_reals(rng, m),
-            87..=89 => Op::EnterEventMode,
-            90..=94 => state_op(rng, s),
-            95..=96 => Op::GetNominalsOfContinuousStates { n: m.states, null: false },
-            97 => directional_derivative(plausible_derivative(rng, m, false)),
-            _ => Op::GetContinuousStates { n: m.states, null: false },
+            20..=34 => O::probe(Probe::GetContinuousStates, m),
+            35..=59 => O::get_derivatives(m),
+            60..=64 => O::probe(Probe::GetEventIndicators, m),
+            65..=69 => O::completed_integrator_step(rng.chance(0.9)),
+            70..=77 => O::set(rng, m, &m.real_inputs).unwrap_or_else(|| O::get_reals(rng, m)),
+            roll => return Err(roll),
+        })
+    }
+
+    /// The next call: the plan's, else one drawn for the instance's phase.
+    pub fn next<'a, S: Deref<Target = Bookkeeping<'a>>>(&mut self, rng: &mut Rng, s: &S) -> O
+    where
+        Self: Phases<S, O>,
+    {
+        if let Some(op) = self.queued(s) {
+            return op;
+        }
+        let m = s.model;
+        match s.view.phase {
+            Phase::Instantiated | Phase::Initialization => self.initialization(rng, s),
+            Phase::StepComplete => self.stepping(rng, s),
+            Phase::EventMode => match rng.below(12) {
+                0..=5 => O::ENTER_CONTINUOUS_TIME_MODE,
+                6 => O::UPDATE_DISCRETE_STATES,
+                7 => O::set(rng, m, &m.step_settable).unwrap_or(O::ENTER_CONTINUOUS_TIME_MODE),
+                8 => O::get_reals(rng, m),
+                9 => O::probe(Probe::GetContinuousStates, m),
+                10 => state_op(rng, s),
+                _ => O::TERMINATE,
+            },
+            Phase::ContinuousTime => self.integrating(rng, s),
+            Phase::StepFailed => self.step_failed(rng, s),
+            Phase::Terminated => match rng.below(4) {
+                0 => O::get_reals(rng, m),
+                1 => state_op(rng, s),
+                _ => O::RESET,
+            },
+            Phase::Unknown => self.unknown(rng, s),
+            Phase::Broken => {
+                // From now on, plans keep the start values.
+                self.tame = true;
+                O::RESET
+            }
         }
     }
 }
 
 /// An FMU state call of an importer: get a new one, overwrite, restore, serialize (size first),
 /// deserialize intact bytes (or, now and then, damaged ones), free.
-pub fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
+fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
     let live = rng.choose(&states.live);
     match (rng.below(8), live) {
         (1, Some(l)) => StateCall::Get { state: Slot::Holding(l.ptr) },
@@ -260,31 +272,9 @@ pub fn state_call(rng: &mut Rng, states: &FmuStates) -> StateCall {
     }
 }
 
-fn state_op(rng: &mut Rng, s: &Session) -> Op {
-    Op::State(state_call(rng, &s.states))
-}
-
-/// A probe's call as an FMI 2.0 op.
-fn probe_op(p: Probe, m: &Description) -> Op {
-    match p {
-        Probe::Read(vr) => Op::GetReal { vr: Arr::Items(vr), null_values: false },
-        Probe::Set(vr, values) => Op::SetReal { vr: Arr::Items(vr), values: Arr::Items(values) },
-        Probe::DoStep { t, h } => Op::DoStep { t, h, no_set_prior: 1 },
-        Probe::GetContinuousStates => Op::GetContinuousStates { n: m.states, null: false },
-        Probe::GetEventIndicators => Op::GetEventIndicators { n: m.event_indicators, null: false },
-        Probe::SetTime(t) => Op::SetTime { t },
-        Probe::SetContinuousStates(x) => Op::SetContinuousStates { x: Arr::Items(x) },
-    }
-}
-
-/// fmi2GetDirectionalDerivative with these unknowns, knowns and seeds.
-fn directional_derivative((unknowns, knowns, dv_known): (Vec<u32>, Vec<u32>, Vec<f64>)) -> Op {
-    Op::GetDirectionalDerivative {
-        unknowns: Arr::Items(unknowns),
-        knowns: Arr::Items(knowns),
-        dv_known: Arr::Items(dv_known),
-        null_dv_unknown: false,
-    }
+/// An FMU state call of an importer (`state_call`) as the version's op.
+pub fn state_op<O: Call>(rng: &mut Rng, s: &Bookkeeping) -> O {
+    O::state(state_call(rng, &s.states))
 }
 
 /// The unknowns, knowns and seeds of a directional derivative, seeds of order one: one to three
@@ -299,19 +289,6 @@ pub fn plausible_derivative(rng: &mut Rng, m: &Description, initialization: bool
     let knowns: Vec<u32> = (0..rng.range(1, 2)).filter_map(|_| rng.choose(known_pool).copied()).collect();
     let seeds = knowns.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
     (unknowns, knowns, seeds)
-}
-
-/// fmi2Set of one to three variables of one type from `candidates` (indices), with values in range.
-fn plausible_set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Op> {
-    let (ty, vr, values) = plausible_values(rng, m, candidates)?;
-    let vr = Arr::Items(vr);
-    let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
-    Some(match ty {
-        Type::Real => Op::SetReal { vr, values: Arr::Items(values.clone()) },
-        Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
-        Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
-        Type::String => Op::SetString { vr, values: Arr::Items(values.iter().map(|_| Text::new("fuzz")).collect()) },
-    })
 }
 
 /// One to three variables of one type from `candidates` (indices) with values in range (as
@@ -329,11 +306,6 @@ pub fn plausible_values(rng: &mut Rng, m: &Description, candidates: &[usize]) ->
     Some((first.ty, vars.iter().map(|v| v.vr).collect(), values))
 }
 
-/// fmi2GetReal of the outputs, of a few Reals, or of every Real.
-fn get_reals(rng: &mut Rng, m: &Description) -> Op {
-    Op::GetReal { vr: Arr::Items(some_reals(rng, m)), null_values: false }
-}
-
 /// The outputs, a few Reals, or every Real.
 pub fn some_reals(rng: &mut Rng, m: &Description) -> Vec<u32> {
     let reals = m.of_type(Type::Real);
@@ -341,39 +313,6 @@ pub fn some_reals(rng: &mut Rng, m: &Description) -> Vec<u32> {
         0..=2 if !m.outputs.is_empty() => m.outputs.clone(),
         0..=6 => (0..rng.range(1, 8)).filter_map(|_| rng.choose(reals).copied()).collect(),
         _ => reals.to_vec(),
-    }
-}
-
-/// First-order derivatives of one or two Real inputs, of a size that keeps them in range for a while.
-fn plausible_slopes(rng: &mut Rng, m: &Description) -> Option<Op> {
-    let vars: Vec<&Variable> =
-        (0..rng.range(1, 2)).filter_map(|_| rng.choose(&m.real_inputs)).map(|&i| &m.variables[i]).collect();
-    if vars.is_empty() {
-        return None;
-    }
-    let values = vars
-        .iter()
-        .map(|v| {
-            let (lo, hi) = v.span();
-            (hi - lo) * rng.uniform(-0.5, 0.5)
-        })
-        .collect();
-    Some(Op::SetRealInputDerivatives {
-        vr: Arr::Items(vars.iter().map(|v| v.vr).collect()),
-        orders: Arr::Items(vec![1; vars.len()]),
-        values: Arr::Items(values),
-    })
-}
-
-/// fmi2SetupExperiment as an importer calls it (see `plausible_experiment`).
-fn plausible_setup(rng: &mut Rng) -> Op {
-    let e = plausible_experiment(rng);
-    Op::SetupExperiment {
-        tolerance_defined: c_int::from(e.tolerance_defined),
-        tolerance: e.tolerance,
-        start: e.start,
-        stop_defined: c_int::from(e.stop_defined),
-        stop: e.stop,
     }
 }
 

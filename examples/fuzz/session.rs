@@ -19,37 +19,23 @@
 //!
 //! Crashes and hangs are caught by `batch`.
 
+use crate::bookkeeping::{Bookkeeping, Target};
 use crate::callbacks::LOG;
 use crate::fmi2::{
     CallbackFunctions, Component, EventInfo, Fmi2, Library, Status, ERROR, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, OK,
     WARNING,
 };
-use crate::fmu_states::{FmuStates, StateCall, StateOutput};
-use crate::model_description::Description;
-use crate::ops::{Arr, Instantiation, Op, Slot, Text};
-use crate::planner::Planner;
+use crate::fmu_states::{FmuStates, StateOutput};
+use crate::ops::{Arr, Instantiation, Op, Text};
 use crate::report::Report;
 use crate::required::{self, Derivative};
-use crate::rng::Rng;
-use crate::sequence::Driven;
+use crate::sequence::{driven, Driven};
 use crate::view::{Phase, View};
-use crate::watch::{Seen, Watch};
+use crate::watch::Seen;
 use crate::wild::{instantiation, wild};
 use std::ffi::CStr;
 use std::os::raw::{c_char, c_int};
 use std::ptr::{null, null_mut};
-
-/// Simulated seconds per sequence at most (the flexible boom runs about 30 times real time).
-const SIMULATION_BUDGET: f64 = 0.5;
-
-/// The instance a call goes to: the sequence's, NULL, or a second one from a wild
-/// fmi2Instantiate, kept until the end of the sequence (its FMU states are foreign to the main one).
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Target {
-    Main,
-    Null,
-    Second,
-}
 
 /// What a call wrote, for the oracle and the bookkeeping.
 enum Output {
@@ -65,89 +51,24 @@ enum Output {
 /// One sequence's instance with the fuzzer's bookkeeping.
 pub struct Session<'a> {
     fmi: &'a Fmi2,
-    pub model: &'a Description,
-    report: &'a mut Report,
-    pub c: Component,
-    /// The `Target::Second` instance, or NULL.
-    pub second: Component,
-    /// The main fmi2Instantiate has been called.
-    opened: bool,
-    /// The main instance is a Model Exchange one.
-    pub me: bool,
-    /// The main instance has a logger.
-    logger: bool,
-    /// The continuous states fmi2GetContinuousStates last returned (Model Exchange).
-    pub x: Vec<f64>,
-    /// `x` was read by the last call to the main instance.
-    pub x_fresh: bool,
+    b: Bookkeeping<'a>,
     /// Callback structures of the instances, alive until the end of the sequence; boxed, since
     /// an FMU may keep the pointer and a Vec moves its elements.
     #[allow(clippy::vec_box)]
     callbacks: Vec<Box<CallbackFunctions>>,
-    pub view: View,
-    pub states: FmuStates,
-    watch: Watch,
-    /// Simulated time so far (an upper bound).
-    simulated: f64,
 }
 
-impl Driven for Session<'_> {
-    type Op = Op;
-    type Planner = Planner;
-    fn instances(&self) -> (Component, Component) {
-        (self.c, self.second)
-    }
-    fn instantiation(&self, rng: &mut Rng) -> Op {
-        Op::Instantiate(instantiation(rng, self.model))
-    }
-    fn planner(rng: &mut Rng) -> Planner {
-        Planner::new(rng)
-    }
-    fn planned(&self, planner: &mut Planner, rng: &mut Rng) -> Op {
-        planner.next(rng, self)
-    }
-    fn wild(&self, rng: &mut Rng) -> Op {
-        wild(rng, self)
-    }
-    fn takes_instance(op: &Op) -> bool {
-        op.takes_component()
-    }
-    fn free_instance(instance: Component) -> Op {
-        Op::FreeInstance { instance }
-    }
-    fn call(&mut self, op: Op, target: Target) -> Result<(), String> {
-        Session::call(self, op, target)
-    }
-}
+driven!(Session, Op, instantiation, wild);
 
 impl<'a> Session<'a> {
     pub fn new(library: &'a Library, report: &'a mut Report) -> Self {
-        Session {
-            fmi: &library.fmi,
-            model: &library.model,
-            report,
-            c: null_mut(),
-            second: null_mut(),
-            opened: false,
-            me: false,
-            logger: false,
-            x: Vec::new(),
-            x_fresh: false,
-            callbacks: Vec::new(),
-            view: View::fresh(),
-            states: FmuStates::default(),
-            watch: Watch::default(),
-            simulated: 0.0,
-        }
+        let b = Bookkeeping::new(&library.model, report, FmuStates::default());
+        Session { fmi: &library.fmi, b, callbacks: Vec::new() }
     }
 
     /// Makes one call and checks the oracle.
     pub fn call(&mut self, op: Op, target: Target) -> Result<(), String> {
-        let (c, on) = match target {
-            Target::Main => (self.c, ""),
-            Target::Null => (null_mut(), " on a NULL instance"),
-            Target::Second => (self.second, " on the second instance"),
-        };
+        let (c, on) = self.instance(target);
         match &op {
             Op::State(call) => self.report.begin(format_args!("{}{on}", call.describe(false))),
             Op::Oversized(o) => self.report.begin(format_args!("{}{on}", o.describe(false))),
@@ -171,8 +92,7 @@ impl<'a> Session<'a> {
         let ok = matches!(status, Some(OK | WARNING));
         if target == Target::Main && !c.is_null() {
             self.check_required(&op, status, ok)?;
-            self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
-            self.x_fresh = false;
+            self.see(if ok { seen(&op, &output) } else { Seen::Other })?;
         }
         match (target, output) {
             (Target::Main, output) => self.observe(op, status, ok, output),
@@ -370,17 +290,10 @@ impl<'a> Session<'a> {
                     self.report.me = self.me;
                     self.logger = spec.callbacks.is_some_and(|c| c.logger);
                 }
-                self.instantiated(c)?
+                let adopt = self.adopt(c);
+                self.adopted(c, adopt)?
             }
-            (Op::FreeInstance { instance }, _) if instance == self.c => {
-                self.c = null_mut();
-                self.states.live.clear();
-                self.states.stale.clear();
-            }
-            (Op::FreeInstance { instance }, _) if instance == self.second => {
-                self.second = null_mut();
-                self.states.foreign.clear();
-            }
+            (Op::FreeInstance { instance }, _) => self.freed(instance),
             (
                 Op::SetReal { vr, .. }
                 | Op::SetInteger { vr, .. }
@@ -420,7 +333,9 @@ impl<'a> Session<'a> {
             (Op::GetString { .. }, Output::Strings(p)) if ok && p.iter().any(|s| s.is_null()) => {
                 return Err("fmi2GetString returned fmi2OK with a NULL string".into());
             }
-            (Op::State(call), Output::Stateful(output)) if ok => self.states.observe(call, output, &mut self.view)?,
+            (Op::State(call), Output::Stateful(output)) if ok => {
+                self.b.states.observe(call, output, &mut self.b.view)?
+            }
             (Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, .. }, Output::Real(t)) if ok => {
                 self.view.synchronised(t)?
             }
@@ -433,22 +348,6 @@ impl<'a> Session<'a> {
         Ok(())
     }
 
-    /// The main instance; else the second one, with an FMU state of it; else one to free right away.
-    fn instantiated(&mut self, c: Component) -> Result<(), String> {
-        if !self.opened {
-            self.opened = true;
-            self.c = c;
-            Ok(())
-        } else if c.is_null() {
-            Ok(())
-        } else if self.second.is_null() {
-            self.second = c;
-            self.call(Op::State(StateCall::Get { state: Slot::Holding(null_mut()) }), Target::Second)
-        } else {
-            self.call(Op::FreeInstance { instance: c }, Target::Main)
-        }
-    }
-
     /// fmi2GetReal said fmi2OK or fmi2Warning: every value must be finite.
     fn check_reals(&self, vr: &Arr<u32>, values: &[f64]) -> Result<(), String> {
         let Some(i) = values.iter().position(|x| !x.is_finite()) else { return Ok(()) };
@@ -459,11 +358,6 @@ impl<'a> Session<'a> {
             Arr::Null(_) => "a value for a NULL vr array".into(),
         };
         Err(format!("fmi2GetReal returned fmi2OK or fmi2Warning, but {name} = {}", values[i]))
-    }
-
-    /// Simulated seconds left for the sequence.
-    pub fn budget(&self) -> f64 {
-        SIMULATION_BUDGET - self.simulated
     }
 }
 
@@ -527,11 +421,11 @@ fn same_len<A, B>(a: &Arr<A>, b: &Arr<B>) -> usize {
 }
 
 /// Checks a string a function returned.
-fn expect_text(p: *const c_char, expected: &str, function: &str) -> Result<(), String> {
+pub fn expect_text(p: *const c_char, expected: &str, function: &str) -> Result<(), String> {
     if p.is_null() {
         return Err(format!("{function} returned NULL"));
     }
-    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string (FMI 2.0, 2.1.4).
+    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string (FMI 2.0, 2.1.4; so in FMI 3.0).
     let text = unsafe { CStr::from_ptr(p) };
     if text.to_bytes() != expected.as_bytes() {
         return Err(format!("{function} returned {text:?}, not {expected:?}"));

@@ -24,23 +24,21 @@
 //!
 //! Crashes and hangs are caught by `batch`, leaks by `sequence`.
 
+use crate::bookkeeping::{Bookkeeping, Target};
 use crate::callbacks::{environment, last_error_says, log_message, LOG};
 use crate::fmi3::{Fmi3, Instance, Library, Status};
-use crate::fmu_states::{FmuStates, StateCall, StateOutput};
+use crate::fmu_states::{FmuStates, StateOutput};
 use crate::machine3::forbidden;
 use crate::model_description::Description;
-use crate::ops::{Arr, Slot, Text};
+use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
-use crate::planner3::Planner3;
 use crate::report::Report;
 use crate::required::{self, Derivative};
-use crate::rng::Rng;
-use crate::sequence::Driven;
-use crate::session::{out, Target};
+use crate::sequence::{driven, Call, Driven};
+use crate::session::{expect_text, out};
 use crate::view::{Phase, View};
-use crate::watch::{Seen, Watch};
+use crate::watch::Seen;
 use crate::wild3::{instantiation3, wild3};
-use std::ffi::CStr;
 use std::os::raw::c_char;
 use std::ptr::{null, null_mut};
 
@@ -48,9 +46,6 @@ const OK: Status = 0;
 const WARNING: Status = 1;
 const DISCARD: Status = 2;
 const ERROR: Status = 3;
-
-/// Simulated seconds per sequence at most (as for FMI 2.0).
-const SIMULATION_BUDGET: f64 = 0.5;
 
 /// What a call wrote.
 enum Output {
@@ -72,94 +67,25 @@ enum Output {
 /// One FMI 3.0 sequence's instance with the fuzzer's bookkeeping.
 pub struct Session3<'a> {
     fmi: &'a Fmi3,
-    pub model: &'a Description,
-    report: &'a mut Report,
-    pub c: Instance,
-    /// The `Target::Second` instance, or NULL.
-    pub second: Instance,
-    opened: bool,
-    /// The main instance is a Model Exchange one.
-    pub me: bool,
-    /// The continuous states fmi3GetContinuousStates last returned.
-    pub x: Vec<f64>,
-    /// `x` was read by the last call to the main instance.
-    pub x_fresh: bool,
-    pub view: View,
-    pub states: FmuStates,
-    watch: Watch,
-    simulated: f64,
+    b: Bookkeeping<'a>,
     /// The step size of the fmi3DoStep that returned fmi3Discard just before (at `view.time`).
     pub discarded: Option<f64>,
-    /// The main instance has a logMessage; discards are delivered (logStatusDiscard, logAll).
-    logger: bool,
+    /// Discards are delivered to the main instance's logMessage (logStatusDiscard, logAll).
     discards_logged: bool,
     all_logged: bool,
 }
 
-impl Driven for Session3<'_> {
-    type Op = Op3;
-    type Planner = Planner3;
-    fn instances(&self) -> (Instance, Instance) {
-        (self.c, self.second)
-    }
-    fn instantiation(&self, rng: &mut Rng) -> Op3 {
-        Op3::Instantiate(instantiation3(rng, self.model))
-    }
-    fn planner(rng: &mut Rng) -> Planner3 {
-        Planner3::new(rng)
-    }
-    fn planned(&self, planner: &mut Planner3, rng: &mut Rng) -> Op3 {
-        planner.next(rng, self)
-    }
-    fn wild(&self, rng: &mut Rng) -> Op3 {
-        wild3(rng, self)
-    }
-    fn takes_instance(op: &Op3) -> bool {
-        op.takes_instance()
-    }
-    fn free_instance(instance: Instance) -> Op3 {
-        Op3::FreeInstance { instance }
-    }
-    fn call(&mut self, op: Op3, target: Target) -> Result<(), String> {
-        Session3::call(self, op, target)
-    }
-}
+driven!(Session3, Op3, instantiation3, wild3);
 
 impl<'a> Session3<'a> {
     pub fn new(library: &'a Library, report: &'a mut Report) -> Self {
-        Session3 {
-            fmi: &library.fmi,
-            model: &library.model,
-            report,
-            c: null_mut(),
-            second: null_mut(),
-            opened: false,
-            me: false,
-            x: Vec::new(),
-            x_fresh: false,
-            view: View::fresh(),
-            states: FmuStates { fmi3: true, ..FmuStates::default() },
-            watch: Watch::default(),
-            simulated: 0.0,
-            discarded: None,
-            logger: false,
-            discards_logged: true,
-            all_logged: false,
-        }
-    }
-
-    /// Simulated seconds left for the sequence.
-    pub fn budget(&self) -> f64 {
-        SIMULATION_BUDGET - self.simulated
+        let b = Bookkeeping::new(&library.model, report, FmuStates { fmi3: true, ..FmuStates::default() });
+        Session3 { fmi: &library.fmi, b, discarded: None, discards_logged: true, all_logged: false }
     }
 
     /// Makes one call and checks the oracle.
     pub fn call(&mut self, op: Op3, target: Target) -> Result<(), String> {
-        let (c, on) = match target {
-            Target::Main => (self.c, ""),
-            Target::Null => (null_mut(), " on a NULL instance"),
-            Target::Second => (self.second, " on the second instance"),
-        };
+        let (c, on) = self.instance(target);
         self.report.begin(format_args!("{}{on}", op.describe()));
         let before = LOG.with(|sink| (sink.borrow().errors, sink.borrow().discards));
         // SAFETY: every pointer passed is NULL or points to as many elements as announced,
@@ -184,8 +110,7 @@ impl<'a> Session3<'a> {
         if live {
             self.check_status(&op, status, (errors, discards))?;
             self.check_required(&op, status, ok)?;
-            self.watch.see(if ok { seen(&op, &output) } else { Seen::Other }, self.model)?;
-            self.x_fresh = false;
+            self.see(if ok { seen(&op, &output) } else { Seen::Other })?;
         }
         if !matches!(op, Op3::DoStep { .. }) {
             self.discarded = None;
@@ -362,17 +287,9 @@ impl<'a> Session3<'a> {
     fn observe(&mut self, op: Op3, status: Option<Status>, ok: bool, output: Output, errors: u64) -> Result<(), String> {
         let phase = self.view.phase;
         match (op, output) {
-            (Op3::GetVersion, Output::Text(p)) => expect_version(p)?,
+            (Op3::GetVersion, Output::Text(p)) => expect_text(p, "3.0", "fmi3GetVersion")?,
             (Op3::Instantiate(spec), Output::Instance(c)) => self.instantiated(&spec, c, errors)?,
-            (Op3::FreeInstance { instance }, _) if instance == self.c => {
-                self.c = null_mut();
-                self.states.live.clear();
-                self.states.stale.clear();
-            }
-            (Op3::FreeInstance { instance }, _) if instance == self.second => {
-                self.second = null_mut();
-                self.states.foreign.clear();
-            }
+            (Op3::FreeInstance { instance }, _) => self.freed(instance),
             (Op3::DoStep { t, h, .. }, Output::Step(flags, last)) => self.stepped(t, h, status, flags, last)?,
             (Op3::ExitInitializationMode, _) if status == Some(ERROR) && phase == Phase::Initialization => {
                 self.view.phase = Phase::Broken
@@ -397,7 +314,7 @@ impl<'a> Session3<'a> {
             (Op3::Terminate, _) => self.view.phase = Phase::Terminated,
             (Op3::Reset, _) => self.view = View::fresh(),
             (Op3::SetTime { t }, _) => self.view.time = t,
-            (Op3::State(call), Output::Stateful(output)) => self.states.observe(call, output, &mut self.view)?,
+            (Op3::State(call), Output::Stateful(output)) => self.b.states.observe(call, output, &mut self.b.view)?,
             (Op3::GetFloat64 { vr, .. }, Output::Reals(v)) => finite_values(self.model, &vr, &v)?,
             (Op3::GetContinuousStates { .. }, Output::Reals(v)) => {
                 finite(&v, "fmi3GetContinuousStates")?;
@@ -443,20 +360,12 @@ impl<'a> Session3<'a> {
             _ => {}
         }
         if !self.opened {
-            self.opened = true;
-            self.c = c;
             self.me = spec.interface == Interface3::ModelExchange;
             self.report.me = self.me;
             (self.logger, self.all_logged) = (spec.logger, spec.logging_on);
-            Ok(())
-        } else if c.is_null() {
-            Ok(())
-        } else if self.second.is_null() {
-            self.second = c;
-            self.call(Op3::State(StateCall::Get { state: Slot::Holding(null_mut()) }), Target::Second)
-        } else {
-            self.call(Op3::FreeInstance { instance: c }, Target::Main)
         }
+        let adopt = self.adopt(c);
+        self.adopted(c, adopt)
     }
 
     /// fmi3SetDebugLogging succeeded: which of the categories that deliver discards are on.
@@ -561,18 +470,6 @@ fn expect_count(n: usize, expected: usize, function: &str, element: &str) -> Res
         return Ok(());
     }
     Err(format!("{function} returned {n}, but the model description has {expected} {element} elements"))
-}
-
-fn expect_version(p: *const c_char) -> Result<(), String> {
-    if p.is_null() {
-        return Err("fmi3GetVersion returned NULL".into());
-    }
-    // SAFETY: a non-NULL pointer from the FMU to a NUL-terminated string.
-    let text = unsafe { CStr::from_ptr(p) };
-    if text.to_bytes() != b"3.0" {
-        return Err(format!("fmi3GetVersion returned {text:?}, not \"3.0\""));
-    }
-    Ok(())
 }
 
 /// fmi3InstantiateCoSimulation, fmi3InstantiateModelExchange or

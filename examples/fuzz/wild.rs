@@ -76,8 +76,7 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
         24 => {
             let vr = vrs(rng, m, real);
             let orders = array(rng, vr.len(), |r| *r.pick(&[1, 1, 1, 0, 2, -1, c_int::MAX]));
-            let values = variables_of(m, &vr).into_iter().map(|v| wild_real(rng, v)).collect();
-            Op::SetRealInputDerivatives { values: maybe_null(rng, values), orders, vr }
+            Op::SetRealInputDerivatives { values: wild_values(rng, &variables_of(m, &vr), wild_real), orders, vr }
         }
         25 => {
             let vr = vrs(rng, m, real);
@@ -231,6 +230,17 @@ pub fn array<T>(rng: &mut Rng, n: usize, mut item: impl FnMut(&mut Rng) -> T) ->
     maybe_null(rng, items)
 }
 
+/// Values for `vars`, each drawn by `value` (which knows its variable, if any), or NULL for them
+/// now and then.
+pub fn wild_values<T>(
+    rng: &mut Rng,
+    vars: &[Option<&Variable>],
+    value: fn(&mut Rng, Option<&Variable>) -> T,
+) -> Arr<T> {
+    let items = vars.iter().map(|&v| value(rng, v)).collect();
+    maybe_null(rng, items)
+}
+
 /// A value reference for a function on type `ty`: mostly of that type, else of another type,
 /// one past the largest, or any number.
 pub fn any_vr(rng: &mut Rng, m: &Description, ty: Type) -> u32 {
@@ -267,14 +277,8 @@ fn wild_set(rng: &mut Rng, m: &Description, ty: Type) -> Op {
     let vr = vrs(rng, m, ty);
     let vars = variables_of(m, &vr);
     match ty {
-        Type::Real => {
-            let values = vars.into_iter().map(|v| wild_real(rng, v)).collect();
-            Op::SetReal { values: maybe_null(rng, values), vr }
-        }
-        Type::Integer => {
-            let values = vars.into_iter().map(|v| wild_integer(rng, v)).collect();
-            Op::SetInteger { values: maybe_null(rng, values), vr }
-        }
+        Type::Real => Op::SetReal { values: wild_values(rng, &vars, wild_real), vr },
+        Type::Integer => Op::SetInteger { values: wild_values(rng, &vars, wild_integer), vr },
         Type::Boolean => Op::SetBoolean { values: array(rng, vars.len(), wild_boolean), vr },
         Type::String => Op::SetString { values: array(rng, vars.len(), |r| wild_text(r, m)), vr },
     }

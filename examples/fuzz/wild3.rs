@@ -14,7 +14,7 @@ use crate::rng::Rng;
 use crate::session3::Session3;
 use crate::wild::{
     any_vr, array, bad_guid, categories, maybe_null, variables_of, vrs, wild_count, wild_experiment, wild_integer,
-    wild_real, wild_state_call, wild_states, wild_step, wild_text, INSTANCE_NAMES, ME_SHARE,
+    wild_real, wild_state_call, wild_states, wild_step, wild_text, wild_values, INSTANCE_NAMES, ME_SHARE,
 };
 
 /// Any of the functions with any arguments (fmi3FreeInstance through a second instance).
@@ -99,14 +99,8 @@ fn wild_set3(rng: &mut Rng, m: &Description) -> Op3 {
     let mut vars: Vec<Option<&Variable>> = variables_of(m, &vr);
     vars.resize(n, None);
     match ty {
-        Type::Real => {
-            let values = vars.into_iter().map(|v| wild_real(rng, v)).collect();
-            Op3::SetFloat64 { values: maybe_null(rng, values), vr }
-        }
-        Type::Integer => {
-            let values = vars.into_iter().map(|v| wild_integer(rng, v)).collect();
-            Op3::SetInt32 { values: maybe_null(rng, values), vr }
-        }
+        Type::Real => Op3::SetFloat64 { values: wild_values(rng, &vars, wild_real), vr },
+        Type::Integer => Op3::SetInt32 { values: wild_values(rng, &vars, wild_integer), vr },
         Type::Boolean => Op3::SetBoolean { values: array(rng, n, |r| *r.pick(&[0, 1, 0, 1, 2, 255])), vr },
         Type::String => Op3::SetString { values: array(rng, n, |r| wild_text(r, m)), vr },
     }
