@@ -285,24 +285,34 @@ impl Model for Faulty {
     fn derivatives(&self, _: &Values, _: &mut [f64]) {}
 }
 
+/// A Faulty instance in failure `mode` whose first step, from 0 to `h`, returns fmi2OK and whose
+/// second, from `h` to 2 `h`, returns `status`.
+fn failed(name: &str, mode: f64, h: f64, status: fmi2Status) -> Slave<Faulty> {
+    let s = Slave::<Faulty>::initialized(name, &[(0, mode)]);
+    assert_eq!(s.step(0.0, h), OK);
+    assert_eq!(s.step(h, h), status);
+    s
+}
+
+/// After a failed step to t = 1: the Error state allows no step; fmi2Reset recovers.
+fn reset_from_error(s: &Slave<Faulty>) {
+    assert_eq!(s.step(1.0, 0.5), ERR, "the Error state allows no step");
+    assert_eq!(unsafe { api::reset::<Faulty>(s.c) }, OK);
+}
+
 /// Principle 4: a panic becomes fmi2Error with a message and the Error state; fmi2Reset recovers.
 #[test]
 fn a_panic_is_caught_at_the_boundary() {
-    let s = Slave::<Faulty>::initialized("panic", &[(0, 1.0)]);
-    assert_eq!(s.step(0.0, 0.5), OK);
-    assert_eq!(s.step(0.5, 0.5), ERR);
+    let s = failed("panic", 1.0, 0.5, ERR);
     assert!(s.last_error().contains("model bug"), "{}", s.last_error());
-    assert_eq!(s.step(1.0, 0.5), ERR, "the Error state allows no step");
-    assert_eq!(unsafe { api::reset::<Faulty>(s.c) }, OK);
+    reset_from_error(&s);
 }
 
 /// Section 4.2.3: a step that cannot be completed returns fmi2Discard; fmi2LastSuccessfulTime
 /// tells how far it got and fmi2Terminated that the slave wants to stop.
 #[test]
 fn a_failed_step_is_discarded_at_the_last_good_time() {
-    let s = Slave::<Faulty>::initialized("discard", &[(0, 2.0)]);
-    assert_eq!(s.step(0.0, 0.4), OK);
-    assert_eq!(s.step(0.4, 0.4), fmi2Status::Discard);
+    let s = failed("discard", 2.0, 0.4, fmi2Status::Discard);
     let (mut t, mut b) = (0.0, 0);
     assert_eq!(unsafe { api::get_real_status::<Faulty>(s.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t) }, OK);
     assert_eq!(t, 0.5);
@@ -316,9 +326,7 @@ fn a_failed_step_is_discarded_at_the_last_good_time() {
 /// naming the variable, and no later fmi2GetReal hands the NaN out with fmi2OK.
 #[test]
 fn a_non_finite_output_is_an_error_naming_it() {
-    let s = Slave::<Faulty>::initialized("nan", &[(0, 3.0)]);
-    assert_eq!(s.step(0.0, 0.5), OK);
-    assert_eq!(s.step(0.5, 0.5), ERR);
+    let s = failed("nan", 3.0, 0.5, ERR);
     let e = s.last_error();
     assert!(
         e.contains("fmi2DoStep") && e.contains("y = NaN") && e.contains("t = 1") && e.contains("Error state"),
@@ -327,6 +335,5 @@ fn a_non_finite_output_is_an_error_naming_it() {
     let mut y = 0.0;
     assert_eq!(unsafe { api::get_real::<Faulty>(s.c, &1, 1, &mut y) }, ERR);
     assert!(s.last_error().contains("y = NaN"), "{}", s.last_error());
-    assert_eq!(s.step(1.0, 0.5), ERR, "the Error state allows no step");
-    assert_eq!(unsafe { api::reset::<Faulty>(s.c) }, OK);
+    reset_from_error(&s);
 }

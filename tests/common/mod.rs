@@ -35,19 +35,26 @@ unsafe extern "C" fn free(p: *mut c_void) {
     libc::free(p)
 }
 
+/// A logger with the one argument the FMU passes after the "%s" format.
+pub type TextLogger =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, *const c_char);
+
+/// `logger` as the C-variadic fmi2CallbackLogger. A C-variadic function cannot be defined in
+/// stable Rust; calling `logger` through the variadic pointer type is ABI-compatible on the
+/// x86_64 System V ABI that the tests run on.
+pub fn variadic(logger: TextLogger) -> fmi2CallbackLogger {
+    Some(unsafe {
+        std::mem::transmute::<
+            TextLogger,
+            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
+        >(logger)
+    })
+}
+
 /// Callback functions whose logger records into `messages`.
 pub fn callbacks(messages: &Messages) -> fmi2CallbackFunctions {
-    // A C-variadic logger cannot be defined in stable Rust; `record` takes the one argument the
-    // FMU passes after "%s". Calling it through the variadic pointer type is ABI-compatible on
-    // the x86_64 System V ABI that this test runs on.
-    let logger = unsafe {
-        std::mem::transmute::<
-            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, *const c_char),
-            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
-        >(record)
-    };
     fmi2CallbackFunctions {
-        logger: Some(logger),
+        logger: variadic(record),
         allocateMemory: Some(alloc),
         freeMemory: Some(free),
         stepFinished: None,

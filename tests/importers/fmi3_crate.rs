@@ -3,56 +3,71 @@
 //! Co-Simulation and Model Exchange against the FMI 2.0 .fmu of the same binary through the same
 //! importer. Needs `boomsim pack` first (scripts/test runs it).
 
+use crate::fmi_crate::{assert_step_response, DP, H, P0, U_REF};
+use crate::fmu;
 use boomsim::fmu::guid::token;
 use boomsim::fmu::Model;
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::{HydraulicBoom, PressureFeedbackController};
+use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi3::import::Fmi3Import;
 use fmi::fmi3::{CoSimulation, Common, Fmi3Model, GetSet, ModelExchange};
 use fmi::traits::FmiImport;
-use std::path::Path;
-
-fn fmu3(id: &str) -> Fmi3Import {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/..")).join(format!("target/fmu/fmi3/{id}.fmu"));
-    assert!(path.exists(), "{} is missing: run `target/release/boomsim pack` first", path.display());
-    fmi::import::from_path(&path).expect("the fmi crate loads the FMI 3.0 FMU")
-}
-
-fn fmu2(id: &str) -> fmi::fmi2::import::Fmi2Import {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/..")).join(format!("target/fmu/{id}.fmu"));
-    fmi::import::from_path(&path).expect("the fmi crate loads the FMI 2.0 FMU")
-}
 
 /// Step of the fed-back pressure by dp after initialisation: u_comp(t) = K_f omega_f dp
 /// e^(-omega_f t) / Q_rated (eq. 6.2), as in the FMI 2.0 test of tests/fmi_crate.rs.
 #[test]
 fn controller_runs_in_the_fmi_crate_as_fmi3_and_matches_the_analytic_step_response() {
-    let import = fmu3("PressureFeedbackController");
-    let md = import.model_description();
-    assert_eq!(md.fmi_version, "3.0");
-    assert_eq!(md.instantiation_token, token::<PressureFeedbackController>());
+    let import = fmu::<Fmi3Import>("PressureFeedbackController");
+    assert_eq!(import.model_description().instantiation_token, token::<PressureFeedbackController>());
     let mut s = import.instantiate_cs("pfc3", false, true, false, false, &[]).expect("instantiates");
     assert_eq!(s.get_version(), "3.0");
     s.enter_initialization_mode(Some(1e-6), 0.0, Some(1.0)).unwrap();
-    let (p0, dp, u_ref) = (45e5, -2e5, -0.05);
-    s.set_float64(&[vr::P, vr::U_REF], &[p0, u_ref]).unwrap();
+    s.set_float64(&[vr::P, vr::U_REF], &[P0, U_REF]).unwrap();
     s.exit_initialization_mode().unwrap();
-    s.set_float64(&[vr::P], &[p0 + dp]).unwrap();
-    let (k_f, w, q, h) = (1.24e-11, 35.8, 25.0 / 60_000.0, 1e-3);
+    s.set_float64(&[vr::P], &[P0 + DP]).unwrap();
     let mut out = [0.0; 2];
     for k in 0..200 {
-        let t = k as f64 * h;
+        let t = k as f64 * H;
         s.get_float64(&[vr::U, vr::U_COMP], &mut out).unwrap();
-        let expected = k_f * w * dp * (-w * t).exp() / q;
-        // Exact discretisation: only rounding of the 1e7 Pa state remains.
-        assert!((out[1] - expected).abs() <= 1e-9 * (k_f * w * dp / q).abs(), "t = {t}: {} vs {expected}", out[1]);
+        assert_step_response(t, out[1]);
         let (mut event, mut terminate, mut early, mut last) = (true, true, true, 0.0);
-        s.do_step(t, h, true, &mut event, &mut terminate, &mut early, &mut last).unwrap();
-        assert!(!event && !terminate && !early && last == t + h);
+        s.do_step(t, H, true, &mut event, &mut terminate, &mut early, &mut last).unwrap();
+        assert!(!event && !terminate && !early && last == t + H);
     }
     let (mut e, mut te, mut ea, mut l) = (false, false, false, 0.0);
-    assert!(s.do_step(0.2, -h, true, &mut e, &mut te, &mut ea, &mut l).is_err(), "negative step refused");
+    assert!(s.do_step(0.2, -H, true, &mut e, &mut te, &mut ea, &mut l).is_err(), "negative step refused");
     assert!(s.terminate().is_err(), "FMI 3.0, 2.3.1: the error left the instance Terminated");
+}
+
+/// fmi2SetupExperiment and fmi2EnterInitializationMode, or fmi3EnterInitializationMode, at t = 0
+/// with the defaults, and the exit from Initialization Mode.
+fn initialized(i: &mut impl fmi::traits::FmiInstance) {
+    i.enter_initialization_mode(None, 0.0, None).unwrap();
+    i.exit_initialization_mode().unwrap();
+}
+
+/// A Model Exchange instance of HydraulicBoom, initialised and in Continuous-Time Mode: its
+/// states, then at t = 0.01 and the states moved by 5 % of their nominals, the derivatives and
+/// the event indicators.
+fn model_exchange_sample(m: &mut impl fmi::traits::FmiModelExchange) -> [Vec<f64>; 3] {
+    initialized(m);
+    m.update_discrete_states(&mut fmi::EventFlags::default()).unwrap();
+    m.enter_continuous_time_mode().unwrap();
+    let (n, nz) = (HydraulicBoom::STATES.len(), HydraulicBoom::EVENT_INDICATORS.len());
+    let (mut x, mut d, mut z) = (vec![0.0; n], vec![0.0; n], vec![f64::NAN; nz]);
+    m.get_continuous_states(&mut x).unwrap();
+    let moved: Vec<f64> = x.iter().zip(HydraulicBoom::STATES).map(|(x, s)| x + 0.05 * s.nominal).collect();
+    m.set_time(0.01).unwrap();
+    m.set_continuous_states(&moved).unwrap();
+    m.get_continuous_state_derivatives(&mut d).unwrap();
+    m.get_event_indicators(&mut z).unwrap();
+    [x, d, z]
+}
+
+/// The bit patterns of `v`, to compare to the last bit.
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
 }
 
 /// The plant lowering the load (valve.u_ref = -0.3 for 0.3 s, flexible boom) in Co-Simulation:
@@ -60,14 +75,11 @@ fn controller_runs_in_the_fmi_crate_as_fmi3_and_matches_the_analytic_step_respon
 #[test]
 fn plant_co_simulation_in_the_fmi_crate_equals_fmi2() {
     use fmi::fmi2::instance::{CoSimulation as Cs2, Common as Common2};
-    let (i3, i2) = (fmu3("HydraulicBoom"), fmu2("HydraulicBoom"));
+    let (i3, i2) = (fmu::<Fmi3Import>("HydraulicBoom"), fmu::<Fmi2Import>("HydraulicBoom"));
     let mut s3 = i3.instantiate_cs("plant3", false, true, false, false, &[]).unwrap();
     let mut s2 = i2.instantiate_cs("plant2", false, true).unwrap();
-    s3.enter_initialization_mode(None, 0.0, None).unwrap();
-    s2.setup_experiment(None, 0.0, None).unwrap();
-    s2.enter_initialization_mode().unwrap();
-    s3.exit_initialization_mode().unwrap();
-    s2.exit_initialization_mode().unwrap();
+    initialized(&mut s3);
+    initialized(&mut s2);
     let outs = [boomsim::models::vr::P3, boomsim::models::vr::P4, boomsim::models::vr::X, boomsim::models::vr::V];
     let (mut y3, mut y2) = ([0.0; 4], [0.0; 4]);
     let h = 1e-3;
@@ -90,41 +102,17 @@ fn plant_co_simulation_in_the_fmi_crate_equals_fmi2() {
 /// FMI 2.0.
 #[test]
 fn plant_model_exchange_in_the_fmi_crate_equals_fmi2() {
-    use fmi::fmi2::instance::{Common as Common2, ModelExchange as Me2};
-    let (i3, i2) = (fmu3("HydraulicBoom"), fmu2("HydraulicBoom"));
+    let (i3, i2) = (fmu::<Fmi3Import>("HydraulicBoom"), fmu::<Fmi2Import>("HydraulicBoom"));
     let mut m3 = i3.instantiate_me("me3", false, true).unwrap();
     let mut m2 = i2.instantiate_me("me2", false, true).unwrap();
-    m3.enter_initialization_mode(None, 0.0, None).unwrap();
-    m2.setup_experiment(None, 0.0, None).unwrap();
-    m2.enter_initialization_mode().unwrap();
-    m3.exit_initialization_mode().unwrap();
-    m2.exit_initialization_mode().unwrap();
-    m3.update_discrete_states(&mut fmi::EventFlags::default()).unwrap();
-    m2.new_discrete_states(&mut fmi::EventFlags::default()).unwrap();
-    m3.enter_continuous_time_mode().unwrap();
-    m2.enter_continuous_time_mode().unwrap();
-    let n = HydraulicBoom::STATES.len();
-    assert_eq!(m3.get_number_of_continuous_states().unwrap(), n);
+    let [x3, d3, z3] = model_exchange_sample(&mut m3);
+    let [x2, d2, z2] = model_exchange_sample(&mut m2);
+    assert_eq!(m3.get_number_of_continuous_states().unwrap(), HydraulicBoom::STATES.len());
     // The same three event indicators, declared as variables in FMI 3.0 (ModelStructure).
-    let nz = HydraulicBoom::EVENT_INDICATORS.len();
-    assert_eq!(m3.get_number_of_event_indicators().unwrap(), nz);
-    let (mut x3, mut x2) = (vec![0.0; n], vec![0.0; n]);
-    m3.get_continuous_states(&mut x3).unwrap();
-    m2.get_continuous_states(&mut x2).unwrap();
+    assert_eq!(m3.get_number_of_event_indicators().unwrap(), HydraulicBoom::EVENT_INDICATORS.len());
     assert_eq!(x3, x2);
-    let x: Vec<f64> = x3.iter().zip(HydraulicBoom::STATES).map(|(x, s)| x + 0.05 * s.nominal).collect();
-    m3.set_time(0.01).unwrap();
-    m2.set_time(0.01).unwrap();
-    m3.set_continuous_states(&x).unwrap();
-    m2.set_continuous_states(&x).unwrap();
-    let (mut d3, mut d2) = (vec![0.0; n], vec![0.0; n]);
-    m3.get_continuous_state_derivatives(&mut d3).unwrap();
-    m2.get_derivatives(&mut d2).unwrap();
     assert!(d3.iter().any(|d| *d != 0.0) && d3.iter().all(|d| d.is_finite()));
-    assert_eq!(d3.iter().map(|d| d.to_bits()).collect::<Vec<_>>(), d2.iter().map(|d| d.to_bits()).collect::<Vec<_>>());
-    let (mut z3, mut z2) = (vec![f64::NAN; nz], vec![f64::NAN; nz]);
-    m3.get_event_indicators(&mut z3).unwrap();
-    m2.get_event_indicators(&mut z2).unwrap();
+    assert_eq!(bits(&d3), bits(&d2));
     assert!(z3.iter().all(|z| z.is_finite()), "{z3:?}");
-    assert_eq!(z3.iter().map(|z| z.to_bits()).collect::<Vec<_>>(), z2.iter().map(|z| z.to_bits()).collect::<Vec<_>>());
+    assert_eq!(bits(&z3), bits(&z2));
 }

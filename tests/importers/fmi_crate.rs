@@ -2,52 +2,55 @@
 //! instantiation, stepping, and the controller's analytic step response.
 //! Needs `boomsim pack` first (scripts/test runs it).
 
+use crate::fmu;
 use boomsim::fmu::guid::guid;
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::PressureFeedbackController;
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
 use fmi::traits::FmiImport;
-use std::path::Path;
 
-fn fmu(id: &str) -> Fmi2Import {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/..")).join(format!("target/fmu/{id}.fmu"));
-    assert!(path.exists(), "{} is missing: run `target/release/boomsim pack` first", path.display());
-    fmi::import::from_path(&path).expect("the fmi crate loads the FMU")
+/// The controller's step response: initial pressure P0, valve reference U_REF, then a step of the
+/// fed-back pressure by DP after initialisation, sampled every H.
+pub const P0: f64 = 45e5;
+pub const DP: f64 = -2e5;
+pub const U_REF: f64 = -0.05;
+pub const H: f64 = 1e-3;
+
+/// The compensation u_comp at time t after the pressure step is the analytic step response of the
+/// test below (also the FMI 3.0 test's, tests/importers/fmi3_crate.rs).
+pub fn assert_step_response(t: f64, u_comp: f64) {
+    let (k_f, w, q) = (1.24e-11, 35.8, 25.0 / 60_000.0);
+    let expected = k_f * w * DP * (-w * t).exp() / q;
+    // Exact discretisation: only rounding of the 1e7 Pa state remains.
+    assert!((u_comp - expected).abs() <= 1e-9 * (k_f * w * DP / q).abs(), "t = {t}: {u_comp} vs {expected}");
 }
 
 /// Step of the fed-back pressure by dp after initialisation: u_comp(t) = K_f omega_f dp
 /// e^(-omega_f t) / Q_rated, the impulse-free step response of eq. 6.2 in spool units.
 #[test]
 fn controller_runs_in_the_fmi_crate_and_matches_the_analytic_step_response() {
-    let import = fmu("PressureFeedbackController");
-    let md = import.model_description();
-    assert_eq!(md.fmi_version, "2.0");
-    assert_eq!(md.guid, guid::<PressureFeedbackController>());
+    let import = fmu::<Fmi2Import>("PressureFeedbackController");
+    assert_eq!(import.model_description().guid, guid::<PressureFeedbackController>());
     let mut s = import.instantiate_cs("pfc", false, true).expect("instantiates");
     assert_eq!(s.get_version(), "2.0");
     assert_eq!(s.get_types_platform(), "default");
     s.setup_experiment(Some(1e-6), 0.0, Some(1.0)).unwrap();
     s.enter_initialization_mode().unwrap();
-    let (p0, dp, u_ref) = (45e5, -2e5, -0.05);
-    s.set_real(&[vr::P, vr::U_REF], &[p0, u_ref]).unwrap();
+    s.set_real(&[vr::P, vr::U_REF], &[P0, U_REF]).unwrap();
     s.exit_initialization_mode().unwrap();
     let mut out = [0.0; 2];
     s.get_real(&[vr::U, vr::U_COMP], &mut out).unwrap();
-    assert_eq!(out, [u_ref, 0.0], "the filter starts at rest: no kick at t = 0");
-    s.set_real(&[vr::P], &[p0 + dp]).unwrap();
-    let (k_f, w, q) = (1.24e-11, 35.8, 25.0 / 60_000.0);
-    let h = 1e-3;
+    assert_eq!(out, [U_REF, 0.0], "the filter starts at rest: no kick at t = 0");
+    s.set_real(&[vr::P], &[P0 + DP]).unwrap();
     for k in 0..200 {
-        let t = k as f64 * h;
+        let t = k as f64 * H;
         s.get_real(&[vr::U, vr::U_COMP], &mut out).unwrap();
-        let expected = k_f * w * dp * (-w * t).exp() / q;
-        // Exact discretisation: only rounding of the 1e7 Pa state remains.
-        assert!((out[1] - expected).abs() <= 1e-9 * (k_f * w * dp / q).abs(), "t = {t}: {} vs {expected}", out[1]);
-        assert!((out[0] - (u_ref + out[1])).abs() < 1e-15);
-        s.do_step(t, h, true).unwrap();
+        assert_step_response(t, out[1]);
+        assert!((out[0] - (U_REF + out[1])).abs() < 1e-15);
+        s.do_step(t, H, true).unwrap();
     }
-    assert!(s.do_step(0.2, -h, true).is_err(), "negative step refused");
+    assert!(s.do_step(0.2, -H, true).is_err(), "negative step refused");
     s.terminate().unwrap();
 }
 
@@ -59,7 +62,7 @@ fn controller_runs_in_the_fmi_crate_and_matches_the_analytic_step_response() {
 fn controller_runs_as_model_exchange_in_the_fmi_crate() {
     use fmi::fmi2::instance::ModelExchange;
     use fmi::EventFlags;
-    let import = fmu("PressureFeedbackController");
+    let import = fmu::<Fmi2Import>("PressureFeedbackController");
     let mut m = import.instantiate_me("pfc-me", false, true).expect("instantiates as ME");
     m.setup_experiment(Some(1e-6), 0.0, None).unwrap();
     m.enter_initialization_mode().unwrap();

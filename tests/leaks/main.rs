@@ -31,6 +31,9 @@
 //!
 //! Run: `cargo test --release --test leaks -- --nocapture` (prints the measured numbers).
 
+#[path = "../common/mod.rs"]
+mod common;
+
 use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
 use boomsim::fmi2::api;
@@ -49,24 +52,22 @@ static LIVE_BYTES: AtomicIsize = AtomicIsize::new(0);
 static LIVE_ALLOCS: AtomicIsize = AtomicIsize::new(0);
 static CALLS: AtomicU64 = AtomicU64::new(0);
 
+/// Counts the allocation `p` of `layout` if it succeeded, and returns it.
+fn counted(p: *mut u8, layout: Layout) -> *mut u8 {
+    if !p.is_null() {
+        LIVE_BYTES.fetch_add(layout.size() as isize, Relaxed);
+        LIVE_ALLOCS.fetch_add(1, Relaxed);
+        CALLS.fetch_add(1, Relaxed);
+    }
+    p
+}
+
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let p = System.alloc(layout);
-        if !p.is_null() {
-            LIVE_BYTES.fetch_add(layout.size() as isize, Relaxed);
-            LIVE_ALLOCS.fetch_add(1, Relaxed);
-            CALLS.fetch_add(1, Relaxed);
-        }
-        p
+        counted(System.alloc(layout), layout)
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        let p = System.alloc_zeroed(layout);
-        if !p.is_null() {
-            LIVE_BYTES.fetch_add(layout.size() as isize, Relaxed);
-            LIVE_ALLOCS.fetch_add(1, Relaxed);
-            CALLS.fetch_add(1, Relaxed);
-        }
-        p
+        counted(System.alloc_zeroed(layout), layout)
     }
     unsafe fn dealloc(&self, p: *mut u8, layout: Layout) {
         System.dealloc(p, layout);
@@ -120,16 +121,8 @@ unsafe extern "C" fn logger(
 }
 
 fn callbacks() -> fmi2CallbackFunctions {
-    // As in tests/common: `logger` takes the one argument the FMU passes after "%s"; calling it
-    // through the variadic pointer type is ABI-compatible on x86_64 System V.
-    let logger = unsafe {
-        std::mem::transmute::<
-            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, *const c_char),
-            unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...),
-        >(logger)
-    };
     fmi2CallbackFunctions {
-        logger: Some(logger),
+        logger: common::variadic(logger),
         allocateMemory: None,
         freeMemory: None,
         stepFinished: None,
@@ -442,28 +435,20 @@ fn no_memory_growth() {
     runs.push(overwrite::<HydraulicBoom>("HydraulicBoom rigid", Some(false), 200));
     runs.push(overwrite::<BoomMechanics>("BoomMechanics rigid", Some(false), 200));
 
-    // Phase 3: 100 orphaned states per instance, freed by fmi2FreeInstance. A warm-up instance
-    // first (it has made the same calls, so later ones find nothing left to initialise lazily).
-    for (case, flexible) in [("warm-up", None), ("PressureFeedbackController", None)] {
-        let (run, peak) = orphans::<Pfc>(case, flexible, 100);
-        if case != "warm-up" {
-            peaks.push((case, run.before.bytes, peak));
-            runs.push(run);
-        }
-    }
-    for (case, flexible) in [("HydraulicBoom rigid", Some(false)), ("HydraulicBoom flexible", None)] {
-        let _ = orphans::<HydraulicBoom>(case, flexible, 100);
-        let (run, peak) = orphans::<HydraulicBoom>(case, flexible, 100);
-        peaks.push((case, run.before.bytes, peak));
-        runs.push(run);
-    }
-    let _ = orphans::<HydraulicCircuit>("HydraulicCircuit", None, 100);
-    let (run, peak) = orphans::<HydraulicCircuit>("HydraulicCircuit", None, 100);
-    peaks.push(("HydraulicCircuit", run.before.bytes, peak));
-    runs.push(run);
-    for (case, flexible) in [("BoomMechanics rigid", Some(false)), ("BoomMechanics flexible", None)] {
-        let _ = orphans::<BoomMechanics>(case, flexible, 100);
-        let (run, peak) = orphans::<BoomMechanics>(case, flexible, 100);
+    // Phase 3: 100 orphaned states per instance, freed by fmi2FreeInstance. Each measured instance
+    // after a warm-up instance (it has made the same calls, so the measured one finds nothing left
+    // to initialise lazily).
+    let cases: [(_, _, fn(&'static str, Option<bool>, usize) -> (Run, isize)); 6] = [
+        ("PressureFeedbackController", None, orphans::<Pfc>),
+        ("HydraulicBoom rigid", Some(false), orphans::<HydraulicBoom>),
+        ("HydraulicBoom flexible", None, orphans::<HydraulicBoom>),
+        ("HydraulicCircuit", None, orphans::<HydraulicCircuit>),
+        ("BoomMechanics rigid", Some(false), orphans::<BoomMechanics>),
+        ("BoomMechanics flexible", None, orphans::<BoomMechanics>),
+    ];
+    for (case, flexible, orphans) in cases {
+        let _ = orphans(case, flexible, 100);
+        let (run, peak) = orphans(case, flexible, 100);
         peaks.push((case, run.before.bytes, peak));
         runs.push(run);
     }

@@ -68,18 +68,15 @@ fn convergence_order_is_five() {
     assert!(errs[2] > 1e-12, "{errs:?}");
 }
 
-/// Records the largest time at which `rhs` was evaluated.
-struct Decay {
-    t_max: Cell<f64>,
-}
+/// A scalar ODE `x' = f(t, x)`.
+struct Scalar<F>(F);
 
-impl OdeSystem for Decay {
+impl<F: Fn(f64, f64) -> f64> OdeSystem for Scalar<F> {
     fn dim(&self) -> usize {
         1
     }
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
-        self.t_max.set(self.t_max.get().max(t));
-        dx[0] = -x[0];
+        dx[0] = (self.0)(t, x[0]);
     }
 }
 
@@ -87,14 +84,19 @@ impl OdeSystem for Decay {
 /// state there matches `e^{-t}` within the tolerance (global error ~ rtol for this decay).
 #[test]
 fn lands_exactly_on_t_end() {
-    let sys = Decay { t_max: Cell::new(0.0) };
+    // The decay x' = -x, recording the largest time at which `rhs` was evaluated.
+    let t_max = Cell::new(0.0_f64);
+    let sys = Scalar(|t: f64, x: f64| {
+        t_max.set(t_max.get().max(t));
+        -x
+    });
     let mut s = Radau5::new(1);
     let mut x = [1.0];
     let mut t = 0.0;
     for t_end in [0.1234567891, 0.3, 0.300001, 1.7] {
-        sys.t_max.set(f64::NEG_INFINITY);
+        t_max.set(f64::NEG_INFINITY);
         s.integrate(&sys, t, &mut x, t_end).unwrap();
-        assert_eq!(sys.t_max.get(), t_end);
+        assert_eq!(t_max.get(), t_end);
         assert!((x[0] - (-t_end).exp()).abs() < 1e-6 * (-t_end).exp(), "{} at {t_end}", x[0]);
         t = t_end;
     }
@@ -177,18 +179,10 @@ fn error_scales_with_tolerance() {
 /// which approaches 0.5 from below to within the minimum step size (rejections halve `h`).
 #[test]
 fn nan_rhs_returns_error_at_last_good_state() {
-    struct Breaks;
-    impl OdeSystem for Breaks {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
-            dx[0] = if t > 0.5 { f64::NAN } else { -x[0] };
-        }
-    }
+    let breaks = Scalar(|t: f64, x: f64| if t > 0.5 { f64::NAN } else { -x });
     let mut s = Radau5::new(1);
     let mut x = [1.0];
-    let e = s.integrate(&Breaks, 0.0, &mut x, 1.0).unwrap_err();
+    let e = s.integrate(&breaks, 0.0, &mut x, 1.0).unwrap_err();
     assert!(matches!(
         e.kind,
         SolveErrorKind::StepSizeTooSmall(FailureCause::NonFiniteRhs)
@@ -262,18 +256,10 @@ fn saved_state_reproduces_bit_identical_results() {
 /// i.e. a few dozen steps on [0, 2] (an explicit method would need ~1e6), at the tolerance.
 #[test]
 fn very_stiff_problem_takes_few_steps() {
-    struct Pr;
-    impl OdeSystem for Pr {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
-            dx[0] = -1e6 * (x[0] - t.sin()) + t.cos();
-        }
-    }
+    let pr = Scalar(|t: f64, x: f64| -1e6 * (x - t.sin()) + t.cos());
     let mut s = Radau5::new(1);
     let mut x = [0.0];
-    s.integrate(&Pr, 0.0, &mut x, 2.0).unwrap();
+    s.integrate(&pr, 0.0, &mut x, 2.0).unwrap();
     assert!((x[0] - 2f64.sin()).abs() < 1e-6, "{}", x[0]);
     assert!(s.stats().accepted_steps < 100, "{:?}", s.stats());
 }
@@ -287,7 +273,7 @@ fn invalid_arguments_are_reported() {
     assert!(s.set_rtol(0.0).is_err());
     let e = s.integrate(&Linear, 1.0, &mut x, 0.5).unwrap_err();
     assert!(matches!(e.kind, SolveErrorKind::InvalidArgument(_)));
-    let e = s.integrate(&Decay { t_max: Cell::new(0.0) }, 0.0, &mut x, 1.0).unwrap_err();
+    let e = s.integrate(&Scalar(|_: f64, x: f64| -x), 0.0, &mut x, 1.0).unwrap_err();
     assert!(matches!(e.kind, SolveErrorKind::InvalidArgument(_)));
     assert_eq!(x, [1.0; 3]);
 }
