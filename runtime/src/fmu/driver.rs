@@ -8,7 +8,8 @@
 //! The one special case is a model whose equations have a closed-form solution over a step:
 //! the controller's first-order filter under a ramped input (eq. 6.2) is stepped exactly by the
 //! model itself ([`Step::Done`]), which no integrator beats; such a model has no ODE state and
-//! the driver no integrator for it.
+//! the driver no integrator for it: [`Model::CLOSED_FORM`] is a constant that the compiler folds,
+//! so that the model's binary links no integrator either.
 
 use super::model::{Log, Model, StepError, StepStart};
 use super::variables::{Values, Variable};
@@ -72,10 +73,16 @@ impl OdeSystem for () {
 }
 
 /// A model with the driver's integrator (none for a model without ODE state).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Driven<M> {
     model: M,
     solver: Option<Radau5>,
+}
+
+impl<M: Model> Clone for Driven<M> {
+    fn clone(&self) -> Self {
+        Driven { model: self.model.clone(), solver: self.solver().cloned() }
+    }
 }
 
 impl<M> Deref for Driven<M> {
@@ -95,7 +102,12 @@ impl<M: Model> Driven<M> {
     /// `model` with a fresh integrator for its ODE state.
     pub fn new(model: M) -> Self {
         let n = model.state().len();
-        Driven { model, solver: (n > 0).then(|| Radau5::new(n)) }
+        Driven { model, solver: (!M::CLOSED_FORM && n > 0).then(|| Radau5::new(n)) }
+    }
+
+    /// The integrator; none for a closed-form model (known at compile time).
+    fn solver(&self) -> Option<&Radau5> {
+        self.solver.as_ref().filter(|_| !M::CLOSED_FORM)
     }
 
     /// Advances from `t` to `t + h`: inputs are `values` at `t`, changing with the given first
@@ -115,7 +127,7 @@ impl<M: Model> Driven<M> {
     ) -> Result<(), StepError> {
         let fail = |time, message: String| StepError { time, message };
         let start = StepStart { values, input_derivatives, t, h };
-        match (self.model.begin_step(&start, log)?, &mut self.solver) {
+        match (self.model.begin_step(&start, log)?, self.solver.as_mut().filter(|_| !M::CLOSED_FORM)) {
             (Step::Done, _) => return Ok(()),
             (Step::Integrate(ode, state), Some(solver)) => {
                 solver.set_tolerance(tolerance, || M::scale(ode)).map_err(|e| fail(t, e.to_string()))?;
@@ -136,7 +148,7 @@ impl<M: Model> Driven<M> {
     /// Writes the model's outputs and locals, and the integrator's counters.
     pub fn outputs(&self, values: &mut Values) {
         self.model.outputs(values);
-        if let Some(solver) = &self.solver {
+        if let Some(solver) = self.solver() {
             let stats = solver.stats();
             values.set_real(vr::SOLVER_STEPS, stats.accepted_steps as f64);
             values.set_real(vr::SOLVER_REJECTED, stats.rejected_steps as f64);
@@ -150,7 +162,7 @@ impl<M: Model> Driven<M> {
     /// The model and its integrator as numbers, for FMU state serialisation: the model's head
     /// ([`Model::head`]), its ODE state, the integrator's state.
     pub fn save(&self) -> Vec<f64> {
-        let solver = self.solver.as_ref().map(Radau5::save_state).unwrap_or_default();
+        let solver = self.solver().map(Radau5::save_state).unwrap_or_default();
         [&self.model.head()[..], self.model.state(), &solver].concat()
     }
 
@@ -158,6 +170,7 @@ impl<M: Model> Driven<M> {
     pub fn load(values: &Values, saved: &[f64]) -> Result<Self, String> {
         let (head, state, saved_solver) = match saved.len() == M::HEAD {
             true => (saved, &[][..], None),
+            false if M::CLOSED_FORM => return Err(format!("{} numbers are no saved model state", saved.len())),
             false => split_saved(saved, M::HEAD).map(|(h, s, v)| (h, s, Some(v)))?,
         };
         let model = M::restore(values, head, state)?;

@@ -167,6 +167,10 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// `()` for a model that steps in closed form.
     type Ode: OdeSystem;
 
+    /// Whether the model steps in closed form: no ODE state, [`Step::Done`] from every
+    /// [`Model::begin_step`], and no integrator in its driver or its binary. Default: no.
+    const CLOSED_FORM: bool = false;
+
     /// Co-Simulation, at the start of a step: takes the step's inputs and returns its ODE with
     /// its state for the driver to integrate, or steps itself in closed form ([`Step::Done`]).
     fn begin_step(&mut self, step: &StepStart<'_>, log: &mut dyn Log) -> Result<Step<'_, Self::Ode>, StepError>;

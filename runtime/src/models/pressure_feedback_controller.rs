@@ -270,6 +270,7 @@ impl Model for PressureFeedbackController {
 
     /// No ODE for the driver: the filter steps in closed form (below).
     type Ode = ();
+    const CLOSED_FORM: bool = true;
 
     /// The filter x' = omega_f (p - x) over the step, exact for the pressure ramped with its
     /// slope ([`HighPassFeedback::advance`]): a closed form no integrator beats.
