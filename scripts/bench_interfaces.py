@@ -11,8 +11,9 @@ reference: ME at rtol 1e-9, the continuous loop without a communication step. A 
 measures the event indicators (rigid boom, B and C1.3, where the compensated spool command
 crosses the dead band): ME with and without CVode's root finding on them. A third one is the
 tolerance an ME user picks: HydraulicBoom alone (rigid, valve.u_ref = -0.3 from rest, 1 s)
-through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9. A benchmark: it
-prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
+through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9; a fourth
+the same at rtol 1e-3 to 1e-5 with CVode's largest BDF order limited to 2 or 1, or its stability
+limit detection on (`--only orders`, 10 s). A benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
 references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
 """
 
@@ -69,30 +70,89 @@ def event_rows() -> list:
     return rows
 
 
+def tolerance_case():
+    """HydraulicBoom ME alone (rigid, u_ref -0.3 from rest, 1 s): the FMU, the simulate_fmu
+    arguments and the reference (CS at rtol 1e-9)."""
+    from fmpy import simulate_fmu
+
+    fmu = str(cosim.FMU_DIR / "HydraulicBoom.fmu")
+    kw = dict(stop_time=1.0, output_interval=1e-3, output=["p1", "p2", "p3", "p4"],
+              start_values={"boom.flexible": False, "valve.u_ref": -0.3})
+    return fmu, kw, simulate_fmu(fmu, fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
+
+
+def p3_error(r, ref) -> float:
+    """Largest p3 error of run r against the reference at its output points [bar]."""
+    return np.abs(np.interp(ref["time"], r["time"], r["p3"]) - ref["p3"]).max() / 1e5
+
+
 def tolerance_rows() -> tuple:
     """HydraulicBoom ME alone through fmpy.simulate_fmu at several CVode tolerances."""
     print("Tolerance (HydraulicBoom ME alone, rigid, u_ref -0.3, 1 s) ...", flush=True)
     from fmpy import simulate_fmu
 
-    fmu = str(cosim.FMU_DIR / "HydraulicBoom.fmu")
-    kw = dict(stop_time=1.0, output_interval=1e-3, output=["p3"],
-              start_values={"boom.flexible": False, "valve.u_ref": -0.3})
-    cs_ref = simulate_fmu(fmu, fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
+    fmu, kw, cs_ref = tolerance_case()
     rows = []
     for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
         try:
             r, wall = timed(simulate_fmu, fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)
-            err = np.abs(np.interp(cs_ref["time"], r["time"], r["p3"]) - cs_ref["p3"]).max() / 1e5
-            rows.append((f"{tol:g}", f"{r['p3'][-1] / 1e5:.4g}", f"{err:.3g}", f"{wall:.2f}"))
+            rows.append((f"{tol:g}", f"{r['p3'][-1] / 1e5:.4g}", f"{p3_error(r, cs_ref):.3g}", f"{wall:.2f}"))
         except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
             rows.append((f"{tol:g}", "failed", str(e).split(":")[0][:60], "-"))
     return cs_ref["p3"][-1] / 1e5, rows
 
 
+def order_rows() -> list:
+    """The tolerance case under CVode with its largest BDF order limited (CVodeSetMaxOrd, bound
+    through ctypes: fmpy leaves SUNDIALS' default 5) and with its stability limit detection
+    (CVodeSetStabLimDet, default off): whether the orders 3-5, not stable near the imaginary
+    axis, are what fails at loose tolerances."""
+    print("BDF order (the tolerance case, CVode's maximum order and stability limit detection) ...", flush=True)
+    import ctypes
+
+    import fmpy.sundials as sundials
+    from fmpy import simulate_fmu
+    from fmpy.sundials.libraries import sundials_cvode
+
+    for name in ("CVodeSetMaxOrd", "CVodeSetStabLimDet"):
+        getattr(sundials_cvode, name).argtypes = [ctypes.c_void_p, ctypes.c_int]
+    get_steps = sundials_cvode.CVodeGetNumSteps
+    get_steps.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_long)]
+    setting, solvers, init = {}, [], sundials.CVodeSolver.__init__
+
+    def configured(self, *args, **kw):
+        init(self, *args, **kw)
+        assert sundials_cvode.CVodeSetMaxOrd(self.cvode_mem, setting["order"]) == 0
+        assert sundials_cvode.CVodeSetStabLimDet(self.cvode_mem, setting["detection"]) == 0
+        solvers.append(self)
+
+    fmu, kw, cs_ref = tolerance_case()
+    rows = []
+    sundials.CVodeSolver.__init__ = configured
+    try:
+        for tol in (1e-3, 1e-4, 1e-5):
+            for order, detection in ((5, 0), (5, 1), (2, 0), (1, 0)):
+                setting.update(order=order, detection=detection)
+                row = (f"{tol:g}", str(order), "on" if detection else "off")
+                try:
+                    r, wall = timed(simulate_fmu, fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)
+                except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
+                    rows.append(row + ("failed", str(e).split(":")[0][:60], "-", "-", "-"))
+                    continue
+                steps = ctypes.c_long()
+                get_steps(solvers[-1].cvode_mem, ctypes.byref(steps))
+                p_max = max(np.abs(r[p]).max() for p in ("p1", "p2", "p3", "p4")) / 1e5
+                rows.append(row + (f"{r['p3'][-1] / 1e5:.4g}", f"{p3_error(r, cs_ref):.3g}", f"{p_max:.4g}",
+                                   str(steps.value), f"{wall:.2f}"))
+    finally:
+        sundials.CVodeSolver.__init__ = init
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
-    ap.add_argument("--only", choices=("interfaces", "events", "tolerance"), help="one table")
+    ap.add_argument("--only", choices=("interfaces", "events", "tolerance", "orders"), help="one table")
     args = ap.parse_args(argv)
     cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
     if args.only in (None, "interfaces"):
@@ -111,6 +171,13 @@ def main(argv=None):
         p3_ref, rows = tolerance_rows()
         print(f"\n| CVode rtol | p3 at 1 s [bar] (CS rtol 1e-9: {p3_ref:.4g}) | max abs p3 error [bar] | wall [s] |")
         print("| --- | --- | --- | --- |")
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+    if args.only in (None, "orders"):
+        rows = order_rows()
+        print("\n| CVode rtol | max BDF order | stability limit detection | p3 at 1 s [bar] "
+              "| max abs p3 error [bar] | max abs p1..p4 [bar] | steps | wall [s] |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
         for row in rows:
             print("| " + " | ".join(row) + " |")
 
