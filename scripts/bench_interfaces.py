@@ -13,7 +13,8 @@ crosses the dead band): ME with and without CVode's root finding on them. A thir
 tolerance an ME user picks: HydraulicBoom alone (rigid, valve.u_ref = -0.3 from rest, 1 s)
 through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9; a fourth
 the same at rtol 1e-3 to 1e-5 with CVode's largest BDF order limited to 2 or 1, or its stability
-limit detection on (`--only orders`, 10 s). A benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
+limit detection on (`--only orders`, 10 s), and a fifth with CVode on the 8 states of the rigid
+boom instead of the FMU's 70 padded slots (`--only layout`, 5 s). A benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
 references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
 """
 
@@ -102,6 +103,30 @@ def tolerance_rows() -> tuple:
     return cs_ref["p3"][-1] / 1e5, rows
 
 
+def with_cvode(adapt, run):
+    """run() with fmpy's CVodeSolver built through adapt(init, self, *args, **kw) instead of its
+    own __init__ (init): the options and state vectors fmpy gives CVode, changed for a study."""
+    import fmpy.sundials as sundials
+
+    init = sundials.CVodeSolver.__init__
+    sundials.CVodeSolver.__init__ = lambda self, *args, **kw: adapt(init, self, *args, **kw)
+    try:
+        return run()
+    finally:
+        sundials.CVodeSolver.__init__ = init
+
+
+def case_row(run, cs_ref) -> tuple:
+    """p3 at 1 s, its largest error and the largest pressure of a tolerance-case run [bar], and its
+    wall time; a failed run as such."""
+    try:
+        r, wall = timed(run)
+    except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
+        return ("failed", str(e).split(":")[0][:60], "-", "-")
+    p_max = max(np.abs(r[p]).max() for p in ("p1", "p2", "p3", "p4")) / 1e5
+    return (f"{r['p3'][-1] / 1e5:.4g}", f"{p3_error(r, cs_ref):.3g}", f"{p_max:.4g}", f"{wall:.2f}")
+
+
 def order_rows() -> list:
     """The tolerance case under CVode with its largest BDF order limited (CVodeSetMaxOrd, bound
     through ctypes: fmpy leaves SUNDIALS' default 5) and with its stability limit detection
@@ -110,49 +135,74 @@ def order_rows() -> list:
     print("BDF order (the tolerance case, CVode's maximum order and stability limit detection) ...", flush=True)
     import ctypes
 
-    import fmpy.sundials as sundials
     from fmpy import simulate_fmu
     from fmpy.sundials.libraries import sundials_cvode
 
     for name in ("CVodeSetMaxOrd", "CVodeSetStabLimDet"):
         getattr(sundials_cvode, name).argtypes = [ctypes.c_void_p, ctypes.c_int]
-    get_steps = sundials_cvode.CVodeGetNumSteps
-    get_steps.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_long)]
-    setting, solvers, init = {}, [], sundials.CVodeSolver.__init__
+    setting = {}
 
-    def configured(self, *args, **kw):
+    def configured(init, self, *args, **kw):
         init(self, *args, **kw)
         assert sundials_cvode.CVodeSetMaxOrd(self.cvode_mem, setting["order"]) == 0
         assert sundials_cvode.CVodeSetStabLimDet(self.cvode_mem, setting["detection"]) == 0
-        solvers.append(self)
 
     fmu, kw, cs_ref = tolerance_case()
     rows = []
-    sundials.CVodeSolver.__init__ = configured
-    try:
-        for tol in (1e-3, 1e-4, 1e-5):
-            for order, detection in ((5, 0), (5, 1), (2, 0), (1, 0)):
-                setting.update(order=order, detection=detection)
-                row = (f"{tol:g}", str(order), "on" if detection else "off")
-                try:
-                    r, wall = timed(simulate_fmu, fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)
-                except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
-                    rows.append(row + ("failed", str(e).split(":")[0][:60], "-", "-", "-"))
-                    continue
-                steps = ctypes.c_long()
-                get_steps(solvers[-1].cvode_mem, ctypes.byref(steps))
-                p_max = max(np.abs(r[p]).max() for p in ("p1", "p2", "p3", "p4")) / 1e5
-                rows.append(row + (f"{r['p3'][-1] / 1e5:.4g}", f"{p3_error(r, cs_ref):.3g}", f"{p_max:.4g}",
-                                   str(steps.value), f"{wall:.2f}"))
-    finally:
-        sundials.CVodeSolver.__init__ = init
+    for tol in (1e-3, 1e-4, 1e-5):
+        for order, detection in ((5, 0), (5, 1), (2, 0), (1, 0)):
+            setting.update(order=order, detection=detection)
+            run = lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)  # noqa: E731
+            rows.append((f"{tol:g}", str(order), "on" if detection else "off")
+                        + case_row(lambda: with_cvode(configured, run), cs_ref))
+    return rows
+
+
+def layout_rows() -> list:
+    """The tolerance case with CVode given the FMU's 70 Model Exchange slots (6 circuit states and
+    32 section angles and rates, the rigid boom's angle and rate copied into every section's slots)
+    or only the 8 states the rigid boom has, the copies filled in before every call to the FMU:
+    whether the padding, which leaves the pressures 6 of CVode's 70 error-norm components, is what
+    fails at loose tolerances."""
+    print("Layout (the tolerance case, CVode on the 70 slots or on the 8 real states) ...", flush=True)
+    import ctypes
+
+    from fmpy import simulate_fmu
+
+    slots, real = 70, [0, 1, 2, 3, 4, 5, 6, 38]  # p1..p4, x_v, u_cbv, section[1].phi, section[1].omega
+    pointer = ctypes.POINTER(ctypes.c_double)
+
+    def sized(init, self, nx, nz, get_x, set_x, get_dx, get_z, get_nominals, *args, **kw):
+        assert nx == slots, nx
+        full = np.zeros(slots)
+        p_full = full.ctypes.data_as(pointer)
+
+        def picked(get):
+            def f(p, n):
+                get(p_full, slots)
+                np.ctypeslib.as_array(p, (n,))[:] = full[real]
+            return f
+
+        def expanded(p, n):
+            x = np.ctypeslib.as_array(p, (n,))
+            full[:6], full[6:38], full[38:] = x[:6], x[6], x[7]
+            set_x(p_full, slots)
+
+        init(self, len(real), nz, picked(get_x), expanded, picked(get_dx), get_z, picked(get_nominals), *args, **kw)
+
+    fmu, kw, cs_ref = tolerance_case()
+    rows = []
+    for tol in (1e-3, 1e-4, 1e-5, 1e-6):
+        run = lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)  # noqa: E731
+        rows.append((f"{tol:g}", "70 slots") + case_row(run, cs_ref))
+        rows.append((f"{tol:g}", "8 states") + case_row(lambda: with_cvode(sized, run), cs_ref))
     return rows
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
-    ap.add_argument("--only", choices=("interfaces", "events", "tolerance", "orders"), help="one table")
+    ap.add_argument("--only", choices=("interfaces", "events", "tolerance", "orders", "layout"), help="one table")
     args = ap.parse_args(argv)
     cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
     if args.only in (None, "interfaces"):
@@ -176,8 +226,15 @@ def main(argv=None):
     if args.only in (None, "orders"):
         rows = order_rows()
         print("\n| CVode rtol | max BDF order | stability limit detection | p3 at 1 s [bar] "
-              "| max abs p3 error [bar] | max abs p1..p4 [bar] | steps | wall [s] |")
-        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+              "| max abs p3 error [bar] | max abs p1..p4 [bar] | wall [s] |")
+        print("| --- | --- | --- | --- | --- | --- | --- |")
+        for row in rows:
+            print("| " + " | ".join(row) + " |")
+    if args.only in (None, "layout"):
+        rows = layout_rows()
+        print("\n| CVode rtol | CVode's states | p3 at 1 s [bar] | max abs p3 error [bar] | max abs p1..p4 [bar] "
+              "| wall [s] |")
+        print("| --- | --- | --- | --- | --- | --- |")
         for row in rows:
             print("| " + " | ".join(row) + " |")
 
