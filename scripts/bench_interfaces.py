@@ -206,38 +206,31 @@ def main(argv=None):
     args = ap.parse_args(argv)
     cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
     if args.only in (None, "interfaces"):
-        rows = interface_rows(cases)
-        print("\n| case | boom | interface | wall [s] | real-time factor | RHS | max abs p3 error [bar] | max abs stroke error [mm] |")
-        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
-        for sid, boom, interface, wall, rtf, rhs, ep3, ex in rows:
-            print(f"| {sid} | {boom} | {interface} | {wall:.2f} | {rtf:.1f}x | {rhs} | {ep3:.3g} | {ex:.3g} |")
+        print_table(("case", "boom", "interface", "wall [s]", "real-time factor", "RHS", "max abs p3 error [bar]",
+                     "max abs stroke error [mm]"),
+                    [(sid, boom, interface, f"{wall:.2f}", f"{rtf:.1f}x", str(rhs), f"{ep3:.3g}", f"{ex:.3g}")
+                     for sid, boom, interface, wall, rtf, rhs, ep3, ex in interface_rows(cases)])
     if args.only in (None, "events"):
-        rows = event_rows()
-        print("\n| case | event indicators | state events | RHS | wall [s] | max abs p3 error [bar] |")
-        print("| --- | --- | --- | --- | --- | --- |")
-        for sid, on, n_events, rhs, wall, ep3 in rows:
-            print(f"| {sid} | {on} | {n_events} | {rhs} | {wall:.2f} | {ep3:.3g} |")
+        print_table(("case", "event indicators", "state events", "RHS", "wall [s]", "max abs p3 error [bar]"),
+                    [(sid, str(on), str(n_events), str(rhs), f"{wall:.2f}", f"{ep3:.3g}")
+                     for sid, on, n_events, rhs, wall, ep3 in event_rows()])
     if args.only in (None, "tolerance"):
         p3_ref, rows = tolerance_rows()
-        print(f"\n| CVode rtol | p3 at 1 s [bar] (CS rtol 1e-9: {p3_ref:.4g}) | max abs p3 error [bar] | wall [s] |")
-        print("| --- | --- | --- | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
+        print_table(("CVode rtol", f"p3 at 1 s [bar] (CS rtol 1e-9: {p3_ref:.4g})", "max abs p3 error [bar]",
+                     "wall [s]"), rows)
+    measured = ("p3 at 1 s [bar]", "max abs p3 error [bar]", "max abs p1..p4 [bar]", "wall [s]")
     if args.only in (None, "orders"):
-        rows = order_rows()
-        print("\n| CVode rtol | max BDF order | stability limit detection | p3 at 1 s [bar] "
-              "| max abs p3 error [bar] | max abs p1..p4 [bar] | wall [s] |")
-        print("| --- | --- | --- | --- | --- | --- | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
+        print_table(("CVode rtol", "max BDF order", "stability limit detection") + measured, order_rows())
     if args.only in (None, "layout"):
-        rows = layout_rows()
-        print("\n| CVode rtol | CVode's states | p3 at 1 s [bar] | max abs p3 error [bar] | max abs p1..p4 [bar] "
-              "| wall [s] |")
-        print("| --- | --- | --- | --- | --- | --- |")
-        for row in rows:
-            print("| " + " | ".join(row) + " |")
+        print_table(("CVode rtol", "CVode's states") + measured, layout_rows())
 
+
+def print_table(columns: tuple, rows: list) -> None:
+    """A Markdown table of the given column titles and rows of text."""
+    print("\n| " + " | ".join(columns) + " |")
+    print("|" + " --- |" * len(columns))
+    for row in rows:
+        print("| " + " | ".join(row) + " |")
 
 if __name__ == "__main__":
     sys.exit(cosim.cli(main))
