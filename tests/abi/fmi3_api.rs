@@ -787,3 +787,17 @@ fn derivatives_in_initialization_mode() {
         }
     }
 }
+
+/// FMI 3.0, 3.2.1 (fmi3EnterInitializationMode: in Model Exchange the tolerance is the importer's
+/// integrator's): a tolerance looser than the model needs is kept with fmi3Warning and a message
+/// naming both, as in FMI 2.0 (tests/abi/hardening.rs); in Co-Simulation it is fmi3OK.
+#[test]
+fn a_model_exchange_tolerance_looser_than_the_model_needs_is_a_warning() {
+    for (me, expected) in [(true, fmi3Status::Warning), (false, OK)] {
+        let i = Inst::<HydraulicBoom>::new(me);
+        let status = unsafe { api::enter_initialization_mode::<HydraulicBoom>(i.c, true, 1e-4, 0.0, false, 0.0) };
+        let m = i.messages.lock().unwrap().iter().map(|m| m.2.clone()).collect::<Vec<_>>().join(" ");
+        assert_eq!(status, expected, "{m}");
+        assert_eq!(m.contains("tolerance = 0.0001 is looser than the 1e-6"), me, "{m}");
+    }
+}

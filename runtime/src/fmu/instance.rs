@@ -188,7 +188,8 @@ impl<M: Model> Instance<M> {
         }
     }
 
-    /// fmi2SetupExperiment. A tolerance outside [`TOLERANCE_RANGE`] is clamped into it (warning).
+    /// fmi2SetupExperiment. A tolerance outside [`TOLERANCE_RANGE`] is clamped into it (warning);
+    /// in Model Exchange, one looser than [`Model::MODEL_EXCHANGE_TOLERANCE`] is kept with a warning.
     pub fn setup_experiment(
         &mut self,
         tolerance: Option<f64>,
@@ -217,6 +218,24 @@ impl<M: Model> Instance<M> {
             }
             tol => tol,
         };
+        if let (Interface::ModelExchange, Some(tol), Some(needed)) =
+            (self.interface, tolerance, M::MODEL_EXCHANGE_TOLERANCE)
+        {
+            if tol > needed {
+                let looser = format!(
+                    "tolerance = {} is looser than the {} this model needs in Model Exchange: BDF integrators such as \
+                     CVode give wrong, even non-physical, pressures at looser ones (the README's tolerance table); set \
+                     the tolerance to {} or less",
+                    num(tol),
+                    num(needed),
+                    num(needed)
+                );
+                warning = Some(match warning {
+                    Some(w) => format!("{w}; {looser}"),
+                    None => looser,
+                });
+            }
+        }
         if let Some(stop) = stop {
             if !(stop.is_finite() && stop >= start) {
                 return Err(format!("stopTime = {} must be finite and >= startTime = {}", num(stop), num(start)));

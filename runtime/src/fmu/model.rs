@@ -161,6 +161,11 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// at the current time. Default: nothing to do.
     fn inputs_set(&mut self, _vrs: &[u32]) {}
 
+    /// The loosest relative tolerance a BDF integrator (CVode, DASSL) needs for the model in Model
+    /// Exchange, as measured; an importer that sets a looser one gets a warning naming this one.
+    /// Default: none (any tolerance).
+    const MODEL_EXCHANGE_TOLERANCE: Option<f64> = None;
+
     /// The ODE Co-Simulation integrates: the same equations as [`Model::derivatives`], in the
     /// model's native coordinates (the rigid boom in its stroke, where Model Exchange exposes
     /// its angle; the flexible boom without the padded slots of Model Exchange's fixed layout).

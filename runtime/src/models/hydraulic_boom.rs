@@ -9,7 +9,7 @@
 //! slope the master passes with fmi2SetRealInputDerivatives (held without one).
 
 pub use super::boom::Boom;
-use super::circuit::CIRCUIT_SCALE;
+use super::circuit::{CIRCUIT_SCALE, ME_TOLERANCE};
 use super::port::Ramp;
 use super::exposed::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
 use super::table::{
@@ -222,6 +222,7 @@ impl Model for HydraulicBoom {
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &PLANT_STATES;
+    const MODEL_EXCHANGE_TOLERANCE: Option<f64> = Some(ME_TOLERANCE);
     const EVENT_INDICATORS: &'static [u32] = super::circuit::EVENT_INDICATORS;
 
     fn configurations() -> Vec<Vec<(u32, Value)>> {

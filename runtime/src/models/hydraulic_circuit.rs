@@ -11,7 +11,7 @@
 //! point, but within a step the circuit uses the integral of v, whose slope is the velocity the
 //! master sends with x.
 
-use super::circuit::CIRCUIT_SCALE;
+use super::circuit::{CIRCUIT_SCALE, ME_TOLERANCE};
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
 use super::table::{
@@ -250,6 +250,7 @@ impl Model for HydraulicCircuit {
     };
     const VARIABLES: &'static [Variable] = &TABLE;
     const STATES: &'static [ContinuousState] = &CIRCUIT_STATES;
+    const MODEL_EXCHANGE_TOLERANCE: Option<f64> = Some(ME_TOLERANCE);
     const EVENT_INDICATORS: &'static [u32] = super::circuit::EVENT_INDICATORS;
     const DIRECTIONAL_DERIVATIVES: bool = true;
 
