@@ -89,6 +89,11 @@ fn the_page_states_generated_facts() {
     assert!(page.contains("(25 l/min)"), "Q_rated in l/min");
     let i = Pfc::INFO;
     assert!(page.contains(&format!("{} to {} s", i.start_time, i.stop_time)));
+    // The Model Exchange tolerance the model needs: any for the controller's linear filter, the
+    // circuit's 1e-6 for HydraulicBoom (the README's tolerance table), the one its warning names.
+    assert!(page.contains("<th>Model Exchange tolerance</th><td>any</td>"), "controller: any tolerance");
+    let page = boomsim_tools::pack::documentation::<boomsim::models::HydraulicBoom>(Version::Fmi2, platforms);
+    assert!(page.contains("<th>Model Exchange tolerance</th><td>1e-6 or tighter"), "HydraulicBoom: 1e-6");
 }
 
 /// The two halves of the cut carry the same coupling recipe (start.F, Z_c, step order, end stops).

@@ -160,6 +160,17 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
         ),
         (interpolation, if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") }),
         ("Log categories", categories.join(", ")),
+        (
+            "Model Exchange tolerance",
+            match M::MODEL_EXCHANGE_TOLERANCE {
+                Some(t) => format!(
+                    "{} or tighter with a BDF integrator such as CVode; a looser one set at initialisation is kept \
+                     with a warning",
+                    num(t)
+                ),
+                None => "any".into(),
+            },
+        ),
         ("After an error", after_error.to_owned()),
         ("Variables", M::VARIABLES.len().to_string()),
     ];
