@@ -13,9 +13,10 @@ crosses the dead band): ME with and without CVode's root finding on them. A thir
 tolerance an ME user picks: HydraulicBoom alone (rigid, valve.u_ref = -0.3 from rest, 1 s)
 through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9; a fourth
 the same at rtol 1e-3 to 1e-5 with CVode's largest BDF order limited to 2 or 1, or its stability
-limit detection on (`--only orders`, 10 s), and a fifth with CVode on the 8 states of the rigid
-boom instead of the FMU's 70 padded slots (`--only layout`, 5 s). A benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 10 minutes on 2 cores (the flexible
-references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
+limit detection on (`--only orders`, 10 s), and a fifth with CVode on the boom's own states
+(8 rigid, 24 flexible) instead of the FMU's 70 padded slots (`--only layout`, 2 minutes). A
+benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 12 minutes on 2 cores
+(the flexible references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
 """
 
 import argparse
@@ -71,14 +72,14 @@ def event_rows() -> list:
     return rows
 
 
-def tolerance_case():
-    """HydraulicBoom ME alone (rigid, u_ref -0.3 from rest, 1 s): the FMU, the simulate_fmu
-    arguments and the reference (CS at rtol 1e-9)."""
+def tolerance_case(flexible: bool = False):
+    """HydraulicBoom ME alone (rigid unless `flexible`, u_ref -0.3 from rest, 1 s): the FMU, the
+    simulate_fmu arguments and the reference (CS at rtol 1e-9)."""
     from fmpy import simulate_fmu
 
     fmu = str(cosim.FMU_DIR / "HydraulicBoom.fmu")
     kw = dict(stop_time=1.0, output_interval=1e-3, output=["p1", "p2", "p3", "p4"],
-              start_values={"boom.flexible": False, "valve.u_ref": -0.3})
+              start_values={"boom.flexible": flexible, "valve.u_ref": -0.3})
     return fmu, kw, simulate_fmu(fmu, fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
 
 
@@ -122,7 +123,10 @@ def case_row(run, cs_ref) -> tuple:
     try:
         r, wall = timed(run)
     except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
-        return ("failed", str(e).split(":")[0][:60], "-", "-")
+        # fmpy's CVode errors name SUNDIALS' source file before saying what happened.
+        text = str(e)
+        what = text.split(" in module")[0] + ": " + text.rsplit(": ", 1)[-1] if " in module" in text else text
+        return ("failed", what[:120], "-", "-")
     p_max = max(np.abs(r[p]).max() for p in ("p1", "p2", "p3", "p4")) / 1e5
     return (f"{r['p3'][-1] / 1e5:.4g}", f"{p3_error(r, cs_ref):.3g}", f"{p_max:.4g}", f"{wall:.2f}")
 
@@ -159,43 +163,52 @@ def order_rows() -> list:
 
 
 def layout_rows() -> list:
-    """The tolerance case with CVode given the FMU's 70 Model Exchange slots (6 circuit states and
-    32 section angles and rates, the rigid boom's angle and rate copied into every section's slots)
-    or only the 8 states the rigid boom has, the copies filled in before every call to the FMU:
-    whether the padding, which leaves the pressures 6 of CVode's 70 error-norm components, is what
-    fails at loose tolerances."""
-    print("Layout (the tolerance case, CVode on the 70 slots or on the 8 real states) ...", flush=True)
+    """The tolerance case, rigid and flexible (the default 4 + 5 sections), with CVode given the
+    FMU's 70 Model Exchange slots (6 circuit states, 32 section angles and 32 rates, the slots
+    beyond the last section copies of it) or only the boom's own states (8 rigid, 24 flexible),
+    the copies filled in before every call to the FMU: whether the padding, which leaves the
+    pressures 6 of CVode's 70 error-norm components, is what fails at loose tolerances."""
+    print("Layout (the tolerance case, CVode on the 70 slots or on the boom's own states) ...", flush=True)
     import ctypes
 
     from fmpy import simulate_fmu
 
-    slots, real = 70, [0, 1, 2, 3, 4, 5, 6, 38]  # p1..p4, x_v, u_cbv, section[1].phi, section[1].omega
+    slots, sections = 70, 32
     pointer = ctypes.POINTER(ctypes.c_double)
 
-    def sized(init, self, nx, nz, get_x, set_x, get_dx, get_z, get_nominals, *args, **kw):
-        assert nx == slots, nx
-        full = np.zeros(slots)
-        p_full = full.ctypes.data_as(pointer)
+    def sized(n):
+        """CVode on the circuit's 6 states and the first n sections' angles and rates."""
+        real = [*range(6 + n), *range(6 + sections, 6 + sections + n)]
 
-        def picked(get):
-            def f(p, n):
-                get(p_full, slots)
-                np.ctypeslib.as_array(p, (n,))[:] = full[real]
-            return f
+        def adapt(init, self, nx, nz, get_x, set_x, get_dx, get_z, get_nominals, *args, **kw):
+            assert nx == slots, nx
+            full = np.zeros(slots)
+            p_full = full.ctypes.data_as(pointer)
 
-        def expanded(p, n):
-            x = np.ctypeslib.as_array(p, (n,))
-            full[:6], full[6:38], full[38:] = x[:6], x[6], x[7]
-            set_x(p_full, slots)
+            def picked(get):
+                def f(p, m):
+                    get(p_full, slots)
+                    np.ctypeslib.as_array(p, (m,))[:] = full[real]
+                return f
 
-        init(self, len(real), nz, picked(get_x), expanded, picked(get_dx), get_z, picked(get_nominals), *args, **kw)
+            def expanded(p, m):
+                x = np.ctypeslib.as_array(p, (m,))
+                phi, omega = x[6:6 + n], x[6 + n:]
+                full[:6], full[6:6 + n], full[6 + n:6 + sections] = x[:6], phi, phi[-1]
+                full[6 + sections:6 + sections + n], full[6 + sections + n:] = omega, omega[-1]
+                set_x(p_full, slots)
 
-    fmu, kw, cs_ref = tolerance_case()
+            init(self, len(real), nz, picked(get_x), expanded, picked(get_dx), get_z, picked(get_nominals),
+                 *args, **kw)
+        return adapt
+
     rows = []
-    for tol in (1e-3, 1e-4, 1e-5, 1e-6):
-        run = lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)  # noqa: E731
-        rows.append((f"{tol:g}", "70 slots") + case_row(run, cs_ref))
-        rows.append((f"{tol:g}", "8 states") + case_row(lambda: with_cvode(sized, run), cs_ref))
+    for boom, n in (("rigid", 1), ("flexible", 9)):
+        fmu, kw, cs_ref = tolerance_case(flexible=boom == "flexible")
+        for tol in (1e-3, 1e-4, 1e-5, 1e-6):
+            run = lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)  # noqa: E731
+            rows.append((boom, f"{tol:g}", "70 slots") + case_row(run, cs_ref))
+            rows.append((boom, f"{tol:g}", f"{6 + 2 * n} states") + case_row(lambda: with_cvode(sized(n), run), cs_ref))
     return rows
 
 
@@ -222,7 +235,7 @@ def main(argv=None):
     if args.only in (None, "orders"):
         print_table(("CVode rtol", "max BDF order", "stability limit detection") + measured, order_rows())
     if args.only in (None, "layout"):
-        print_table(("CVode rtol", "CVode's states") + measured, layout_rows())
+        print_table(("boom", "CVode rtol", "CVode's states") + measured, layout_rows())
 
 
 def print_table(columns: tuple, rows: list) -> None:
