@@ -16,7 +16,8 @@ the same at rtol 1e-3 to 1e-5 with CVode's largest BDF order limited to 2 or 1, 
 limit detection on (`--only orders`, 10 s), and a fifth with CVode on the boom's own states
 (8 rigid, 24 flexible) instead of the FMU's 70 padded slots (`--only layout`, 2 minutes). A
 benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 12 minutes on 2 cores
-(the flexible references take most of it). Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only]
+(the flexible references take most of it).
+Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only] [--only TABLE]
 """
 
 import argparse
@@ -96,11 +97,9 @@ def tolerance_rows() -> tuple:
     fmu, kw, cs_ref = tolerance_case()
     rows = []
     for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
-        try:
-            r, wall = timed(simulate_fmu, fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)
-            rows.append((f"{tol:g}", f"{r['p3'][-1] / 1e5:.4g}", f"{p3_error(r, cs_ref):.3g}", f"{wall:.2f}"))
-        except Exception as e:  # noqa: BLE001 - a failed run is a row of the table
-            rows.append((f"{tol:g}", "failed", str(e).split(":")[0][:60], "-"))
+        p3, error, _, wall = case_row(lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw),
+                                      cs_ref)
+        rows.append((f"{tol:g}", p3, error, wall))
     return cs_ref["p3"][-1] / 1e5, rows
 
 
@@ -244,6 +243,7 @@ def print_table(columns: tuple, rows: list) -> None:
     print("|" + " --- |" * len(columns))
     for row in rows:
         print("| " + " | ".join(row) + " |")
+
 
 if __name__ == "__main__":
     sys.exit(cosim.cli(main))
