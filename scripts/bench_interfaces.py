@@ -14,7 +14,7 @@ tolerance an ME user picks: HydraulicBoom alone (rigid, valve.u_ref = -0.3 from 
 through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9; a fourth
 the same at rtol 1e-3 to 1e-5 with CVode's largest BDF order limited to 2 or 1, or its stability
 limit detection on (`--only orders`, 10 s), and a fifth with CVode on the boom's own states
-(8 rigid, 24 flexible) instead of the FMU's 70 padded slots (`--only layout`, 2 minutes). A
+(7 rigid, 23 flexible) instead of the FMU's 69 padded slots (`--only layout`, 2 minutes). A
 benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 12 minutes on 2 cores
 (the flexible references take most of it).
 Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only] [--only TABLE]
@@ -97,9 +97,9 @@ def tolerance_rows() -> tuple:
     fmu, kw, cs_ref = tolerance_case()
     rows = []
     for tol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
-        p3, error, _, wall = case_row(lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw),
-                                      cs_ref)
-        rows.append((f"{tol:g}", p3, error, wall))
+        run = lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)  # noqa: E731
+        p3, error, p_max, wall = case_row(run, cs_ref)
+        rows.append((f"{tol:g}", p3, error, p_max, wall))
     return cs_ref["p3"][-1] / 1e5, rows
 
 
@@ -163,21 +163,24 @@ def order_rows() -> list:
 
 def layout_rows() -> list:
     """The tolerance case, rigid and flexible (the default 4 + 5 sections), with CVode given the
-    FMU's 70 Model Exchange slots (6 circuit states, 32 section angles and 32 rates, the slots
-    beyond the last section copies of it) or only the boom's own states (8 rigid, 24 flexible),
-    the copies filled in before every call to the FMU: whether the padding, which leaves the
-    pressures 6 of CVode's 70 error-norm components, is what fails at loose tolerances."""
-    print("Layout (the tolerance case, CVode on the 70 slots or on the boom's own states) ...", flush=True)
+    FMU's Model Exchange slots (the circuit's 5 states, 32 section angles and 32 rates, the
+    slots beyond the last section copies of it) or only the boom's own states (7 rigid, 23
+    flexible), the copies filled in before every call to the FMU: whether the padding, which
+    leaves the pressures 3 of CVode's 69 error-norm components, is what fails at loose
+    tolerances."""
+    print("Layout (the tolerance case, CVode on the 69 slots or on the boom's own states) ...", flush=True)
     import ctypes
 
-    from fmpy import simulate_fmu
+    from fmpy import read_model_description, simulate_fmu
 
-    slots, sections = 70, 32
+    sections = 32
+    slots = len(read_model_description(tolerance_case()[0]).derivatives)
+    circuit = slots - 2 * sections
     pointer = ctypes.POINTER(ctypes.c_double)
 
     def sized(n):
-        """CVode on the circuit's 6 states and the first n sections' angles and rates."""
-        real = [*range(6 + n), *range(6 + sections, 6 + sections + n)]
+        """CVode on the circuit's states and the first n sections' angles and rates."""
+        real = [*range(circuit + n), *range(circuit + sections, circuit + sections + n)]
 
         def adapt(init, self, nx, nz, get_x, set_x, get_dx, get_z, get_nominals, *args, **kw):
             assert nx == slots, nx
@@ -192,9 +195,10 @@ def layout_rows() -> list:
 
             def expanded(p, m):
                 x = np.ctypeslib.as_array(p, (m,))
-                phi, omega = x[6:6 + n], x[6 + n:]
-                full[:6], full[6:6 + n], full[6 + n:6 + sections] = x[:6], phi, phi[-1]
-                full[6 + sections:6 + sections + n], full[6 + sections + n:] = omega, omega[-1]
+                phi, omega = x[circuit:circuit + n], x[circuit + n:]
+                full[:circuit], full[circuit:circuit + n] = x[:circuit], phi
+                full[circuit + n:circuit + sections] = phi[-1]
+                full[circuit + sections:circuit + sections + n], full[circuit + sections + n:] = omega, omega[-1]
                 set_x(p_full, slots)
 
             init(self, len(real), nz, picked(get_x), expanded, picked(get_dx), get_z, picked(get_nominals),
@@ -206,8 +210,9 @@ def layout_rows() -> list:
         fmu, kw, cs_ref = tolerance_case(flexible=boom == "flexible")
         for tol in (1e-3, 1e-4, 1e-5, 1e-6):
             run = lambda: simulate_fmu(fmu, fmi_type="ModelExchange", relative_tolerance=tol, **kw)  # noqa: E731
-            rows.append((boom, f"{tol:g}", "70 slots") + case_row(run, cs_ref))
-            rows.append((boom, f"{tol:g}", f"{6 + 2 * n} states") + case_row(lambda: with_cvode(sized(n), run), cs_ref))
+            rows.append((boom, f"{tol:g}", f"{slots} slots") + case_row(run, cs_ref))
+            rows.append((boom, f"{tol:g}", f"{circuit + 2 * n} states")
+                        + case_row(lambda: with_cvode(sized(n), run), cs_ref))
     return rows
 
 
@@ -229,7 +234,7 @@ def main(argv=None):
     if args.only in (None, "tolerance"):
         p3_ref, rows = tolerance_rows()
         print_table(("CVode rtol", f"p3 at 1 s [bar] (CS rtol 1e-9: {p3_ref:.4g})", "max abs p3 error [bar]",
-                     "wall [s]"), rows)
+                     "max abs p1..p4 [bar]", "wall [s]"), rows)
     measured = ("p3 at 1 s [bar]", "max abs p3 error [bar]", "max abs p1..p4 [bar]", "wall [s]")
     if args.only in (None, "orders"):
         print_table(("CVode rtol", "max BDF order", "stability limit detection") + measured, order_rows())

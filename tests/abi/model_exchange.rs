@@ -7,6 +7,7 @@ use crate::common;
 use boomsim::fmi2::api;
 use boomsim::fmi2::types::*;
 use boomsim::fmu::Model;
+use boomsim::hydraulics::circuit::{N_STATES as C, X_V};
 use boomsim::models::pressure_feedback_controller::vr as pfc;
 use boomsim::models::{vr, BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
 use crate::common::Slave;
@@ -265,15 +266,15 @@ fn slots_beyond_the_last_section_repeat_it() {
         let (mut x, mut dx) = (vec![0.0; n], vec![0.0; n]);
         assert_eq!(api::get_continuous_states::<HydraulicBoom>(s.c, x.as_mut_ptr(), n), OK);
         assert_eq!(api::enter_continuous_time_mode::<HydraulicBoom>(s.c), OK);
-        x[6 + 3] += 1e-3; // bend the arm: section 4 turns
+        x[C + 3] += 1e-3; // bend the arm: section 4 turns
         assert_eq!(api::set_continuous_states::<HydraulicBoom>(s.c, x.as_ptr(), n), OK);
         assert_eq!(api::get_derivatives::<HydraulicBoom>(s.c, dx.as_mut_ptr(), n), OK);
         for k in 9..32 {
-            for (a, b) in [(6 + 8, 6 + k), (38 + 8, 38 + k)] {
+            for (a, b) in [(C + 8, C + k), (C + 32 + 8, C + 32 + k)] {
                 assert_eq!((x[a], dx[a]), (x[b], dx[b]), "slot {}", k + 1);
             }
         }
-        assert!(dx[38 + 3] != 0.0, "the bent section accelerates");
+        assert!(dx[C + 32 + 3] != 0.0, "the bent section accelerates");
     }
 }
 
@@ -291,8 +292,8 @@ fn a_rate_state_beyond_the_largest_number_is_refused() {
         let (mut x, mut after) = (vec![0.0; n], vec![0.0; n]);
         assert_eq!(api::get_continuous_states::<HydraulicBoom>(s.c, x.as_mut_ptr(), n), OK);
         let mut bad = vec![0.0; n];
-        bad[6..38].fill(0.0); // theta2 = 0: horizontal
-        bad[38..].fill(f64::MAX);
+        bad[C..C + 32].fill(0.0); // theta2 = 0: horizontal
+        bad[C + 32..].fill(f64::MAX);
         bad[0] = 7e6;
         assert_eq!(api::set_continuous_states::<HydraulicBoom>(s.c, bad.as_ptr(), n), ERR);
         assert!(s.last_error().contains("boom.section[1].omega = 1.7976931348623157e308 rad/s"), "{}", s.last_error());
@@ -339,7 +340,7 @@ fn event_indicators_mark_the_dead_band() {
         for (x_v, signs) in
             [(0.0, [-1.0, -1.0, 1.0]), (2.0 * x_db, [-1.0, 1.0, 1.0]), (-2.0 * x_db, [-1.0, -1.0, -1.0])]
         {
-            x[4] = x_v;
+            x[X_V] = x_v;
             assert_eq!(api::set_continuous_states::<HydraulicBoom>(s.c, x.as_ptr(), n), OK);
             assert_eq!(api::get_event_indicators::<HydraulicBoom>(s.c, z.as_mut_ptr(), 3), OK);
             let got: Vec<f64> = z.iter().map(|z| z.signum()).collect();

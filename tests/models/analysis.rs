@@ -35,7 +35,7 @@ struct Variant {
 }
 
 fn hydraulic_vr(name: &str) -> u32 {
-    vr::HYDRAULICS + PARAMS.iter().position(|p| p.spec.name == name).expect("parameter") as u32
+    vr::hydraulic(PARAMS.iter().position(|p| p.spec.name == name).expect("parameter"))
 }
 
 fn circuit(v: &Variant) -> Circuit {

@@ -80,11 +80,45 @@ def test_scenarios_as_model_exchange_match_co_simulation(scenario, boom, toleran
     assert regress.compare(f"{scenario}-{boom} ME", me, cs, rules) == []
 
 
+@pytest.mark.parametrize("flexible", [False, True])
+def test_model_exchange_at_an_importers_tolerance(flexible):
+    """HydraulicBoom alone, u_ref = -0.3 from rest, 1 s: the lowering oscillates (p3 swings
+    between 3 and 239 bar at about 3 Hz). Under fmpy's CVode at rtol 1e-4, the default tolerance
+    of Dymola and OMSimulator, against the FMU's own Radau IIA at rtol 1e-9 (a second
+    integrator): p3 within 2 bar at every output point (issue 27's acceptance; 1 % of its swing),
+    and every pressure within [-1.01325, 400] bar: above absolute vacuum, and below 400 bar, which
+    no state of this circuit reaches (supply 200 bar, CBV setting 210 bar; the reference peaks at
+    239 bar). Before line 1 was quasi-static, CVode's iterates overshot p1 through the
+    compensator's kinks and the run reached 5e7 bar with OK statuses."""
+    kw = dict(stop_time=1.0, output_interval=1e-3, output=["p1", "p2", "p3", "p4"],
+              start_values={"boom.flexible": flexible, "valve.u_ref": -0.3})
+    me = simulate_fmu(fmu_path("HydraulicBoom"), fmi_type="ModelExchange", relative_tolerance=1e-4, **kw)
+    ref = simulate_fmu(fmu_path("HydraulicBoom"), fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
+    error = np.abs(np.interp(ref["time"], me["time"], me["p3"]) - ref["p3"]).max() / 1e5
+    assert error < 2.0, f"p3 {error:.3g} bar off"
+    for p in ("p1", "p2", "p3", "p4"):
+        assert -1.01325e5 <= me[p].min() and me[p].max() <= 400e5, (p, me[p].min(), me[p].max())
+
+
+def test_compensated_lowering_at_an_importers_tolerance(tolerances):
+    """Scenario B (rigid boom, plant and controller as one ME system) under CVode at rtol 1e-4:
+    every regression metric within the regression suite's own tolerances of the CS run
+    (scripts/baselines/tolerances.toml). Not covered, as measured (README, Model Exchange
+    tolerance): U rigid fails at 3.9 s (CVode sets p4 below absolute vacuum, which the
+    controller refuses), B flexible's u_comp_rms is 2.6 times the CS value, U flexible passes
+    but takes 2.6 million RHS (8 minutes)."""
+    sc = cosim.load_scenario("B")
+    me = metrics.compute(cosim.run_me(sc, "rigid", tolerance=1e-4))
+    cs = metrics.compute(cosim.run(sc, "rigid"))
+    assert regress.compare("B-rigid ME 1e-4", me, cs, tolerances) == []
+
+
 def test_directional_derivatives_through_fmpy():
-    """HydraulicCircuit's Jacobian column of the state p4 through fmpy's getDirectionalDerivative
+    """HydraulicCircuit's Jacobian column of the state cbv.u_cbv (the load-holding valve 30 %
+    open while lowering: it drives p2, p3 and itself) through fmpy's getDirectionalDerivative
     against central differences of fmpy's getDerivatives: relative 1e-6 on the entries above
-    1e-8 of the column's largest (h = 1 Pa: truncation h^2 f''' and round-off eps |f| / h both
-    below 1e-8 of the entries)."""
+    1e-8 of the column's largest (h = 1e-7 of the opening: truncation h^2 f''' and round-off
+    eps |f| / h both below 1e-8 of the entries)."""
     from ctypes import POINTER, c_double
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Model
@@ -102,10 +136,12 @@ def test_directional_derivatives_through_fmpy():
     m.newDiscreteStates()
     m.enterContinuousTimeMode()
     n = len(md.derivatives)
+    state = {d.variable.derivative.name: k for k, d in enumerate(md.derivatives)}
     x = np.zeros(n)
     m.getContinuousStates(x.ctypes.data_as(POINTER(c_double)), n)
-    x[3] += 20e5  # rod side pressurised: the valve and the CBV pilot act
-    x[4] = -2e-3  # spool open, lowering
+    x[state["p4"]] += 20e5  # rod side pressurised: the valve and the CBV pilot act
+    x[state["valve.x_v"]] = -2e-3  # spool open, lowering
+    x[state["cbv.u_cbv"]] = 0.3
 
     def derivatives(x):
         m.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), n)
@@ -113,11 +149,12 @@ def test_directional_derivatives_through_fmpy():
         m.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), n)
         return dx
 
-    h = 1.0
-    column = (derivatives(x + h * np.eye(n)[3]) - derivatives(x - h * np.eye(n)[3])) / (2 * h)
+    h = 1e-7
+    seed = np.eye(n)[state["cbv.u_cbv"]]
+    column = (derivatives(x + h * seed) - derivatives(x - h * seed)) / (2 * h)
     derivatives(x)
     ders = [d.variable.valueReference for d in md.derivatives]
-    dd = np.array(m.getDirectionalDerivative(ders, [vr["p4"]], [1.0]))
+    dd = np.array(m.getDirectionalDerivative(ders, [vr["cbv.u_cbv"]], [1.0]))
     big = np.abs(dd) > 1e-8 * np.abs(dd).max()
     assert big.sum() >= 2
     assert np.allclose(dd[big], column[big], rtol=1e-6, atol=0), (dd, column)

@@ -10,13 +10,16 @@ Needs `boomsim pack --platforms all` (scripts/test does it) and scripts/setup-cr
 What agrees how well, and why:
 - the controller's outputs to 1e-12 relative: a closed-form filter (exp, arithmetic), identical
   code; only libm's exp may differ, by an ulp;
-- the plants' outputs, at rtol 1e-6, to 1e-5 of each output's largest magnitude over the run: the
-  same code, but the platforms' libm (glibc on x86-64 and aarch64, msvcrt on Windows) differs in
-  the last bit of exp, pow, tanh, sin/cos/acos, and the adaptive Radau IIA integrator turns such
-  differences into different step sequences: two integrations of the same ODE, each with its
-  global error a small multiple of rtol, so they may differ by a few rtol (10 rtol allowed). A real
-  defect (a wrong ABI, a mis-linked math function, a truncated constant) is far larger. The
-  largest differences are printed (pytest -s) and quoted in the README."""
+- the plants' outputs, at rtol 1e-6, to 1e-5 of each output's largest magnitude over the run, or
+  to twice linux64's own global error in that output where it is larger: the same code, but the
+  platforms' libm (glibc on x86-64 and aarch64, msvcrt on Windows) differs in the last bit of exp,
+  pow, tanh, sin/cos/acos, and the adaptive Radau IIA integrator turns such differences into
+  different step sequences: two integrations of the same ODE, each within its global error of the
+  converged solution, so they may differ by that much. The global error is measured against the
+  same run at rtol 1e-10 on linux64; it is a few rtol except where the controller's high-pass
+  filter differentiates the integrator's error (B with the flexible arm: 1e-4 of Q4's range as
+  the spool opens). A real defect (a wrong ABI, a mis-linked math function, a truncated constant)
+  is far larger. The largest differences are printed (pytest -s) and quoted in the README."""
 
 import os
 import pathlib
@@ -101,11 +104,13 @@ def runs(hosts, unpacked):
     """run(), each (scenario, platform, FMI version) once for the tests of this module."""
     done = {}
 
-    def get(name, platform, fmi):
-        if (name, platform, fmi) not in done:
+    def get(name, platform, fmi, converged=False):
+        if (name, platform, fmi, converged) not in done:
             _, fmus, steps, ops, _ = next(s for s in SCENARIOS if s[0] == name)
-            done[name, platform, fmi] = run(hosts, unpacked, platform, steps, fmus, ops, fmi)
-        return done[name, platform, fmi]
+            if converged:
+                ops = [o for o in ops if not o.startswith("tol:")] + ["tol:1e-10"]
+            done[name, platform, fmi, converged] = run(hosts, unpacked, platform, steps, fmus, ops, fmi)
+        return done[name, platform, fmi, converged]
 
     return get
 
@@ -178,15 +183,20 @@ def test_every_platform_computes_the_same(runs, name, fmus, steps, ops, rtol, fm
     through FMI 2.0 and FMI 3.0."""
     reference = runs(name, "linux64", fmi)
     assert len(reference) == steps // 100 and all(len(r) == len(reference[0]) for r in reference)
+    # Relative to each output's largest magnitude over the run (a flow crossing zero has no
+    # relative error of its own).
+    columns = range(len(reference[0]))
+    scale = [max(abs(r[j]) for r in reference) or 1.0 for j in columns]
+    converged = runs(name, "linux64", fmi, converged=True)
+    bound = [max(rtol, 2 * max(abs(a[j] - c[j]) for a, c in zip(reference, converged)) / scale[j]) for j in columns]
     for platform in PLATFORMS[1:]:
         rows = runs(name, platform, fmi)
         assert len(rows) == len(reference)
-        # Relative to each output's largest magnitude over the run (a flow crossing zero has no
-        # relative error of its own).
-        scale = [max(abs(r[j]) for r in reference) or 1.0 for j in range(len(reference[0]))]
-        worst = max(abs(a - b) / s for a_row, b_row in zip(reference, rows) for a, b, s in zip(a_row, b_row, scale))
-        print(f"{name} on {platform}, FMI {fmi}: largest relative difference to linux64 {worst:.3g}")
-        assert worst <= rtol, f"{name} on {platform}, FMI {fmi}: {worst:.3g} > {rtol:g}"
+        excess = [max(abs(a[j] - b[j]) for a, b in zip(reference, rows)) / scale[j] / bound[j] for j in columns]
+        j = max(columns, key=lambda j: excess[j])
+        print(f"{name} on {platform}, FMI {fmi}: largest relative difference to linux64 "
+              f"{excess[j] * bound[j]:.3g} (output {j}, allowed {bound[j]:.3g})")
+        assert excess[j] <= 1.0, f"{name} on {platform}, FMI {fmi}: output {j} {excess[j] * bound[j]:.3g} > {bound[j]:.3g}"
 
 
 @pytest.mark.parametrize("platform", PLATFORMS)

@@ -129,11 +129,21 @@ impl Dcv {
     /// The roots are regularised ([`orifice::reg_sqrt`]); a reversed pressure drop gives reverse
     /// flow instead of the thesis' undefined root.
     pub fn flows<T: Scalar>(&self, u: T, p1: T, p2: T, p4: T, p_t: f64, p_tr: f64) -> [T; 2] {
-        let k1 = self.k1();
+        let q_p = self.p_flow(u, p1, p2, p4, p_tr);
         if u >= 0.0 {
-            [orifice::flow(k1, u, p1 - p2, p_tr), orifice::flow(k1, u, p4 - p_t, p_tr)]
+            [q_p, orifice::flow(self.k1(), u, p4 - p_t, p_tr)]
         } else {
-            [orifice::flow(k1, u, p2 - p_t, p_tr), orifice::flow(k1, u, p1 - p4, p_tr)]
+            [orifice::flow(self.k1(), u, p2 - p_t, p_tr), -q_p]
+        }
+    }
+
+    /// The flow out of line 1 through the P port, `Q_P`: Q2 (2.40) for `u >= 0`, -Q4 (2.43) for
+    /// `u < 0`, the one metering flow of [`Dcv::flows`] that p1 drives.
+    pub fn p_flow<T: Scalar>(&self, u: T, p1: T, p2: T, p4: T, p_tr: f64) -> T {
+        if u >= 0.0 {
+            orifice::flow(self.k1(), u, p1 - p2, p_tr)
+        } else {
+            -orifice::flow(self.k1(), u, p1 - p4, p_tr)
         }
     }
 

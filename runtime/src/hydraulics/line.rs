@@ -85,8 +85,6 @@ fn exp_small<T: Scalar>(x: T) -> T {
 /// Line volumes of Fig. 2.8 (section 5.1.1) and the hose compliance (eq. 5.2, Table 5.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lines {
-    /// Volume between PCV and main spool, `V_L1` 2 cm^3 (inside the valve block: rigid).
-    pub v_l1: f64,
     /// Line 2 (DCV port A to CBV, hose H1), `V_L2` 100 cm^3.
     pub v_l2: f64,
     /// Line 3 (CBV to piston-side chamber, hose H2), `V_L3` 150 cm^3.
@@ -187,7 +185,7 @@ mod tests {
     #[test]
     fn mass_conservation_and_no_vacuum() {
         let f = fluid();
-        let lines = Lines { v_l1: 0.0, v_l2: 100.0 * CM3, v_l3: 0.0, v_l4: 0.0, c_hose: 0.00065e-5 };
+        let lines = Lines { v_l2: 100.0 * CM3, v_l3: 0.0, v_l4: 0.0, c_hose: 0.00065e-5 };
         let c_wall = lines.hose_compliance(lines.v_l2);
         let v0_dead = lines.v_l2;
         let area = 3.3e-3;

@@ -422,16 +422,6 @@ pub const PARAMS: &[Param] = &[
         "not in the thesis (constant bulk modulus); a fifth of Simscape's 0.5 % for the same law: README, Cavitation"
     ),
     param!(
-        "line.v_l1",
-        lines.v_l1,
-        2.0 * CM3,
-        "m3",
-        "cm3",
-        [0.01 * CM3, 1e4 * CM3],
-        "Volume between PCV and main spool",
-        "parameter list, 5.1.1"
-    ),
-    param!(
         "line.v_l2",
         lines.v_l2,
         100.0 * CM3,
@@ -563,7 +553,7 @@ impl Default for Circuit {
                 c_l: 0.0,
             },
             fluid: Fluid { beta: 0.0, air_fraction: 0.0 },
-            lines: Lines { v_l1: 0.0, v_l2: 0.0, v_l3: 0.0, v_l4: 0.0, c_hose: 0.0 },
+            lines: Lines { v_l2: 0.0, v_l3: 0.0, v_l4: 0.0, c_hose: 0.0 },
             p_tr: 0.0,
         };
         for p in PARAMS {

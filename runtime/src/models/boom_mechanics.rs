@@ -163,7 +163,7 @@ impl BoomMechanics {
     fn with_state(values: &Values, state: Option<&[f64]>, t: f64, [input, c_m]: [f64; 2]) -> Result<Self, String> {
         let mut circuit = Circuit::default();
         for k in [STROKE, K_STOP, C_STOP] {
-            (PARAMS[k].set)(&mut circuit, values.real(vr::HYDRAULICS + k as u32));
+            (PARAMS[k].set)(&mut circuit, values.real(vr::hydraulic(k)));
         }
         let (cylinder, stroke) = (circuit.cylinder, circuit.cylinder.stroke);
         let boom = Boom::from_values(values, stroke)?;

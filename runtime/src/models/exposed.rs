@@ -9,6 +9,7 @@
 
 use super::vr;
 use crate::fmu::{ContinuousState, Seeds, Variable};
+use crate::hydraulics::circuit::N_STATES as N_CIRCUIT;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::scalar::Dual64;
 
@@ -16,20 +17,22 @@ use crate::scalar::Dual64;
 const PHI_NOMINAL: f64 = 2e-3;
 const OMEGA_NOMINAL: f64 = 0.1;
 
-/// `der()` of state `k` of HydraulicBoom's layout (the circuit's six, then the boom's 64); the
-/// same value reference in every model that has the state.
+/// The value reference of `der()` of slot `k` of HydraulicBoom's layout as it was with line 1
+/// integrated (p1, the circuit's other five, then the boom's 64); the same in every model that
+/// has the state. Slot 0, der(p1), is retired: line 1 is quasi-static
+/// ([`crate::hydraulics::Circuit::line1_pressure`]).
 const fn der_vr(k: usize) -> u32 {
     vr::DERIVATIVES + k as u32
 }
 
-/// The circuit's states p1..p4, spool position, load-holding opening, with their nominals
+/// The circuit's states p2..p4, spool position, load-holding opening, with their nominals
 /// ([`super::circuit::CIRCUIT_SCALE`]).
-pub(crate) const CIRCUIT_STATES: [ContinuousState; 6] = {
-    let r = [vr::P1, vr::P2, vr::P3, vr::P4, vr::X_V, vr::U_CBV];
-    let mut s = [ContinuousState { state: 0, derivative: 0, nominal: 0.0 }; 6];
+pub(crate) const CIRCUIT_STATES: [ContinuousState; N_CIRCUIT] = {
+    let r = [vr::P2, vr::P3, vr::P4, vr::X_V, vr::U_CBV];
+    let mut s = [ContinuousState { state: 0, derivative: 0, nominal: 0.0 }; N_CIRCUIT];
     let mut k = 0;
-    while k < 6 {
-        s[k] = ContinuousState { state: r[k], derivative: der_vr(k), nominal: super::circuit::CIRCUIT_SCALE[k] };
+    while k < N_CIRCUIT {
+        s[k] = ContinuousState { state: r[k], derivative: der_vr(1 + k), nominal: super::circuit::CIRCUIT_SCALE[k] };
         k += 1;
     }
     s
@@ -52,19 +55,18 @@ pub(crate) const BOOM_STATES: [ContinuousState; 2 * MAX_SECTIONS] = {
 };
 
 /// HydraulicBoom's states: the circuit's, then the boom's.
-pub(crate) const PLANT_STATES: [ContinuousState; 6 + 2 * MAX_SECTIONS] = {
-    let mut s = [CIRCUIT_STATES[0]; 6 + 2 * MAX_SECTIONS];
+pub(crate) const PLANT_STATES: [ContinuousState; N_CIRCUIT + 2 * MAX_SECTIONS] = {
+    let mut s = [CIRCUIT_STATES[0]; N_CIRCUIT + 2 * MAX_SECTIONS];
     let mut k = 0;
     while k < s.len() {
-        s[k] = if k < 6 { CIRCUIT_STATES[k] } else { BOOM_STATES[k - 6] };
+        s[k] = if k < N_CIRCUIT { CIRCUIT_STATES[k] } else { BOOM_STATES[k - N_CIRCUIT] };
         k += 1;
     }
     s
 };
 
 /// The `der()` variables of the circuit's states.
-pub(crate) const CIRCUIT_DERIVATIVES: [Variable; 6] = [
-    der("der(p1)", 0, "Pa/s", "bar/s"),
+pub(crate) const CIRCUIT_DERIVATIVES: [Variable; N_CIRCUIT] = [
     der("der(p2)", 1, "Pa/s", "bar/s"),
     der("der(p3)", 2, "Pa/s", "bar/s"),
     der("der(p4)", 3, "Pa/s", "bar/s"),
@@ -140,7 +142,7 @@ pub(crate) const BOOM_DERIVATIVES: [Variable; 2 * MAX_SECTIONS] = [
     der("der(boom.section[32].omega)", 69, "rad/s2", ""),
 ];
 
-/// The derivative variable of state `k`.
+/// The derivative variable of slot `k` ([`der_vr`]).
 const fn der(name: &'static str, k: usize, unit: &'static str, display: &'static str) -> Variable {
     Variable::real_local(name, der_vr(k), unit, display, "Time derivative of the continuous state (Model Exchange)")
 }

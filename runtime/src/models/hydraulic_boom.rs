@@ -3,7 +3,8 @@
 //! flexible (2.1.4, 3.1.2, [`crate::mechanics::flexible_boom`]), advanced inside fmi2DoStep by
 //! the stiff Radau IIA integrator ([`crate::solver`]).
 //!
-//! States: the circuit's six (p1..p4, spool position, load-holding opening), then the boom's
+//! States: the circuit's five (p2..p4, spool position, load-holding opening; p1 is quasi-static,
+//! [`Circuit::line1_pressure`]), then the boom's
 //! generalised coordinates q and velocities q_dot (rigid: the stroke; flexible: the absolute
 //! angle of each section). The operator's reference `valve.u_ref` is linear over a step with the
 //! slope the master passes with fmi2SetRealInputDerivatives (held without one).
@@ -68,18 +69,19 @@ const DOCUMENTATION: &str = r#"<p>The circuit of thesis Fig. 2.8: supply, pressu
 PVG32 main spool with dead band and first-order dynamics (eq. 2.40-2.48; with <code>valve.omega_loop</code> &gt; 0 the
 PVES's own position loop, speed-limited by the reaction times of Table 4.2), counterbalance valve with check valve and
 piloted load-holding valve (eq. 2.55-2.59), asymmetric cylinder with end stops and friction (eq. 2.60-2.65), line
-volumes with hose compliance (eq. 5.2) and entrained air near vacuum; driving the boom, by default the lumped flexible
+volumes with hose compliance (eq. 5.2) and entrained air near vacuum, line 1 (compensator to spool)
+quasi-static; driving the boom, by default the lumped flexible
 arm of sections 2.1.4 and 3.1.2 (<code>boom.n2</code> + <code>boom.n3</code> sections, eq. 2.34-2.39), or with
 <code>boom.flexible</code> = false the rigid boom of sections 2.1.1-2.1.2 (kinematics eq. 2.1-2.15, kinetics eq.
 2.16-2.19) as one degree of freedom in the cylinder stroke. A stiff Radau IIA (order 5) integrator advances the
-circuit's six states and the boom's coordinates and velocities (rigid: the stroke; flexible: one angle per section)
+circuit's five states and the boom's coordinates and velocities (rigid: the stroke; flexible: one angle per section)
 inside fmi2DoStep with the tolerance of fmi2SetupExperiment; the flexible arm costs about ten times the rigid
 boom's time (see the README's speed table).</p>
 <p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
 spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>
 <p>Model Exchange: the importer's integrator gets the same states in every configuration (FMI 2.0 fixes their number;
-the table above lists them): the circuit's six, then the section angles <code>boom.section[k].phi</code> and their rates
+the table above lists them): the circuit's five, then the section angles <code>boom.section[k].phi</code> and their rates
 <code>boom.section[k].omega</code>. Slots beyond the last section repeat it, with its derivative; the rigid boom is
 its angle theta2 in every slot (Co-Simulation integrates it in the stroke). Three event indicators mark where the
 right-hand side jumps: the spool reference through zero (the dead band) and the spool at either edge of the dead

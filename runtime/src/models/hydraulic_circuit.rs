@@ -2,7 +2,8 @@
 //! with a mechanical port instead of the boom ([`super::port`]), for coupling to external
 //! mechanics such as [`super::BoomMechanics`].
 //!
-//! States: the circuit's six (p1..p4, spool position, load-holding opening); with the TLM port
+//! States: the circuit's five (p2..p4, spool position, load-holding opening; p1 is quasi-static,
+//! [`Circuit::line1_pressure`]); with the TLM port
 //! also the rod's stroke and velocity. Plain port: the stroke follows the velocity input within a
 //! step, x(t) = x_k + integral of v, v(t) = v_k + v' (t - t_k) (v' from
 //! fmi2SetRealInputDerivatives, 0 holds v), so chamber volumes and piston flows agree. The

@@ -224,11 +224,11 @@ impl<const N: usize> TableBuilder<N> {
         self
     }
 
-    /// Appends the circuit parameters `params[from..to]` at their [`vr::HYDRAULICS`] references.
+    /// Appends the circuit parameters `params[from..to]` at their [`vr::hydraulic`] references.
     pub(crate) const fn hydraulics(mut self, params: &[Param<Circuit>], from: usize, to: usize) -> Self {
         let mut k = from;
         while k < to {
-            self.rows[self.len] = param(vr::HYDRAULICS + k as u32, params[k].spec);
+            self.rows[self.len] = param(vr::hydraulic(k), params[k].spec);
             (self.len, k) = (self.len + 1, k + 1);
         }
         self

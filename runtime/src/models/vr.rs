@@ -41,8 +41,17 @@ pub const SECTION_RATES: u32 = 300;
 /// Derivatives of the continuous states: `DERIVATIVES + k` is der() of state k of
 /// HydraulicBoom's layout ([`crate::models::states`]).
 pub const DERIVATIVES: u32 = 400;
-/// Hydraulic parameters: `HYDRAULICS + index` in [`crate::hydraulics::params::PARAMS`].
+/// Hydraulic parameters: [`hydraulic`] of their index in [`crate::hydraulics::params::PARAMS`].
 pub const HYDRAULICS: u32 = 100;
+/// `HYDRAULICS + 39` was `line.v_l1`, the volume of line 1, retired when line 1 became
+/// quasi-static ([`crate::hydraulics::Circuit::line1_pressure`]); the parameters after it keep
+/// their references.
+const RETIRED_V_L1: usize = 39;
+
+/// The value reference of the hydraulic parameter `PARAMS[k]`.
+pub const fn hydraulic(k: usize) -> u32 {
+    HYDRAULICS + k as u32 + (k >= RETIRED_V_L1) as u32
+}
 /// Boom parameters: `BOOM + index` in [`crate::mechanics::params::BOOM_PARAMS`].
 pub const BOOM: u32 = 200;
 /// Flexible-beam parameters: `BEAM + index` in [`crate::mechanics::params::BEAM_PARAMS`].
