@@ -27,9 +27,9 @@ pub fn beat() {
 const BATCH: u64 = 20;
 /// A sequence still running after this long is a hang. Not 10 s: legal but extreme parameters
 /// make the plant's integrator slow, not stuck (HydraulicBoom FMI 3.0, seed 14862978723300872466:
-/// line.v_l1 = 2 ml, cylinder.v_dead_a = 0.16 l, a 6-section arm; 33 291 steps for 20 us of one
-/// step, 34.6 s for the sequence on the quiet machine; the numerics issue's stiction and fast
-/// modes), and a loaded machine stretches that further.
+/// line.v_l1 = 2 ml, when line 1 was integrated, cylinder.v_dead_a = 0.16 l, a 6-section arm;
+/// 33 291 steps for 20 us of one step, 34.6 s for the sequence on the quiet machine; the
+/// numerics issue's stiction and fast modes), and a loaded machine stretches that further.
 const SEQUENCE_TIMEOUT: Duration = Duration::from_secs(120);
 /// Exit status of a child whose sequence violated the oracle (the message is in the report).
 const EXIT_VIOLATION: c_int = 1;
