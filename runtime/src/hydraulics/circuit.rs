@@ -20,6 +20,7 @@ use super::dcv::Dcv;
 use super::friction::Friction;
 use super::line::{Fluid, Lines};
 use super::pcv::Pcv;
+use super::solve::falling_root;
 use super::supply::Supply;
 use crate::scalar::{max, Dual64, Scalar};
 
@@ -90,10 +91,6 @@ pub struct Eval<T = f64> {
     /// `f_pressure - f_friction + f_stop`.
     pub force: T,
 }
-
-/// Newton/bisection steps of [`Circuit::line1_pressure`] at most: bisection alone narrows the
-/// widest bracket (a few hundred bar) to round-off in about 60.
-const LINE1_ITERATIONS: usize = 100;
 
 /// The compensator and the net flow of line 1 at one pressure p1 ([`Circuit::line1`]).
 struct Line1<T> {
@@ -212,7 +209,7 @@ impl Circuit {
     /// reverse flow (p1 above both p_s and p_x + p_pcv), and there every flow leaves line 1. It
     /// is bracketed by the lowest of p_T, p2, p4 (everything flows in) and the highest of p_s,
     /// p2, p4, p_x + p_pcv + p_fc,pcv (everything flows out), and found by Newton's method
-    /// safeguarded by bisection. Dual parts (exact Jacobians) follow from the implicit function
+    /// safeguarded by bisection ([`falling_root`]). Dual parts (exact Jacobians) follow from the implicit function
     /// theorem.
     pub fn line1_pressure<T: Scalar>(&self, u: T, p2: T, p4: T, p_x: T) -> T {
         let (u_re, p2_re, p4_re, p_x_re) = (u.re(), p2.re(), p4.re(), p_x.re());
@@ -222,41 +219,23 @@ impl Circuit {
             (n.re, n.eps)
         };
         let (p_s, p_t) = (self.supply.p_s, self.supply.p_t);
-        let mut lo = p_t.min(p2_re).min(p4_re);
-        let mut hi = p_s.max(p2_re).max(p4_re).max(p_x_re + self.pcv.p_spring + self.pcv.p_fc);
+        let lo = p_t.min(p2_re).min(p4_re);
+        let hi = p_s.max(p2_re).max(p4_re).max(p_x_re + self.pcv.p_spring + self.pcv.p_fc);
         // Start where the compensator passes what leaves line 1 at its closing pressure `top`,
         // its opening falling linearly over p_fc (eq. 2.49): the root while it regulates, to the
         // little that the spool's flow changes over p_fc.
         let top = (p_x_re + self.pcv.p_spring + self.pcv.p_fc).clamp(lo, hi);
         let leaving = -self.line1(top, u_re, p2_re, p4_re, p_x_re).net;
         let open = self.pcv.flow(1.0, p_s, top, self.p_tr);
-        let mut p1 = if leaving > 0.0 && open > 0.0 {
-            hi = top;
-            (top - self.pcv.p_fc * (leaving / open).min(1.0)).max(lo)
+        let (p1, hi) = if leaving > 0.0 && open > 0.0 {
+            ((top - self.pcv.p_fc * (leaving / open).min(1.0)).max(lo), top)
         } else {
-            top
+            (top, hi)
         };
-        let (mut g, mut dg) = net(p1);
-        let mut g_before = f64::INFINITY;
-        for _ in 0..LINE1_ITERATIONS {
-            if g > 0.0 {
-                lo = p1;
-            } else {
-                hi = p1;
-            }
-            // Converged: Newton's next step below 1e-10 of p_s (2 mPa; the step that the dual
-            // correction below takes then leaves an error of order (2 mPa)^2 |g''/g'|, far
-            // below round-off), or the bracket within 4 ulp of p_s.
-            if g == 0.0 || (dg < 0.0 && g.abs() <= 1e-10 * p_s * -dg) || hi - lo <= 4.0 * f64::EPSILON * p_s {
-                break;
-            }
-            // Newton's step where it stays in the bracket and the last one at least halved the
-            // imbalance (it cycles about the root of the compensator's square root at p_s).
-            let newton = p1 - g / dg;
-            let fast = dg < 0.0 && newton > lo && newton < hi && g.abs() <= 0.5 * g_before.abs();
-            (p1, g_before) = (if fast { newton } else { 0.5 * (lo + hi) }, g);
-            (g, dg) = net(p1);
-        }
+        // Newton's next step below 1e-10 of p_s (2 mPa; the step that the dual correction below
+        // takes then leaves an error of order (2 mPa)^2 |g''/g'|, far below round-off), or the
+        // bracket within 4 ulp of p_s.
+        let (p1, g, dg) = falling_root(net, lo, hi, p1, 1e-10 * p_s, 4.0 * f64::EPSILON * p_s);
         if dg >= 0.0 {
             return T::from(p1);
         }
