@@ -17,7 +17,8 @@ limit detection on (`--only orders`, 10 s), and a fifth with CVode on the boom's
 (7 rigid, 23 flexible) instead of the FMU's 69 padded slots (`--only layout`, 2 minutes). A
 benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 12 minutes on 2 cores
 (the flexible references take most of it).
-Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only] [--only TABLE]
+Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only | --flexible-only] [--only TABLE]
+       [--param NAME=VALUE ...]
 """
 
 import argparse
@@ -40,17 +41,18 @@ def timed(f, *args, **kw):
     return r, time.perf_counter() - t0
 
 
-def interface_rows(cases) -> list:
-    """CS and ME per case, against the ME reference at rtol 1e-9."""
+def interface_rows(cases, params: dict) -> list:
+    """CS and ME per case, against the ME reference at rtol 1e-9; `params`: the plant's and
+    controller's parameters for every run."""
     rows = []
     start = time.perf_counter()
     for k, (sid, boom) in enumerate(cases, 1):
         sc = cosim.load_scenario(sid)
         print(f"[{k}/{len(cases)} {time.perf_counter() - start:.0f} s] {sid} {boom}: reference (ME, rtol 1e-9) ...",
               flush=True)
-        ref = cosim.run_me(sc, boom, stop_time=STOP, tolerance=1e-9)
-        for interface, run in (("CS 1 ms", lambda: cosim.run(sc, boom, stop_time=STOP)),
-                               ("ME CVode", lambda: cosim.run_me(sc, boom, stop_time=STOP))):
+        ref = cosim.run_me(sc, boom, stop_time=STOP, tolerance=1e-9, params=params)
+        for interface, run in (("CS 1 ms", lambda: cosim.run(sc, boom, stop_time=STOP, params=params)),
+                               ("ME CVode", lambda: cosim.run_me(sc, boom, stop_time=STOP, params=params))):
             res, wall = timed(run)
             d, r = res.data, ref.data
             rows.append((sid, boom, interface, wall, STOP / wall, res.counts["rhs"],
@@ -219,14 +221,22 @@ def layout_rows() -> list:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
+    ap.add_argument("--flexible-only", action="store_true", help="skip the rigid boom")
     ap.add_argument("--only", choices=("interfaces", "events", "tolerance", "orders", "layout"), help="one table")
+    ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                    help="a parameter of the interfaces table's runs (repeatable), e.g. boom.damping=1")
     args = ap.parse_args(argv)
-    cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")]
+    try:
+        params = {k: float(v) for k, v in (p.split("=", 1) for p in args.param)}
+    except ValueError:
+        ap.error(f"--param {' '.join(args.param)}: expected NAME=VALUE with a number")
+    cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")
+             and not (args.flexible_only and c[1] == "rigid")]
     if args.only in (None, "interfaces"):
         print_table(("case", "boom", "interface", "wall [s]", "real-time factor", "RHS", "max abs p3 error [bar]",
                      "max abs stroke error [mm]"),
                     [(sid, boom, interface, f"{wall:.2f}", f"{rtf:.1f}x", str(rhs), f"{ep3:.3g}", f"{ex:.3g}")
-                     for sid, boom, interface, wall, rtf, rhs, ep3, ex in interface_rows(cases)])
+                     for sid, boom, interface, wall, rtf, rhs, ep3, ex in interface_rows(cases, params)])
     if args.only in (None, "events"):
         print_table(("case", "event indicators", "state events", "RHS", "wall [s]", "max abs p3 error [bar]"),
                     [(sid, str(on), str(n_events), str(rhs), f"{wall:.2f}", f"{ep3:.3g}")

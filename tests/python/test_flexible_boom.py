@@ -61,6 +61,35 @@ def test_free_vibration_matches_the_lowest_linearised_mode(boom, eigen):
     assert crossing_frequency(t[window], p3[window]) == pytest.approx(expected, rel=0.03)
 
 
+def test_structural_damping_decays_as_the_linearised_mode(boom):
+    """`boom.damping = 1` (the arm's Rayleigh damping, xi at its first bending mode) in the
+    nonlinear FMU against the linearisation of `boomsim eigen --set boom.damping=1`: after the
+    pulse of the test above, the envelope of p3's oscillation decays as exp(-zeta omega_n t) with
+    the lowest mode's zeta (0.8 %, against 0.01 % under the thesis' per-section law). The decay
+    rate is a line fitted to the log of one peak per period over 8 s (some 20 periods, to e^-1
+    of the amplitude). Measured 0.136 1/s against the linearisation's 0.120: the rod side's air
+    stiffens with the amplitude (the frequency is 1.8 % above the linear one, see the test
+    above), which moves the mode towards the arm, whose damping it carries; 20 % covers that and
+    still tells the two laws apart by a factor of 60."""
+    out = subprocess.run([str(ROOT / "target" / "release" / "boomsim"), "eigen", "--json", "--set",
+                          "boom.damping=1"], capture_output=True, text=True, check=True)
+    linear = json.loads(out.stdout)
+    mode = linear["modes"][0]
+    start = {"start.x": linear["stroke_mm"] / 1e3, "friction.c_p_bak": 0.0, "friction.p_static": 0.0,
+             "boom.damping": 1}
+    t, p3 = run(boom, lambda t: 0.03 if t < 0.6 else 0.0, 10.0, **start)
+    window = t > 2.0
+    t, y = t[window], p3[window] - p3[window].mean()
+    # One peak per period: the largest sample between two upward zero crossings.
+    up = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    tops = [a + np.argmax(y[a:b]) for a, b in zip(up[:-1], up[1:])]
+    slope = np.polyfit(t[tops], np.log(y[tops]), 1)[0]
+    sigma = mode["frequency_hz"] * 2 * np.pi * mode["damping_ratio"]
+    assert 0.005 < mode["damping_ratio"] < 0.02
+    assert crossing_frequency(t, y) == pytest.approx(mode["frequency_hz"], rel=0.03)
+    assert -slope == pytest.approx(sigma, rel=0.2), (slope, mode)
+
+
 def test_flexible_boom_lowers_the_oscillation_frequency(boom, eigen):
     """Thesis 3.3: the boom's flexibility lowers the system's natural frequency, so the limit
     cycle of the uncompensated lowering (480 mm, u = -0.1) oscillates slower with the flexible

@@ -1,6 +1,7 @@
 //! The command line's wrong-argument paths: negative numbers reach the value checks (they used
 //! to be taken for options), an operating point out of range names the value and the range, and
-//! a benchmark of zero duration is refused instead of printing a table of zeros.
+//! a benchmark of zero duration is refused instead of printing a table of zeros, and a parameter
+//! of `boomsim eigen --set` is checked as the FMU checks it.
 
 use std::process::Command;
 
@@ -11,12 +12,21 @@ fn boomsim(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn wrong_arguments_get_one_clear_line() {
-    let (ok, e) = boomsim(&["analyze", "--xc", "-10"]);
-    assert!(!ok && e.contains("x_c = -10 mm is outside the stroke [0, 500] mm"), "{e}");
-    let (ok, e) = boomsim(&["analyze", "--p4", "-5"]);
-    assert!(!ok && e.contains("p4 = -5 bar must be >= 0"), "{e}");
-    let (ok, e) = boomsim(&["bench", "--duration", "0"]);
-    assert!(!ok && e.contains("0 is not a positive number of seconds"), "{e}");
-    let (ok, e) = boomsim(&["pack", "--platforms", "darwin64", "--out", "target/cli-test"]);
-    assert!(!ok && e.contains("unknown platform \"darwin64\"") && e.contains("linux64, win64, aarch64-linux"), "{e}");
+    let cases: [(&[&str], &[&str]); 8] = [
+        (&["analyze", "--xc", "-10"], &["x_c = -10 mm is outside the stroke [0, 500] mm"]),
+        (&["analyze", "--p4", "-5"], &["p4 = -5 bar must be >= 0"]),
+        (&["bench", "--duration", "0"], &["0 is not a positive number of seconds"]),
+        (
+            &["pack", "--platforms", "darwin64", "--out", "target/cli-test"],
+            &["unknown platform \"darwin64\"", "linux64, win64, aarch64-linux"],
+        ),
+        (&["eigen", "--set", "boom.n2=40"], &["boom.n2 = 40 is outside its valid range [0, 16]"]),
+        (&["eigen", "--set", "boom.xi=-0.1"], &["boom.xi = -0.1 is outside its valid range [0, 1]"]),
+        (&["eigen", "--set", "p3=1"], &["HydraulicBoom has no parameter \"p3\""]),
+        (&["eigen", "--set", "boom.n2"], &["expected NAME=VALUE"]),
+    ];
+    for (args, expected) in cases {
+        let (ok, e) = boomsim(args);
+        assert!(!ok && expected.iter().all(|x| e.contains(x)), "{args:?}: {e}");
+    }
 }

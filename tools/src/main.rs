@@ -70,6 +70,10 @@ enum Cmd {
         /// pressure); the `rig` entry always uses the thesis' 1 bar.
         #[arg(long, allow_negative_numbers = true)]
         p4: Option<f64>,
+        /// A parameter of the HydraulicBoom for the listed modes, NAME=VALUE (repeatable), e.g.
+        /// boom.n2=2 or boom.xi=0.05; the `rig` entry keeps the defaults.
+        #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+        set: Vec<String>,
     },
     /// Write modelDescription/<ModelIdentifier>.xml (FMI 2.0) and
     /// modelDescription/fmi3/<ModelIdentifier>.xml (FMI 3.0) from the variable tables.
@@ -232,16 +236,17 @@ fn bench_realtime(repeats: usize, duration: f64) -> Result<(), String> {
     Ok(())
 }
 
-fn eigen(json: bool, count: usize, p4_bar: Option<f64>) -> Result<(), String> {
-    use boomsim_tools::analysis::modes::{hydraulic_boom_modes, rig, Mode};
+fn eigen(json: bool, count: usize, p4_bar: Option<f64>, set: &[String]) -> Result<(), String> {
+    use boomsim_tools::analysis::modes::{hydraulic_boom_modes, parameter_change, rig, Mode};
     if let Some(p) = p4_bar {
         if !(0.0..=100.0).contains(&p) {
             return Err(format!("--p4 {p} bar is outside [0, 100] bar (start.p4's range)"));
         }
     }
     let p4 = p4_bar.map(|p| p * 1e5);
-    let (x0, flexible) = hydraulic_boom_modes(true, p4)?;
-    let (_, rigid) = hydraulic_boom_modes(false, p4)?;
+    let changes = set.iter().map(|arg| parameter_change(arg)).collect::<Result<Vec<_>, _>>()?;
+    let (x0, flexible) = hydraulic_boom_modes(true, p4, &changes)?;
+    let (_, rigid) = hydraulic_boom_modes(false, p4, &changes)?;
     let rig = rig()?;
     let list = |m: &[Mode]| -> Vec<serde_json::Value> {
         m.iter()
@@ -253,6 +258,7 @@ fn eigen(json: bool, count: usize, p4_bar: Option<f64>) -> Result<(), String> {
         let out = serde_json::json!({
             "stroke_mm": x0 * 1e3,
             "p4_bar": p4_bar.unwrap_or(0.0),
+            "set": set,
             "modes": list(&flexible),
             "rigid_modes": list(&rigid),
             "rig": {
@@ -271,11 +277,21 @@ fn eigen(json: bool, count: usize, p4_bar: Option<f64>) -> Result<(), String> {
         return Ok(());
     }
     println!(
-        "HydraulicBoom at rest, boom horizontal at stroke {:.1} mm, spool closed, rod side at {} bar, no friction",
+        "HydraulicBoom at rest, boom horizontal at stroke {:.1} mm, spool closed, rod side at {} bar, no friction{}",
         x0 * 1e3,
-        p4_bar.unwrap_or(0.0)
+        p4_bar.unwrap_or(0.0),
+        if set.is_empty() { String::new() } else { format!(", {}", set.join(", ")) }
     );
-    for (name, modes) in [("flexible (4 + 5)", &flexible), ("rigid", &rigid)] {
+    let sections = |name: &str| {
+        use boomsim::fmu::{Model, Value};
+        let start = || models::HydraulicBoom::VARIABLES.iter().find(|v| v.name == name).map(|v| v.start_value());
+        match changes.iter().find(|(n, _)| *n == name).map(|(_, v)| v.clone()).or_else(start) {
+            Some(Value::Integer(n)) => n,
+            other => unreachable!("{name} is an Integer parameter, not {other:?}"),
+        }
+    };
+    let flexible_name = format!("flexible ({} + {})", sections("boom.n2"), sections("boom.n3"));
+    for (name, modes) in [(flexible_name.as_str(), &flexible), ("rigid", &rigid)] {
         println!("{name}:");
         for m in modes.iter().take(count) {
             println!("  {:10.3} Hz  zeta {:.4}", m.frequency_hz, m.damping_ratio);
@@ -343,7 +359,7 @@ fn main() -> ExitCode {
         Cmd::Bench { json, duration, model_exchange, .. } => {
             bench(json, duration).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
         }
-        Cmd::Eigen { json, count, p4 } => eigen(json, count, p4),
+        Cmd::Eigen { json, count, p4, set } => eigen(json, count, p4, &set),
         Cmd::Xml { check } => xml(check),
         Cmd::Deflection { json } => deflection(json),
         Cmd::Cosim => boomsim_tools::cosim::main(),

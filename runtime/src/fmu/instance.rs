@@ -873,7 +873,7 @@ fn settable(v: &Variable, continuous_state: bool, state: Mode) -> Result<(), Str
 }
 
 /// Checks a new value against the variable's declared range; NaN and infinities are refused.
-pub(crate) fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
+pub fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
     match (v.kind, value) {
         (Kind::Real { min, max, unit, .. }, Value::Real(x)) => {
             // Formatted only for an error; the dimensionless unit "1" is not written.
