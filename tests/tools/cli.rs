@@ -12,7 +12,7 @@ fn boomsim(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn wrong_arguments_get_one_clear_line() {
-    let cases: [(&[&str], &[&str]); 8] = [
+    let cases: [(&[&str], &[&str]); 11] = [
         (&["analyze", "--xc", "-10"], &["x_c = -10 mm is outside the stroke [0, 500] mm"]),
         (&["analyze", "--p4", "-5"], &["p4 = -5 bar must be >= 0"]),
         (&["bench", "--duration", "0"], &["0 is not a positive number of seconds"]),
@@ -24,6 +24,9 @@ fn wrong_arguments_get_one_clear_line() {
         (&["eigen", "--set", "boom.xi=-0.1"], &["boom.xi = -0.1 is outside its valid range [0, 1]"]),
         (&["eigen", "--set", "p3=1"], &["HydraulicBoom has no parameter \"p3\""]),
         (&["eigen", "--set", "boom.n2"], &["expected NAME=VALUE"]),
+        (&["bench", "--set", "boom.damping=2"], &["boom.damping = 2 is outside its valid range [0, 1]"]),
+        (&["bench", "--set", "boom.damping=1", "--json"], &["does not go with --json"]),
+        (&["bench", "--realtime", "--set", "boom.damping=1"], &["does not go with --realtime"]),
     ];
     for (args, expected) in cases {
         let (ok, e) = boomsim(args);

@@ -5,9 +5,9 @@
 //! exported symbols call), through the C ABI by loading the built shared libraries with `dlopen`
 //! as an importer would.
 
+pub use crate::in_process::{InProcess, Slave};
 use boomsim::fmi2::types::*;
 use boomsim::fmu::{guid::guid, Model, Value};
-pub use crate::in_process::{InProcess, Slave};
 use boomsim::models::hydraulic_boom::vr as hb;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
 use boomsim::models::{HydraulicBoom, PressureFeedbackController};
@@ -30,6 +30,8 @@ type Setup = unsafe extern "C" fn(fmi2Component, c_int, f64, f64, c_int, f64) ->
 type RealIo = unsafe extern "C" fn(fmi2Component, *const u32, usize, *mut f64) -> fmi2Status;
 type DoStep = unsafe extern "C" fn(fmi2Component, f64, f64, c_int) -> fmi2Status;
 type SetBoolean = unsafe extern "C" fn(fmi2Component, *const u32, usize, *const c_int) -> fmi2Status;
+/// fmi2SetInteger has the same signature (fmi2Integer is a C int).
+type SetInteger = SetBoolean;
 type Free = unsafe extern "C" fn(fmi2Component);
 
 /// A slave loaded from its shared library and called through the exported C functions.
@@ -93,6 +95,7 @@ impl CAbi {
             let enter: Component = std::mem::transmute(sym(c"fmi2EnterInitializationMode")?);
             let exit: Component = std::mem::transmute(sym(c"fmi2ExitInitializationMode")?);
             let set_boolean: SetBoolean = std::mem::transmute(sym(c"fmi2SetBoolean")?);
+            let set_integer: SetInteger = std::mem::transmute(sym(c"fmi2SetInteger")?);
             let (name, id) = (c"bench", CString::new(guid::<M>()).map_err(|e| e.to_string())?);
             let c = instantiate(name.as_ptr(), FMI2_COSIMULATION, id.as_ptr(), std::ptr::null(), &*callbacks, 0, 0);
             if c.is_null() {
@@ -113,7 +116,8 @@ impl CAbi {
                 match x {
                     Value::Real(x) => s.set(*r, *x)?,
                     Value::Boolean(b) => check(set_boolean(c, r, 1, &(*b as c_int)), "fmi2SetBoolean")?,
-                    v => return Err(format!("start value {v:?} is not a Real or Boolean")),
+                    Value::Integer(i) => check(set_integer(c, r, 1, i), "fmi2SetInteger")?,
+                    v => return Err(format!("start value {v:?} is not a Real, Integer or Boolean")),
                 }
             }
             check(exit(c), "fmi2ExitInitializationMode")?;
@@ -289,7 +293,16 @@ fn case_random(plant: &mut dyn Slave, duration: f64, record: &mut Vec<[f64; 3]>)
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
         let x = plant.get(hb::X)?;
-        plant.set(hb::U_REF, if x < 0.15 { u.abs() } else if x > 0.6 { -u.abs() } else { u })?;
+        plant.set(
+            hb::U_REF,
+            if x < 0.15 {
+                u.abs()
+            } else if x > 0.6 {
+                -u.abs()
+            } else {
+                u
+            },
+        )?;
         let t0 = k as f64 * 0.5;
         steps(plant, None, t0, (duration - t0).min(0.5), Some(record))?;
     }
@@ -361,13 +374,15 @@ fn timed(
 
 /// Every benchmark: cases U, B and R (at rest) with the rigid and the flexible (4 + 5) boom,
 /// in-process and through the C ABI of the libraries in `library_dir` (`lib<ModelIdentifier>.so`, as
-/// `cargo build --release` leaves them).
-pub fn run_all(library_dir: &Path, duration: f64) -> Result<Vec<BenchResult>, String> {
+/// `cargo build --release` leaves them); `changes`: the HydraulicBoom's parameters besides the
+/// boom switch (value reference, value).
+pub fn run_all(library_dir: &Path, duration: f64, changes: &[(u32, Value)]) -> Result<Vec<BenchResult>, String> {
     let lib = |id: &str| library_dir.join(format!("lib{id}.so"));
     let (hb_lib, pfc_lib) = (lib(HydraulicBoom::INFO.identifier), lib(PressureFeedbackController::INFO.identifier));
     let mut out = Vec::new();
     for (boom, flexible) in [("rigid", false), ("flexible", true)] {
-        let start = [(hb::FLEXIBLE, Value::Boolean(flexible))];
+        let start: Vec<_> =
+            [(hb::FLEXIBLE, Value::Boolean(flexible))].into_iter().chain(changes.iter().cloned()).collect();
         for via in ["in-process", "c-abi"] {
             let plant = || -> Result<Box<dyn Slave>, String> {
                 Ok(match via {

@@ -56,6 +56,11 @@ enum Cmd {
         /// Runs per case of `--realtime`, > 0.
         #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         repeats: u32,
+        /// A parameter of the HydraulicBoom, NAME=VALUE (repeatable): every case runs with the
+        /// defaults and then with these, and the table adds their ratios (same run, so load
+        /// cancels), e.g. --set boom.damping=1.
+        #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+        set: Vec<String>,
     },
     /// Modes of the HydraulicBoom linearised at rest with the boom horizontal (full payload,
     /// spool closed): the flexible boom (default n2 = 4, n3 = 5) and, for comparison, the rigid one.
@@ -158,10 +163,27 @@ fn bench_interfaces() -> Result<(), String> {
     status.success().then_some(()).ok_or_else(|| format!("scripts/bench_interfaces.py: {status}"))
 }
 
-fn bench(json: bool, duration: f64) -> Result<(), String> {
+fn bench(json: bool, duration: f64, set: &[String]) -> Result<(), String> {
+    use boomsim::fmu::Model;
+    use boomsim_tools::analysis::modes::parameter_change;
+    let changes = set
+        .iter()
+        .map(|arg| {
+            let (name, value) = parameter_change(arg)?;
+            let v =
+                models::HydraulicBoom::VARIABLES.iter().find(|v| v.name == name).expect("a HydraulicBoom parameter");
+            Ok((v.vr, value))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    if json && !changes.is_empty() {
+        return Err("--set prints a comparison table; it does not go with --json".into());
+    }
     build_fmus(&boomsim_tools::platform::PLATFORMS[0])?;
     let libs = target_dir().join("release");
-    let results = boomsim_tools::bench::run_all(&libs, duration)?;
+    if !changes.is_empty() {
+        return bench_changes(&libs, duration, &changes, set);
+    }
+    let results = boomsim_tools::bench::run_all(&libs, duration, &[])?;
     let cycle_in = boomsim_tools::bench::controller_cycle(
         &mut boomsim_tools::bench::InProcess::<models::PressureFeedbackController>::new(1e-6, &[])?,
         200_000,
@@ -204,6 +226,40 @@ fn bench(json: bool, duration: f64) -> Result<(), String> {
         cycle_in * 1e9,
         cycle_c * 1e9
     );
+    Ok(())
+}
+
+/// `boomsim bench --set`: every case with the default parameters, then with `changes`, and the
+/// ratios (default over changed: above 1, the change is faster or needs fewer evaluations).
+fn bench_changes(
+    libs: &Path,
+    duration: f64,
+    changes: &[(u32, boomsim::fmu::Value)],
+    set: &[String],
+) -> Result<(), String> {
+    let reference = boomsim_tools::bench::run_all(libs, duration, &[])?;
+    let changed = boomsim_tools::bench::run_all(libs, duration, changes)?;
+    println!("{duration} s per case, 1 ms steps, rtol 1e-6; default against {}", set.join(", "));
+    println!(
+        "{:<5} {:<8} {:<11} {:>8} {:>8} {:>10} {:>10} {:>8} {:>8} {:>9} {:>9}",
+        "case", "boom", "via", "rtf", "rtf set", "rhs", "rhs set", "jac", "jac set", "speed-up", "rhs ratio"
+    );
+    for (a, b) in reference.iter().zip(&changed) {
+        println!(
+            "{:<5} {:<8} {:<11} {:>8.0} {:>8.0} {:>10} {:>10} {:>8} {:>8} {:>9.2} {:>9.2}",
+            a.case,
+            a.boom,
+            a.via,
+            a.rtf(),
+            b.rtf(),
+            a.rhs_evals,
+            b.rhs_evals,
+            a.jac_evals,
+            b.jac_evals,
+            a.wall_s / b.wall_s,
+            a.rhs_evals as f64 / b.rhs_evals as f64
+        );
+    }
     Ok(())
 }
 
@@ -355,9 +411,12 @@ fn main() -> ExitCode {
     }
     let result = match Cli::parse().command {
         Cmd::Pack { out, platforms } => pack(&out, &platforms),
+        Cmd::Bench { realtime: true, set, .. } if !set.is_empty() => Err("--set compares the cases U, B and R; \
+             it does not go with --realtime"
+            .into()),
         Cmd::Bench { realtime: true, duration, repeats, .. } => bench_realtime(repeats as usize, duration),
-        Cmd::Bench { json, duration, model_exchange, .. } => {
-            bench(json, duration).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
+        Cmd::Bench { json, duration, model_exchange, set, .. } => {
+            bench(json, duration, &set).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
         }
         Cmd::Eigen { json, count, p4, set } => eigen(json, count, p4, &set),
         Cmd::Xml { check } => xml(check),
