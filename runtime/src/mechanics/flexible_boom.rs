@@ -314,8 +314,10 @@ impl FlexibleBoom {
 
     /// The arm's first bending frequency (rad/s): the lowest omega of K w = omega^2 M w,
     /// undeformed and horizontal (q = 0), with the cylinder locked (g^T w = 0: the rotation
-    /// about B and the rod stand still), springs only (gravity's geometric stiffness, 1e-4 of
-    /// theirs, left out). The structural damping is set at it (see [`Self::new`]'s dampers).
+    /// about B and the rod stand still), springs only: the gravity-loaded rest shape and
+    /// gravity's geometric stiffness are left out (together 0.03 % against the whole plant
+    /// linearised with a rigid oil column, `boomsim_tools`' test
+    /// `structural_damping_sits_at_the_arms_bending_mode`). `boom.damping` = 1 sets beta at it.
     pub fn bending_frequency(&self) -> Result<f64, MechanicsError> {
         let n = self.n;
         let q = [0.0; MAX_SECTIONS];
