@@ -220,16 +220,14 @@ def layout_rows() -> list:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
-    ap.add_argument("--flexible-only", action="store_true", help="skip the rigid boom")
+    booms = ap.add_mutually_exclusive_group()
+    booms.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
+    booms.add_argument("--flexible-only", action="store_true", help="skip the rigid boom")
     ap.add_argument("--only", choices=("interfaces", "events", "tolerance", "orders", "layout"), help="one table")
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                     help="a parameter of the interfaces table's runs (repeatable), e.g. boom.damping=1")
     args = ap.parse_args(argv)
-    try:
-        params = {k: float(v) for k, v in (p.split("=", 1) for p in args.param)}
-    except ValueError:
-        ap.error(f"--param {' '.join(args.param)}: expected NAME=VALUE with a number")
+    params = cosim.parse_params(ap, args.param)
     cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")
              and not (args.flexible_only and c[1] == "rigid")]
     if args.only in (None, "interfaces"):

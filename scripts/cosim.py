@@ -81,6 +81,15 @@ def cli(main) -> int:
         return 2
 
 
+def parse_params(ap, pairs: list[str]) -> dict:
+    """The FMU parameters of a script's repeatable `--param NAME=VALUE` as {name: float}; a pair
+    that is not one ends the script through `ap.error` with one line."""
+    try:
+        return {k: float(v) for k, v in (p.split("=", 1) for p in pairs)}
+    except ValueError:
+        ap.error(f"--param {' '.join(pairs)}: expected NAME=VALUE with a number")
+
+
 def scenario_ids() -> list[str]:
     """The scenario ids of scripts/scenarios/, in the catalogue's order."""
     order = {"U": 0, "A": 1, "S": 2, "B": 3}

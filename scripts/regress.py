@@ -151,10 +151,7 @@ def main(argv=None) -> int:
                     help="compare every metric within this relative tolerance (plus its abs floor) "
                          "instead of tolerances.toml's")
     args = ap.parse_args(argv)
-    try:
-        params = {k: float(v) for k, v in (p.split("=", 1) for p in args.param)}
-    except ValueError:
-        ap.error(f"--param {' '.join(args.param)}: expected NAME=VALUE with a number")
+    params = cosim.parse_params(ap, args.param)
     if args.update and (params or args.rel is not None):
         ap.error("--update writes the baselines of the default FMUs: no --param or --rel with it")
     only = {s for s in args.only.split(",") if s}

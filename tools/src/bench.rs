@@ -5,9 +5,9 @@
 //! exported symbols call), through the C ABI by loading the built shared libraries with `dlopen`
 //! as an importer would.
 
-pub use crate::in_process::{InProcess, Slave};
 use boomsim::fmi2::types::*;
 use boomsim::fmu::{guid::guid, Model, Value};
+pub use crate::in_process::{InProcess, Slave};
 use boomsim::models::hydraulic_boom::vr as hb;
 use boomsim::models::pressure_feedback_controller::vr as pfc;
 use boomsim::models::{HydraulicBoom, PressureFeedbackController};
@@ -293,16 +293,7 @@ fn case_random(plant: &mut dyn Slave, duration: f64, record: &mut Vec<[f64; 3]>)
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         let u = (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
         let x = plant.get(hb::X)?;
-        plant.set(
-            hb::U_REF,
-            if x < 0.15 {
-                u.abs()
-            } else if x > 0.6 {
-                -u.abs()
-            } else {
-                u
-            },
-        )?;
+        plant.set(hb::U_REF, if x < 0.15 { u.abs() } else if x > 0.6 { -u.abs() } else { u })?;
         let t0 = k as f64 * 0.5;
         steps(plant, None, t0, (duration - t0).min(0.5), Some(record))?;
     }

@@ -164,16 +164,10 @@ fn bench_interfaces() -> Result<(), String> {
 }
 
 fn bench(json: bool, duration: f64, set: &[String]) -> Result<(), String> {
-    use boomsim::fmu::Model;
     use boomsim_tools::analysis::modes::parameter_change;
     let changes = set
         .iter()
-        .map(|arg| {
-            let (name, value) = parameter_change(arg)?;
-            let v =
-                models::HydraulicBoom::VARIABLES.iter().find(|v| v.name == name).expect("a HydraulicBoom parameter");
-            Ok((v.vr, value))
-        })
+        .map(|arg| parameter_change(arg).map(|(v, value)| (v.vr, value)))
         .collect::<Result<Vec<_>, String>>()?;
     if json && !changes.is_empty() {
         return Err("--set prints a comparison table; it does not go with --json".into());
@@ -300,7 +294,10 @@ fn eigen(json: bool, count: usize, p4_bar: Option<f64>, set: &[String]) -> Resul
         }
     }
     let p4 = p4_bar.map(|p| p * 1e5);
-    let changes = set.iter().map(|arg| parameter_change(arg)).collect::<Result<Vec<_>, _>>()?;
+    let changes = set
+        .iter()
+        .map(|arg| parameter_change(arg).map(|(v, value)| (v.name, value)))
+        .collect::<Result<Vec<_>, String>>()?;
     let (x0, flexible) = hydraulic_boom_modes(true, p4, &changes)?;
     let (_, rigid) = hydraulic_boom_modes(false, p4, &changes)?;
     let rig = rig()?;
@@ -338,15 +335,14 @@ fn eigen(json: bool, count: usize, p4_bar: Option<f64>, set: &[String]) -> Resul
         p4_bar.unwrap_or(0.0),
         if set.is_empty() { String::new() } else { format!(", {}", set.join(", ")) }
     );
-    let sections = |name: &str| {
-        use boomsim::fmu::{Model, Value};
-        let start = || models::HydraulicBoom::VARIABLES.iter().find(|v| v.name == name).map(|v| v.start_value());
-        match changes.iter().find(|(n, _)| *n == name).map(|(_, v)| v.clone()).or_else(start) {
-            Some(Value::Integer(n)) => n,
-            other => unreachable!("{name} is an Integer parameter, not {other:?}"),
-        }
+    let beam = boomsim::mechanics::params::BeamParams::default();
+    let sections = |name: &str, default: usize| {
+        changes.iter().rev().find(|(n, _)| *n == name).map_or(default, |(_, v)| match v {
+            boomsim::fmu::Value::Integer(k) => *k as usize,
+            _ => default,
+        })
     };
-    let flexible_name = format!("flexible ({} + {})", sections("boom.n2"), sections("boom.n3"));
+    let flexible_name = format!("flexible ({} + {})", sections("boom.n2", beam.n2), sections("boom.n3", beam.n3));
     for (name, modes) in [(flexible_name.as_str(), &flexible), ("rigid", &rigid)] {
         println!("{name}:");
         for m in modes.iter().take(count) {
