@@ -1,7 +1,8 @@
 //! The command line's wrong-argument paths: negative numbers reach the value checks (they used
 //! to be taken for options), an operating point out of range names the value and the range, and
-//! a benchmark of zero duration is refused instead of printing a table of zeros, and a parameter
-//! of `boomsim eigen --set` is checked as the FMU checks it.
+//! a benchmark of zero duration is refused instead of printing a table of zeros, a parameter
+//! of `boomsim eigen --set` is checked as the FMU checks it, and `boomsim linearize` refuses a
+//! point without a steady lowering and a file it cannot write.
 
 use std::process::Command;
 
@@ -12,7 +13,7 @@ fn boomsim(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn wrong_arguments_get_one_clear_line() {
-    let cases: [(&[&str], &[&str]); 11] = [
+    let cases: [(&[&str], &[&str]); 17] = [
         (&["analyze", "--xc", "-10"], &["x_c = -10 mm is outside the stroke [0, 500] mm"]),
         (&["analyze", "--p4", "-5"], &["p4 = -5 bar must be >= 0"]),
         (&["bench", "--duration", "0"], &["0 is not a positive number of seconds"]),
@@ -27,6 +28,12 @@ fn wrong_arguments_get_one_clear_line() {
         (&["bench", "--set", "boom.damping=2"], &["boom.damping = 2 is outside its valid range [0, 1]"]),
         (&["bench", "--set", "boom.damping=1", "--json"], &["does not go with --json"]),
         (&["bench", "--realtime", "--set", "boom.damping=1"], &["does not go with --realtime"]),
+        (&["linearize", "--u-ref", "-2"], &["--u-ref -2 is outside [-1, 1]"]),
+        (&["linearize", "--u-ref", "0"], &["valve.u_ref = 0: a steady lowering needs a reference below 0", "--rest"]),
+        (&["linearize", "--stroke", "600"], &["start.x = 0.6 is outside the stroke [0, 0.5] m"]),
+        (&["linearize", "--output", "p9"], &["--output p9: not an output of the HydraulicBoom", "p4"]),
+        (&["linearize", "--at", "-1"], &["--at -1 s is outside (0, 1000] s"]),
+        (&["linearize", "--out", "model.txt"], &["--out model.txt: the extension must be .json, .npz or .mat"]),
     ];
     for (args, expected) in cases {
         let (ok, e) = boomsim(args);

@@ -5,6 +5,7 @@
 //! [`boomsim`]; nothing here is linked into an FMU binary.
 
 pub mod analysis;
+pub mod arrays;
 /// Timing through dlopen: Unix only.
 #[cfg(unix)]
 pub mod bench;

@@ -100,6 +100,11 @@ enum Cmd {
     /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
     #[command(allow_negative_numbers = true)]
     Analyze(Box<boomsim_tools::analysis::cli::AnalyzeArgs>),
+    /// The HydraulicBoom's linear model dx = A x + B u, y = C x + D u at an operating point (a
+    /// steady lowering, rest, or a time of a run), open or closed with the pressure feedback,
+    /// from exact derivatives: eigenvalues, margins, Bode data, .json/.npz/.mat files.
+    #[command(allow_negative_numbers = true)]
+    Linearize(Box<boomsim_tools::analysis::linearize_cli::LinearizeArgs>),
 }
 
 /// A finite number > 0 (clap value parser).
@@ -419,6 +424,7 @@ fn main() -> ExitCode {
         Cmd::Deflection { json } => deflection(json),
         Cmd::Cosim => boomsim_tools::cosim::main(),
         Cmd::Analyze(args) => boomsim_tools::analysis::cli::run(&args, root()),
+        Cmd::Linearize(args) => boomsim_tools::analysis::linearize_cli::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -117,7 +117,7 @@ impl OdeSystem for Plant {
 
 impl Plant {
     /// The right-hand side with the operator's reference `u_ref`.
-    fn rhs_with<T: Scalar>(&self, u_ref: T, s: &[T], dx: &mut [T]) {
+    pub fn rhs_with<T: Scalar>(&self, u_ref: T, s: &[T], dx: &mut [T]) {
         let dof = self.boom.mechanics().dof();
         let (c, boom) = s.split_at(N_CIRCUIT);
         let (q, qd) = boom.split_at(dof);
@@ -148,7 +148,7 @@ impl Plant {
 
     /// The outputs (circuit, stroke and velocity, boom) at the plant state `s` with the
     /// reference `u_ref`, as (value reference, value).
-    fn output_rows<T: Scalar>(&self, u_ref: T, s: &[T]) -> impl Iterator<Item = (u32, T)> {
+    pub fn output_rows<T: Scalar>(&self, u_ref: T, s: &[T]) -> impl Iterator<Item = (u32, T)> {
         let k = self.boom.kinetics();
         let (c, boom) = s.split_at(N_CIRCUIT);
         let (q, qd) = boom.split_at(self.boom.mechanics().dof());

@@ -8,6 +8,8 @@ pub mod criterion;
 #[cfg(test)]
 mod dimensions;
 pub mod feedback;
+pub mod linearize;
+pub mod linearize_cli;
 pub mod margins;
 pub mod modes;
 pub mod operating_point;

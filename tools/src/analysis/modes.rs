@@ -80,30 +80,36 @@ pub fn parameter_change(arg: &str) -> Result<(&'static Variable, Value), String>
 /// The HydraulicBoom at rest with the boom horizontal (stroke where the rigid boom's theta2 = 0),
 /// full payload and the spool closed, the rod side at tank pressure or trapped at `p4` (Pa,
 /// gauge; p3 then carries the load on top of it), linearised: (stroke [m], modes).
-///
-/// Friction is left out (`friction.c_p_bak` = `friction.p_static` = 0): Coulomb friction has no
-/// small-signal linearisation at rest; its tanh regularisation would act as a viscous damper of
-/// F/v_s ~ 5e6 N s/m and lock the cylinder. Its effect on an oscillation depends on the amplitude.
 pub fn hydraulic_boom_modes(
     flexible: bool,
     p4: Option<f64>,
     changes: &[(&str, Value)],
 ) -> Result<(f64, Vec<Mode>), String> {
-    let mut values = Values::new(HydraulicBoom::VARIABLES);
-    let mut set = |name: &str, v: Value| -> Result<(), String> {
-        let i = HydraulicBoom::VARIABLES
-            .iter()
-            .position(|x| x.name == name)
-            .ok_or_else(|| format!("HydraulicBoom has no variable \"{name}\""))?;
-        values.put(i, v);
-        Ok(())
-    };
-    set("friction.c_p_bak", Value::Real(0.0))?;
-    set("friction.p_static", Value::Real(0.0))?;
-    set("boom.flexible", Value::Boolean(flexible))?;
-    for (name, x) in changes {
-        set(name, x.clone())?;
-    }
+    let rest = rest(flexible, p4, changes)?;
+    Ok((rest.stroke, modes(jacobian(&rest.plant, 0.0, &rest.state, &rest.plant.state_scale()))))
+}
+
+/// The plant at rest with the boom horizontal ([`hydraulic_boom_modes`]).
+pub struct Rest {
+    pub plant: Plant,
+    /// The stroke where the boom is horizontal (m).
+    pub stroke: f64,
+    /// The static equilibrium there.
+    pub state: Vec<f64>,
+}
+
+/// The plant of [`hydraulic_boom_modes`] and its state.
+///
+/// Friction is left out (`friction.c_p_bak` = `friction.p_static` = 0): Coulomb friction has no
+/// small-signal linearisation at rest; its tanh regularisation would act as a viscous damper of
+/// F/v_s ~ 5e6 N s/m and lock the cylinder. Its effect on an oscillation depends on the amplitude.
+pub fn rest(flexible: bool, p4: Option<f64>, changes: &[(&str, Value)]) -> Result<Rest, String> {
+    let off = [
+        ("friction.c_p_bak", Value::Real(0.0)),
+        ("friction.p_static", Value::Real(0.0)),
+        ("boom.flexible", Value::Boolean(flexible)),
+    ];
+    let mut values = plant_values(off.iter().chain(changes).map(|(n, v)| (*n, v.clone())))?;
     let rigid = {
         let mut v = values.clone();
         v.put(v.position(vr::FLEXIBLE).expect("flexible switch"), Value::Boolean(false));
@@ -125,11 +131,24 @@ pub fn hydraulic_boom_modes(
             hi = mid
         }
     }
-    let x0 = 0.5 * (lo + hi);
-    values.set_real(vr::X0, x0);
+    let stroke = 0.5 * (lo + hi);
+    values.set_real(vr::X0, stroke);
     let plant = Plant::from_values(&values)?;
-    let state = plant.equilibrium(x0, p4)?;
-    Ok((x0, modes(jacobian(&plant, 0.0, &state, &plant.state_scale()))))
+    let state = plant.equilibrium(stroke, p4)?;
+    Ok(Rest { plant, stroke, state })
+}
+
+/// The HydraulicBoom's start values with `changes` (name, value) applied.
+pub fn plant_values<'a>(changes: impl IntoIterator<Item = (&'a str, Value)>) -> Result<Values, String> {
+    let mut values = Values::new(HydraulicBoom::VARIABLES);
+    for (name, x) in changes {
+        let i = HydraulicBoom::VARIABLES
+            .iter()
+            .position(|v| v.name == name)
+            .ok_or_else(|| format!("HydraulicBoom has no variable \"{name}\""))?;
+        values.put(i, x);
+    }
+    Ok(values)
 }
 
 /// The lowest mode at the conditions of the rig's eigenfrequency measurement, thesis 5.1.3.
