@@ -51,24 +51,7 @@ fn circuit(v: &Variant) -> Circuit {
 /// and the steady `p4` that passes the compensated flow `|u_ref| Q_rated` (CBV back pressure
 /// neglected, as in Fig. 2.18).
 fn linear_point(c: &Circuit, boom: &RigidBoom, x: f64) -> Option<OperatingPoint> {
-    let (cyl, ln, beta) = (&c.cylinder, &c.lines, c.fluid.beta);
-    let op = OperatingPoint {
-        x_c: x,
-        mu_p: c.cbv.mu_p,
-        p_set: c.cbv.p_set,
-        mass: boom.m_eff(x),
-        load: boom.static_force(x),
-        beta,
-        c1_extra: (cyl.v_dead_a + ln.v_l3) / beta + ln.hose_compliance(ln.v_l3),
-        c2_extra: (cyl.v_dead_b + ln.v_l4) / beta + ln.hose_compliance(ln.v_l4),
-        area: cyl.area_a(),
-        mu_c: cyl.mu_c(),
-        stroke: cyl.stroke,
-        k2: c.cbv.k2(),
-        p_fo: c.cbv.p_fo_cbv,
-        ..OperatingPoint::default()
-    };
-    op.with_flow(U_REF.abs() * c.dcv.q_rated / cyl.mu_c())
+    OperatingPoint::of_circuit(c, boom, x, 0.0).with_flow(U_REF.abs() * c.dcv.q_rated / c.cylinder.mu_c())
 }
 
 /// Largest real part of the poles of eq. 2.82 at stroke `x`.

@@ -2,6 +2,7 @@
 
 use super::linearize::{crossovers, operating_point, LinearModel, Point, DEFAULT_OUTPUTS};
 use super::modes::parameter_change;
+use super::sine_test::{sine_response, AMPLITUDE, SETTLE};
 use crate::arrays::{self, Array};
 use boomsim::control::HighPassFeedback;
 use boomsim::fmu::Value;
@@ -53,9 +54,15 @@ pub struct LinearizeArgs {
     #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
     pub set: Vec<String>,
     /// Add the frequency response of every output to valve.u_ref (0.1 to 100 Hz, 40 points per
-    /// decade) to the JSON.
+    /// decade) to the JSON, and at a steady lowering that of p4 in section 2.3's reduced model
+    /// (eq. 2.76, 2.81, 6.4; with --feedback 6.8's loop) at the same point with the rigid boom.
     #[arg(long)]
     pub bode: bool,
+    /// With --feedback at a steady lowering: p4's response to a 2 % swing of the reference at
+    /// these frequencies [Hz, comma separated] measured on the nonlinear closed loop (the sine
+    /// test; about 0.1 s per frequency rigid, 0.5 s flexible), added to the JSON and the table.
+    #[arg(long, value_delimiter = ',', requires = "feedback", conflicts_with_all = ["rest", "at"])]
+    pub sine: Vec<f64>,
     /// Print JSON: the point, names and units, A, B, C, D, eigenvalues, margins, Bode data.
     #[arg(long)]
     pub json: bool,
@@ -114,7 +121,26 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
         Some(f) => Some(crossovers(|w| open.open_loop(f, w).expect("p4 is a state"), MARGIN_BAND.0, MARGIN_BAND.1)),
         None => None,
     };
-    let report = report(args, point, &model, feedback.as_ref(), margins.as_ref());
+    let mut report = report(args, point, &model, feedback.as_ref(), margins.as_ref());
+    if let Point::Lowering { stroke, .. } = point {
+        if args.bode {
+            report["bode"]["reduced_p4"] = reduced_p4(&changes, stroke, &open, feedback.as_ref())?;
+        }
+    }
+    if let Some(f) = &feedback {
+        let mut sines = Vec::new();
+        for &f_hz in &args.sine {
+            if !(f_hz > 0.0 && f_hz <= 100.0) {
+                return Err(format!("--sine {f_hz} Hz is outside (0, 100] Hz"));
+            }
+            let s = sine_response(&plant, &x, u_ref, f, f_hz)?;
+            sines.push(json!({"frequency_hz": f_hz, "output": "p4", "gain": s.response.norm(),
+                "phase_deg": s.response.arg().to_degrees(), "stroke_mm": s.stroke * 1e3}));
+        }
+        if !sines.is_empty() {
+            report["sine"] = json!({"amplitude": AMPLITUDE, "settle_s": SETTLE, "points": sines});
+        }
+    }
     if let Some(path) = &args.out {
         if path.extension().is_some_and(|e| e == "json") {
             std::fs::write(path, report.to_string()).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -151,6 +177,45 @@ fn named_arrays(m: &LinearModel) -> Vec<(&'static str, Array)> {
         ("output_units", units(&m.outputs)),
         ("eigenvalues", Array::Complex(m.eigenvalues())),
     ]
+}
+
+/// The frequencies of `--bode` (Hz): 0.1 to 100, 40 per decade.
+fn bode_frequencies() -> Vec<f64> {
+    (0..=120).map(|k| 0.1 * 10f64.powf(k as f64 / 40.0)).collect()
+}
+
+/// p4's response to the reference in section 2.3's reduced model at the point of `open` (its p4
+/// and stroke, the same parameters with the rigid boom's effective mass and load):
+/// `-Q_rated G_v / (C2 s + H)` (eq. 2.76, 2.81 and the valve lag eq. 6.4, in flows per unit
+/// opening; negative: opening towards lowering raises p4), with the feedback
+/// `-Q_rated G_v / (C2 s + H + G_f G_v)` (Fig. 6.2, eq. 6.8's denominator).
+fn reduced_p4(
+    changes: &[(&str, Value)],
+    stroke: f64,
+    open: &LinearModel,
+    f: Option<&HighPassFeedback>,
+) -> Result<Json, String> {
+    use super::feedback::{filter, valve};
+    use super::plant::{admittance, HParams};
+    let rigid = [("boom.flexible", Value::Boolean(false))];
+    let values = super::modes::plant_values(changes.iter().cloned().chain(rigid))?;
+    let plant = boomsim::models::hydraulic_boom::Plant::from_values(&values)?;
+    let boomsim::models::hydraulic_boom::Boom::Rigid(boom) = &plant.boom else { unreachable!("built rigid") };
+    let p4 = open.x0[open.state("p4")?];
+    let op = super::OperatingPoint::of_circuit(&plant.circuit, boom, stroke, p4);
+    let lin = op.linearise().map_err(|e| format!("the reduced model at this point: {e}"))?;
+    let (y, dcv) = (admittance(lin.c2, &HParams::new(&op, &lin).h()), &plant.circuit.dcv);
+    let gv = valve(dcv.omega_v);
+    let h: Vec<Complex<f64>> = bode_frequencies()
+        .iter()
+        .map(|f_hz| {
+            let w = f_hz * std::f64::consts::TAU;
+            let feedback = f.map_or(Complex::new(0.0, 0.0), |f| filter(f).at(w) * gv.at(w));
+            -dcv.q_rated * gv.at(w) / (y.at(w) + feedback)
+        })
+        .collect();
+    Ok(json!({"gain": h.iter().map(|h| h.norm()).collect::<Vec<_>>(),
+              "phase_deg": unwrap(h.iter().map(|h| h.arg().to_degrees()))}))
 }
 
 /// Natural frequency (Hz) and damping ratio of an eigenvalue.
@@ -202,7 +267,7 @@ fn report(
         out["margins"] = json!({"gain": list(gain, "db"), "phase": list(phase, "deg")});
     }
     if args.bode {
-        let f: Vec<f64> = (0..=120).map(|k| 0.1 * 10f64.powf(k as f64 / 40.0)).collect();
+        let f = bode_frequencies();
         let h: Vec<DMatrix<Complex<f64>>> = f.iter().map(|f| m.frequency_response(f * std::f64::consts::TAU)).collect();
         let channels = (0..m.outputs.len())
             .map(|j| {
@@ -250,6 +315,16 @@ fn text(report: &Json, m: &LinearModel) -> String {
         let (f, z) = mode(l);
         let kind = if l.im == 0.0 { "real" } else { "" };
         let _ = writeln!(s, "  {:>12.4} {:+12.4}j 1/s   {:9.3} Hz  zeta {:8.4} {kind}", l.re, l.im, f, z);
+    }
+    for p in report["sine"]["points"].as_array().into_iter().flatten() {
+        let _ = writeln!(
+            s,
+            "sine test at {:6.2} Hz: p4 / u_ref {:.4e} Pa at {:7.2} deg (nonlinear, mean stroke {:.1} mm)",
+            p["frequency_hz"].as_f64().unwrap_or(f64::NAN),
+            p["gain"].as_f64().unwrap_or(f64::NAN),
+            p["phase_deg"].as_f64().unwrap_or(f64::NAN),
+            p["stroke_mm"].as_f64().unwrap_or(f64::NAN)
+        );
     }
     if let Some(m) = report.get("margins") {
         let _ = writeln!(s, "feedback {}: open loop cut at the spool reference", report["feedback"]);

@@ -17,6 +17,7 @@ pub mod plant;
 pub mod poly;
 pub mod report;
 pub mod routh;
+pub mod sine_test;
 pub mod step;
 pub mod sweep;
 pub mod tf;

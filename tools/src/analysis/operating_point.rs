@@ -15,6 +15,7 @@
 use boomsim::hydraulics::solve::bisect;
 use boomsim::hydraulics::Circuit;
 use boomsim::mechanics::params::BoomParams;
+use boomsim::mechanics::rigid_boom::RigidBoom;
 use boomsim::units::{bar, mm};
 
 /// Stroke of the Table 6.1 operating point (m).
@@ -93,6 +94,32 @@ pub fn identify_table_6_1() -> Table61Identification {
         .min_by(|a, b| (a - mu_p_exact).abs().total_cmp(&(b - mu_p_exact).abs()))
         .expect("non-empty");
     Table61Identification { mu_p_exact, mu_p, mass: area * area / (c1 * TABLE_6_1_OMEGA_N.powi(2)) }
+}
+
+impl OperatingPoint {
+    /// The point of section 2.3 for boomsim's circuit `c` driving the rigid boom `boom` at stroke
+    /// `x_c` with the rod side at `p4`: the boom's effective mass at the cylinder (eq. 2.68) and
+    /// static load (eq. 2.19), the line and dead volumes and hose compliance (eq. 5.2) as extra
+    /// capacitance, the CBV's and cylinder's parameters.
+    pub fn of_circuit(c: &Circuit, boom: &RigidBoom, x_c: f64, p4: f64) -> Self {
+        let (cyl, ln, beta) = (&c.cylinder, &c.lines, c.fluid.beta);
+        OperatingPoint {
+            x_c,
+            p4,
+            mu_p: c.cbv.mu_p,
+            p_set: c.cbv.p_set,
+            mass: boom.m_eff(x_c),
+            load: boom.static_force(x_c),
+            beta,
+            c1_extra: (cyl.v_dead_a + ln.v_l3) / beta + ln.hose_compliance(ln.v_l3),
+            c2_extra: (cyl.v_dead_b + ln.v_l4) / beta + ln.hose_compliance(ln.v_l4),
+            area: cyl.area_a(),
+            mu_c: cyl.mu_c(),
+            stroke: cyl.stroke,
+            k2: c.cbv.k2(),
+            p_fo: c.cbv.p_fo_cbv,
+        }
+    }
 }
 
 impl Default for OperatingPoint {
