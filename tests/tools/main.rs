@@ -1,4 +1,5 @@
 //! The `boomsim` command line and the generated modelDescription.xml and documentation pages.
 
 mod cli;
+mod linearize;
 mod model_description;

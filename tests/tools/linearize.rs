@@ -1,0 +1,76 @@
+//! The small-signal test through the FMUs themselves: HydraulicBoom and
+//! PressureFeedbackController co-simulated through the FMI layer (`boomsim cosim`, the sweeps'
+//! native runner: FMI 2.0 Co-Simulation, 1 ms, Gauss-Seidel with p4's slope), experiment B from
+//! rest at 480 mm with a 2 % swing on the operator's reference, against `boomsim linearize`'s
+//! closed loop at the stroke the run passes through.
+
+use boomsim::control::HighPassFeedback;
+use boomsim::fmu::Value;
+use boomsim_tools::analysis::linearize::{linearize, operating_point, Point};
+use boomsim_tools::analysis::sine_test::AMPLITUDE;
+use nalgebra::{Complex, DMatrix, DVector};
+use serde_json::json;
+
+const U_REF: f64 = -0.05;
+const H: f64 = 1e-3;
+/// From rest, B's lowering settles within a second (Fig. 6.10: 0.7 s); the fit starts at 3 s.
+const SETTLE: f64 = 3.0;
+
+/// (t, p4, stroke) every communication point of B from rest with `u_ref + a sin(w t)`.
+fn cosim(flexible: bool, amplitude: f64, omega: f64, stop: f64) -> Vec<[f64; 3]> {
+    let n = (stop / H).round() as usize;
+    let u_ref: Vec<f64> = (0..=n).map(|k| U_REF + amplitude * (omega * k as f64 * H).sin()).collect();
+    let request = json!({
+        "stop_time": stop, "step": H, "record_every": 1, "interpolate": true, "feedback_start": "t0",
+        "enable": true, "u_ref": u_ref, "outputs": ["p4", "cbv.u_cbv", "cylinder.x"], "cbv_open": 0.01,
+        "plant": {"start.x": 0.48, "boom.flexible": flexible}, "controller": {},
+    });
+    let (header, rows) = boomsim_tools::cosim::run(&request).expect("the co-simulation runs");
+    let columns = header["columns"].as_u64().unwrap() as usize;
+    // Rows: t, u_ref, u_comp, u, then the outputs.
+    rows.chunks(columns).map(|r| [r[0], r[4], r[6]]).collect()
+}
+
+/// p4 / u_ref at 1, 2.5 and 5 Hz from the FMUs against the linear closed loop: the difference
+/// of the runs with and without the swing, fitted by its fundamental and a linear trend over
+/// whole periods after 3 s, rigid and flexible, around 460 mm. Measured within 0.4 % and 0.15
+/// deg; tolerance 1 % and 1 deg: the communication step holds the spool command over 1 ms (a lag
+/// of 0.5 ms, 0.9 deg at 5 Hz, which the interpolated p4 mostly recovers), the run starts from
+/// rest rather than at the steady lowering, and the stroke moves +-9 mm within the window.
+#[test]
+fn the_fmus_answer_a_small_sine_as_the_linear_model_says() {
+    let feedback = HighPassFeedback::default();
+    for flexible in [false, true] {
+        for f_hz in [1.0, 2.5, 5.0] {
+            let w = std::f64::consts::TAU * f_hz;
+            let period = 1.0 / f_hz;
+            let t0 = SETTLE + period - SETTLE % period;
+            let stop = t0 + period * (2.0 * f_hz).ceil().max(2.0);
+            let window = |rows: Vec<[f64; 3]>| -> Vec<[f64; 3]> {
+                rows.into_iter().filter(|r| r[0] >= t0 - 1e-9 && r[0] <= stop + 1e-9).collect()
+            };
+            let (with, without) = (window(cosim(flexible, AMPLITUDE, w, stop)), window(cosim(flexible, 0.0, w, stop)));
+            let m = DMatrix::from_fn(with.len(), 4, |i, j| {
+                let t = with[i][0];
+                [(w * t).sin(), (w * t).cos(), 1.0, t - t0][j]
+            });
+            let d = DVector::from_iterator(with.len(), with.iter().zip(&without).map(|(p, q)| p[1] - q[1]));
+            let c = (m.transpose() * &m).lu().solve(&(m.transpose() * d)).unwrap();
+            let measured = Complex::new(c[0], c[1]) / AMPLITUDE;
+            let stroke = without.iter().map(|r| r[2]).sum::<f64>() / without.len() as f64;
+            let changes = [("boom.flexible", Value::Boolean(flexible))];
+            let (plant, x, u) = operating_point(Point::Lowering { u_ref: U_REF, stroke }, &changes).unwrap();
+            let closed = linearize(&plant, &x, u, &["p4"]).unwrap().closed_loop(&feedback).unwrap();
+            let h = closed.frequency_response(w)[(0, 0)];
+            let (gain, phase) = (measured.norm() / h.norm(), (measured / h).arg().to_degrees());
+            println!(
+                "flexible {flexible}, {f_hz} Hz at {:.1} mm: gain ratio {gain:.4}, phase {phase:+.2} deg",
+                stroke * 1e3
+            );
+            assert!(
+                (gain - 1.0).abs() < 0.01 && phase.abs() < 1.0,
+                "flexible {flexible}, {f_hz} Hz at {stroke} m: gain ratio {gain}, phase {phase} deg"
+            );
+        }
+    }
+}
