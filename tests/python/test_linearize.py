@@ -84,6 +84,17 @@ def test_feedback_adds_the_filter_state_and_margins():
     assert not stable(json.loads(linearize("--boom", "rigid", "--json")))
 
 
+def test_the_circuit_has_the_ports_inputs(tmp_path):
+    """HydraulicCircuit's model (its plain port): three inputs in the FMU's names, the force on
+    the rod first among the outputs, written to .mat like the HydraulicBoom's."""
+    report = json.loads(linearize("--model", "HydraulicCircuit", "--json", "--out", str(tmp_path / "c.mat")))
+    assert [i["name"] for i in report["inputs"]] == ["valve.u_ref", "cylinder.x", "cylinder.v"]
+    assert [o["name"] for o in report["outputs"]] == ["cylinder.F", "p3", "p4"]
+    mat = scipy.io.loadmat(tmp_path / "c.mat")
+    assert mat["B"].shape == (5, 3) and mat["D"].shape == (3, 3)
+    np.testing.assert_array_equal(mat["D"], np.array(report["D"]))
+
+
 def test_the_bode_figure_has_its_text_inside_and_the_sine_points(tmp_path):
     """scripts/plot_bode.py (docs/linearize.md's figure): every text inside the canvas, both axes
     labelled with units, the sine test's points on the closed-loop curve within 5 % (they are

@@ -86,9 +86,12 @@ impl LinearModel {
     /// PressureFeedbackController computes it, without its clamp of u): the spool reference
     /// becomes `u_ref + g (p4 - x_f)` with `g = K_f omega_f / Q_rated` and the filter state
     /// `x_f' = omega_f (p4 - x_f)` is appended as `filter.p_lp`, at p4 (u_comp = 0 at the point).
-    /// The input stays `valve.u_ref`, now the operator's reference.
+    /// The first input, `valve.u_ref`, becomes the operator's reference; others stay.
     pub fn closed_loop(&self, f: &HighPassFeedback) -> Result<LinearModel, String> {
-        let (n, p) = (self.a.nrows(), self.state("p4")?);
+        if self.inputs.first().is_none_or(|i| i.name != "valve.u_ref") {
+            return Err("the feedback acts on valve.u_ref, the model's first input".into());
+        }
+        let (n, m, p) = (self.a.nrows(), self.b.ncols(), self.state("p4")?);
         let g = f.k_f * f.omega_f / f.q_rated;
         let mut a = DMatrix::zeros(n + 1, n + 1);
         a.view_mut((0, 0), (n, n)).copy_from(&self.a);
@@ -98,8 +101,8 @@ impl LinearModel {
         }
         a[(n, p)] = f.omega_f;
         a[(n, n)] = -f.omega_f;
-        let mut b = DMatrix::zeros(n + 1, 1);
-        b.view_mut((0, 0), (n, 1)).copy_from(&self.b);
+        let mut b = DMatrix::zeros(n + 1, m);
+        b.view_mut((0, 0), (n, m)).copy_from(&self.b);
         let mut c = DMatrix::zeros(self.c.nrows(), n + 1);
         c.view_mut((0, 0), (self.c.nrows(), n)).copy_from(&self.c);
         for j in 0..self.c.nrows() {
@@ -145,6 +148,16 @@ pub enum Point {
     /// The state at time `t` (s) after the reference steps from 0 to `u_ref` at rest at `stroke`
     /// (m): a scenario's lowering (U, B) run by the FMU's integrator (Radau IIA, rtol 1e-8).
     Time { u_ref: f64, stroke: f64, t: f64 },
+}
+
+/// The plant's steady lowering at `u_ref` through `stroke` ([`steady_lowering`]): the plant,
+/// its state and the stroke's velocity there.
+pub fn plant_point(changes: &[(&str, Value)], u_ref: f64, stroke: f64) -> Result<(Plant, Vec<f64>, f64), String> {
+    let (plant, x, _) = operating_point(Point::Lowering { u_ref, stroke }, changes)?;
+    let dof = plant.boom.mechanics().dof();
+    let (q, qd) = x[N_CIRCUIT..].split_at(dof);
+    let velocity = plant.boom.kinetics().stroke_rate(q, qd);
+    Ok((plant, x, velocity))
 }
 
 /// The plant with the parameter `changes` and its state and reference at `point`.

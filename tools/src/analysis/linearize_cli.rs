@@ -1,5 +1,6 @@
 //! Options and entry point of `boomsim linearize` (engineering units on the command line).
 
+use super::directional::{circuit_model, CIRCUIT_OUTPUTS};
 use super::linearize::{crossovers, operating_point, LinearModel, Point, DEFAULT_OUTPUTS};
 use super::modes::parameter_change;
 use super::sine_test::{sine_response, AMPLITUDE, SETTLE};
@@ -13,6 +14,12 @@ use std::path::PathBuf;
 /// `boomsim linearize`: the HydraulicBoom's linear model at an operating point.
 #[derive(clap::Args, Debug, Clone)]
 pub struct LinearizeArgs {
+    /// The model: HydraulicBoom (circuit and boom; input valve.u_ref) or HydraulicCircuit (the
+    /// circuit alone with its plain port, through its own directional derivatives; inputs
+    /// valve.u_ref, cylinder.x, cylinder.v; default outputs cylinder.F, p3, p4), at the
+    /// HydraulicBoom's steady lowering.
+    #[arg(long, default_value = "HydraulicBoom", value_parser = ["HydraulicBoom", "HydraulicCircuit"])]
+    pub model: String,
     /// The boom: rigid or flexible (the lumped arm, boom.n2 + boom.n3 sections).
     #[arg(long, default_value = "flexible", value_parser = ["rigid", "flexible"])]
     pub boom: String,
@@ -102,13 +109,27 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
     } else {
         Point::Lowering { u_ref: args.u_ref, stroke: args.stroke * 1e-3 }
     };
-    let outputs: Vec<&str> = if args.outputs.is_empty() {
-        DEFAULT_OUTPUTS.to_vec()
-    } else {
-        args.outputs.iter().map(String::as_str).collect()
+    let circuit = args.model == "HydraulicCircuit";
+    let outputs: Vec<&str> = match (args.outputs.is_empty(), circuit) {
+        (true, true) => CIRCUIT_OUTPUTS.to_vec(),
+        (true, false) => DEFAULT_OUTPUTS.to_vec(),
+        (false, _) => args.outputs.iter().map(String::as_str).collect(),
     };
-    let (plant, x, u_ref) = operating_point(point, &changes)?;
-    let open = super::linearize::linearize(&plant, &x, u_ref, &outputs)?;
+    // The HydraulicBoom's point (for the sine test), or HydraulicCircuit's model at the same.
+    let (open, boom_point) = if circuit {
+        let Point::Lowering { u_ref, stroke } = point else {
+            return Err("--model HydraulicCircuit is linearised at a steady lowering (its port's stroke and velocity \
+                        those of the HydraulicBoom there), not with --rest or --at"
+                .into());
+        };
+        if !args.sine.is_empty() {
+            return Err("--sine drives the HydraulicBoom's closed loop; not with --model HydraulicCircuit".into());
+        }
+        (circuit_model(&changes, u_ref, stroke, &outputs)?, None)
+    } else {
+        let (plant, x, u_ref) = operating_point(point, &changes)?;
+        (super::linearize::linearize(&plant, &x, u_ref, &outputs)?, Some((plant, x, u_ref)))
+    };
     let feedback = args.feedback.then(|| {
         let d = HighPassFeedback::default();
         HighPassFeedback { k_f: args.k_f.unwrap_or(d.k_f), omega_f: args.omega_f.unwrap_or(d.omega_f), ..d }
@@ -122,18 +143,18 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
         None => None,
     };
     let mut report = report(args, point, &model, feedback.as_ref(), margins.as_ref());
-    if let Point::Lowering { stroke, .. } = point {
+    if let (Point::Lowering { stroke, .. }, false) = (point, circuit) {
         if args.bode {
             report["bode"]["reduced_p4"] = reduced_p4(&changes, stroke, &open, feedback.as_ref())?;
         }
     }
-    if let Some(f) = &feedback {
+    if let (Some(f), Some((plant, x, u_ref))) = (&feedback, &boom_point) {
         let mut sines = Vec::new();
         for &f_hz in &args.sine {
             if !(f_hz > 0.0 && f_hz <= 100.0) {
                 return Err(format!("--sine {f_hz} Hz is outside (0, 100] Hz"));
             }
-            let s = sine_response(&plant, &x, u_ref, f, f_hz)?;
+            let s = sine_response(plant, x, *u_ref, f, f_hz)?;
             sines.push(json!({"frequency_hz": f_hz, "output": "p4", "gain": s.response.norm(),
                 "phase_deg": s.response.arg().to_degrees(), "stroke_mm": s.stroke * 1e3}));
         }
@@ -248,6 +269,7 @@ fn report(
         .collect::<Vec<_>>();
     let mut out = json!({
         "point": point,
+        "model": args.model,
         "boom": args.boom,
         "set": args.set,
         "feedback": feedback.map(|f| json!({"K_f": f.k_f, "omega_f": f.omega_f, "Q_rated": f.q_rated})),
@@ -298,11 +320,16 @@ fn unwrap(phases: impl Iterator<Item = f64>) -> Vec<f64> {
 fn text(report: &Json, m: &LinearModel) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ =
-        writeln!(s, "HydraulicBoom ({} boom) linearised at {}", report["boom"].as_str().unwrap_or(""), report["point"]);
     let _ = writeln!(
         s,
-        "{} states, {} input, {} outputs; operating point:",
+        "{} ({} boom) linearised at {}",
+        report["model"].as_str().unwrap_or(""),
+        report["boom"].as_str().unwrap_or(""),
+        report["point"]
+    );
+    let _ = writeln!(
+        s,
+        "{} states, {} inputs, {} outputs; operating point:",
         m.states.len(),
         m.inputs.len(),
         m.outputs.len()

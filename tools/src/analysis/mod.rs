@@ -7,6 +7,7 @@ pub mod cli;
 pub mod criterion;
 #[cfg(test)]
 mod dimensions;
+pub mod directional;
 pub mod feedback;
 pub mod linearize;
 pub mod linearize_cli;
