@@ -13,7 +13,7 @@ fn boomsim(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn wrong_arguments_get_one_clear_line() {
-    let cases: [(&[&str], &[&str]); 19] = [
+    let cases: [(&[&str], &[&str]); 20] = [
         (&["analyze", "--xc", "-10"], &["x_c = -10 mm is outside the stroke [0, 500] mm"]),
         (&["analyze", "--p4", "-5"], &["p4 = -5 bar must be >= 0"]),
         (&["bench", "--duration", "0"], &["0 is not a positive number of seconds"]),
@@ -34,7 +34,11 @@ fn wrong_arguments_get_one_clear_line() {
         (&["linearize", "--output", "p9"], &["--output p9: not an output of the HydraulicBoom", "p4"]),
         (&["linearize", "--at", "-1"], &["--at -1 s is outside (0, 1000] s"]),
         (&["linearize", "--out", "model.txt"], &["--out model.txt: the extension must be .json, .npz or .mat"]),
-        (&["linearize", "--model", "HydraulicCircuit", "--rest"], &["HydraulicCircuit is linearised at a steady lowering"]),
+        (&["linearize", "--feedback", "--k-f", "1"], &["--k-f 1 is outside [0, 1e-8] m4.s2/kg (K_f)"]),
+        (
+            &["linearize", "--model", "HydraulicCircuit", "--rest"],
+            &["HydraulicCircuit is linearised at a steady lowering"],
+        ),
         (
             &["linearize", "--model", "HydraulicCircuit", "--feedback", "--sine", "1"],
             &["--sine drives the HydraulicBoom's closed loop"],

@@ -20,6 +20,7 @@
 
 use super::modes::{plant_values, rest};
 use super::poly::eigenvalues;
+use super::sine_test::run_to;
 use boomsim::control::HighPassFeedback;
 use boomsim::fmu::variables::Kind;
 use boomsim::fmu::{Causality, Model, Value};
@@ -146,22 +147,33 @@ pub enum Point {
     /// tank pressure, friction left out ([`super::modes::rest`]).
     Rest { p4: Option<f64> },
     /// The state at time `t` (s) after the reference steps from 0 to `u_ref` at rest at `stroke`
-    /// (m): a scenario's lowering (U, B) run by the FMU's integrator (Radau IIA, rtol 1e-8).
-    Time { u_ref: f64, stroke: f64, t: f64 },
+    /// (m), the loop open or closed by `feedback` from the step on: a scenario's lowering (U, B)
+    /// run by the FMU's integrator (Radau IIA, rtol 1e-8).
+    Time { u_ref: f64, stroke: f64, t: f64, feedback: Option<HighPassFeedback> },
 }
 
 /// The plant's steady lowering at `u_ref` through `stroke` ([`steady_lowering`]): the plant,
 /// its state and the stroke's velocity there.
 pub fn plant_point(changes: &[(&str, Value)], u_ref: f64, stroke: f64) -> Result<(Plant, Vec<f64>, f64), String> {
-    let (plant, x, _) = operating_point(Point::Lowering { u_ref, stroke }, changes)?;
+    let Operating { plant, x, .. } = operating_point(Point::Lowering { u_ref, stroke }, changes)?;
     let dof = plant.boom.mechanics().dof();
     let (q, qd) = x[N_CIRCUIT..].split_at(dof);
     let velocity = plant.boom.kinetics().stroke_rate(q, qd);
     Ok((plant, x, velocity))
 }
 
+/// The plant at an operating point.
+pub struct Operating {
+    pub plant: Plant,
+    /// The plant's state.
+    pub x: Vec<f64>,
+    pub u_ref: f64,
+    /// The feedback filter's state `filter.p_lp` of a time point run with the loop closed.
+    pub filter: Option<f64>,
+}
+
 /// The plant with the parameter `changes` and its state and reference at `point`.
-pub fn operating_point(point: Point, changes: &[(&str, Value)]) -> Result<(Plant, Vec<f64>, f64), String> {
+pub fn operating_point(point: Point, changes: &[(&str, Value)]) -> Result<Operating, String> {
     let plant = |x0: f64| -> Result<Plant, String> {
         let x = [("start.x", Value::Real(x0))];
         Plant::from_values(&plant_values(changes.iter().cloned().chain(x))?)
@@ -170,21 +182,42 @@ pub fn operating_point(point: Point, changes: &[(&str, Value)]) -> Result<(Plant
         Point::Lowering { u_ref, stroke } => {
             let plant = plant(stroke)?;
             let x = steady_lowering(&plant, u_ref, stroke)?;
-            Ok((plant, x, u_ref))
+            Ok(Operating { plant, x, u_ref, filter: None })
         }
         Point::Rest { p4 } => {
             // rest() sets the boom before `changes`: a boom.flexible there decides.
             let r = rest(true, p4, changes)?;
-            Ok((r.plant, r.state, 0.0))
+            Ok(Operating { plant: r.plant, x: r.state, u_ref: 0.0, filter: None })
         }
-        Point::Time { u_ref, stroke, t } => {
-            let mut plant = plant(stroke)?;
-            let mut x = plant.equilibrium(stroke, None)?;
+        Point::Time { u_ref, stroke, t, feedback } => {
+            let plant = plant(stroke)?;
+            let (x, x_f) = time_point(&plant, stroke, u_ref, t, feedback.as_ref())?;
+            Ok(Operating { plant, x, u_ref, filter: feedback.map(|_| x_f) })
+        }
+    }
+}
+
+/// The plant's state `t` seconds after the reference steps to `u_ref` at rest at `stroke`, and
+/// the filter state there with the `feedback` (without, p4).
+pub fn time_point(
+    plant: &Plant,
+    stroke: f64,
+    u_ref: f64,
+    t: f64,
+    feedback: Option<&HighPassFeedback>,
+) -> Result<(Vec<f64>, f64), String> {
+    let rest = plant.equilibrium(stroke, None)?;
+    match feedback {
+        Some(f) => run_to(plant, &rest, u_ref, f, t),
+        None => {
+            let mut plant = plant.clone();
             plant.u_ref = Ramp { t0: 0.0, y0: u_ref, slope: 0.0 };
+            let mut x = rest;
             let mut solver = Radau5::new(x.len());
             solver.set_tolerance(1e-8, || plant.state_scale()).map_err(|e| e.to_string())?;
             solver.integrate(&plant, 0.0, &mut x, t).map_err(|e| format!("the run to t = {t} s failed: {e}"))?;
-            Ok((plant, x, u_ref))
+            let p4 = x[boomsim::hydraulics::circuit::P4];
+            Ok((x, p4))
         }
     }
 }
@@ -500,8 +533,8 @@ mod tests {
 
     fn lowering(flexible: bool) -> (Plant, Vec<f64>) {
         let changes = [("boom.flexible", Value::Boolean(flexible))];
-        let (plant, x, _) = operating_point(Point::Lowering { u_ref: U_REF, stroke: STROKE }, &changes).unwrap();
-        (plant, x)
+        let o = operating_point(Point::Lowering { u_ref: U_REF, stroke: STROKE }, &changes).unwrap();
+        (o.plant, o.x)
     }
 
     /// Experiment B's reference at Table 6.1's stroke.
@@ -525,8 +558,8 @@ mod tests {
     fn modes_at_rest_equal_eigens() {
         for (flexible, tolerance) in [(false, 1e-8), (true, 5e-4)] {
             let changes = [("boom.flexible", Value::Boolean(flexible))];
-            let (plant, x, u) = operating_point(Point::Rest { p4: Some(1e5) }, &changes).unwrap();
-            let exact = modes_of(&linearize(&plant, &x, u, &DEFAULT_OUTPUTS).unwrap());
+            let o = operating_point(Point::Rest { p4: Some(1e5) }, &changes).unwrap();
+            let exact = modes_of(&linearize(&o.plant, &o.x, o.u_ref, &DEFAULT_OUTPUTS).unwrap());
             let (_, eigen) = hydraulic_boom_modes(flexible, Some(1e5), &[]).unwrap();
             assert_eq!(exact.len(), eigen.len(), "flexible {flexible}");
             for (a, b) in exact.iter().zip(&eigen) {
@@ -584,8 +617,8 @@ mod tests {
                 let measured = sine_response(&plant, &x0, U_REF, &feedback, f_hz).unwrap();
                 let changes = [("boom.flexible", Value::Boolean(flexible))];
                 let point = Point::Lowering { u_ref: U_REF, stroke: measured.stroke };
-                let (p, x, _) = operating_point(point, &changes).unwrap();
-                let closed = linearize(&p, &x, U_REF, &["p4"]).unwrap().closed_loop(&feedback).unwrap();
+                let o = operating_point(point, &changes).unwrap();
+                let closed = linearize(&o.plant, &o.x, U_REF, &["p4"]).unwrap().closed_loop(&feedback).unwrap();
                 let h = closed.frequency_response(std::f64::consts::TAU * f_hz)[(0, 0)];
                 let (gain, phase) = (measured.response.norm() / h.norm(), (measured.response / h).arg().to_degrees());
                 assert!(
@@ -624,8 +657,9 @@ mod tests {
     fn matched_plant_agrees_with_the_reduced_model() {
         use crate::analysis::feedback::{filter, open_loop, valve};
         use crate::analysis::plant::{admittance, HParams};
-        let (plant, x, u) = operating_point(Point::Lowering { u_ref: U_REF, stroke: STROKE }, &MATCHED).unwrap();
-        let m = linearize(&plant, &x, u, &["p4"]).unwrap();
+        let Operating { plant, x, u_ref, .. } =
+            operating_point(Point::Lowering { u_ref: U_REF, stroke: STROKE }, &MATCHED).unwrap();
+        let m = linearize(&plant, &x, u_ref, &["p4"]).unwrap();
         let Boom::Rigid(boom) = &plant.boom else { panic!("rigid") };
         let op = crate::analysis::OperatingPoint::of_circuit(&plant.circuit, boom, STROKE, m.y0[0]);
         let lin = op.linearise().unwrap();

@@ -6,6 +6,7 @@ use super::modes::parameter_change;
 use super::sine_test::{sine_response, AMPLITUDE, SETTLE};
 use crate::arrays::{self, Array};
 use boomsim::control::HighPassFeedback;
+use boomsim::fmu::log::num;
 use boomsim::fmu::Value;
 use nalgebra::{Complex, DMatrix};
 use serde_json::{json, Value as Json};
@@ -96,6 +97,19 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
     if !(-1.0..=1.0).contains(&args.u_ref) {
         return Err(format!("--u-ref {} is outside [-1, 1] (valve.u_ref's range)", args.u_ref));
     }
+    let feedback = args.feedback.then(|| {
+        let d = HighPassFeedback::default();
+        HighPassFeedback { k_f: args.k_f.unwrap_or(d.k_f), omega_f: args.omega_f.unwrap_or(d.omega_f), ..d }
+    });
+    if let Some(f) = &feedback {
+        for (k, x) in [f.k_f, f.omega_f].into_iter().enumerate() {
+            let p = &boomsim::control::FEEDBACK_PARAMS[k].spec;
+            if !(p.min..=p.max).contains(&x) {
+                let (flag, lo, hi) = (["k-f", "omega-f"][k], num(p.min), num(p.max));
+                return Err(format!("--{flag} {} is outside [{lo}, {hi}] {} ({})", num(x), p.unit, p.name));
+            }
+        }
+    }
     let point = if args.rest {
         if let Some(p) = args.p4.filter(|p| !(0.0..=100.0).contains(p)) {
             return Err(format!("--p4 {p} bar is outside [0, 100] bar (start.p4's range)"));
@@ -105,7 +119,7 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
         if !(t > 0.0 && t <= 1000.0) {
             return Err(format!("--at {t} s is outside (0, 1000] s"));
         }
-        Point::Time { u_ref: args.u_ref, stroke: args.start * 1e-3, t }
+        Point::Time { u_ref: args.u_ref, stroke: args.start * 1e-3, t, feedback }
     } else {
         Point::Lowering { u_ref: args.u_ref, stroke: args.stroke * 1e-3 }
     };
@@ -127,15 +141,17 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
         }
         (circuit_model(&changes, u_ref, stroke, &outputs)?, None)
     } else {
-        let (plant, x, u_ref) = operating_point(point, &changes)?;
-        (super::linearize::linearize(&plant, &x, u_ref, &outputs)?, Some((plant, x, u_ref)))
+        let o = operating_point(point, &changes)?;
+        (super::linearize::linearize(&o.plant, &o.x, o.u_ref, &outputs)?, Some(o))
     };
-    let feedback = args.feedback.then(|| {
-        let d = HighPassFeedback::default();
-        HighPassFeedback { k_f: args.k_f.unwrap_or(d.k_f), omega_f: args.omega_f.unwrap_or(d.omega_f), ..d }
-    });
     let model = match &feedback {
-        Some(f) => open.closed_loop(f)?,
+        Some(f) => {
+            let mut closed = open.closed_loop(f)?;
+            if let Some(x_f) = boom_point.as_ref().and_then(|o| o.filter) {
+                *closed.x0.last_mut().expect("the filter state") = x_f;
+            }
+            closed
+        }
         None => open.clone(),
     };
     let margins = match &feedback {
@@ -148,13 +164,13 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
             report["bode"]["reduced_p4"] = reduced_p4(&changes, stroke, &open, feedback.as_ref())?;
         }
     }
-    if let (Some(f), Some((plant, x, u_ref))) = (&feedback, &boom_point) {
+    if let (Some(f), Some(o)) = (&feedback, &boom_point) {
         let mut sines = Vec::new();
         for &f_hz in &args.sine {
             if !(f_hz > 0.0 && f_hz <= 100.0) {
                 return Err(format!("--sine {f_hz} Hz is outside (0, 100] Hz"));
             }
-            let s = sine_response(plant, x, *u_ref, f, f_hz)?;
+            let s = sine_response(&o.plant, &o.x, o.u_ref, f, f_hz)?;
             sines.push(json!({"frequency_hz": f_hz, "output": "p4", "gain": s.response.norm(),
                 "phase_deg": s.response.arg().to_degrees(), "stroke_mm": s.stroke * 1e3}));
         }
@@ -257,7 +273,9 @@ fn report(
     let point = match point {
         Point::Lowering { u_ref, stroke } => json!({"kind": "lowering", "u_ref": u_ref, "stroke_mm": stroke * 1e3}),
         Point::Rest { p4 } => json!({"kind": "rest", "p4_bar": p4.unwrap_or(0.0) / 1e5}),
-        Point::Time { u_ref, stroke, t } => json!({"kind": "time", "u_ref": u_ref, "start_mm": stroke * 1e3, "t": t}),
+        Point::Time { u_ref, stroke, t, .. } => {
+            json!({"kind": "time", "u_ref": u_ref, "start_mm": stroke * 1e3, "t": t})
+        }
     };
     let eig = m
         .eigenvalues()

@@ -84,6 +84,27 @@ fn run(sys: &Driven<'_>, x0: &[f64], periods: usize) -> Result<Vec<[f64; 3]>, St
     Ok(out)
 }
 
+/// The closed loop from the plant state `x0` with the filter at rest at its p4 (the controller
+/// starting with the step, as in the thesis) under the held reference `u_ref` until `t_end`:
+/// (the plant's state, the filter state `filter.p_lp`). The time-point form of `boomsim
+/// linearize --at T --feedback`.
+pub fn run_to(
+    plant: &Plant,
+    x0: &[f64],
+    u_ref: f64,
+    feedback: &HighPassFeedback,
+    t_end: f64,
+) -> Result<(Vec<f64>, f64), String> {
+    let sys = Driven { plant, feedback, u_ref, amplitude: 0.0, omega: 0.0 };
+    let mut x = x0.to_vec();
+    x.push(x0[P4]);
+    let mut solver = Radau5::new(x.len());
+    solver.set_tolerance(1e-8, || plant.state_scale().into_iter().chain([1e5]).collect()).map_err(|e| e.to_string())?;
+    solver.integrate(&sys, 0.0, &mut x, t_end).map_err(|e| format!("the run to t = {t_end} s failed: {e}"))?;
+    let x_f = x.pop().expect("the filter state");
+    Ok((x, x_f))
+}
+
 /// p4's response to a swing of the reference at `frequency_hz` around the steady lowering `x0`
 /// at `u_ref`, the loop closed by `feedback`: over at least two periods and one second.
 pub fn sine_response(
@@ -98,18 +119,25 @@ pub fn sine_response(
     let driven = |amplitude| Driven { plant, feedback, u_ref, amplitude, omega };
     let with = run(&driven(AMPLITUDE), x0, periods)?;
     let without = run(&driven(0.0), x0, periods)?;
-    // Least squares of d(t) = c1 sin + c2 cos + c3 + c4 (t - t0).
-    let t0 = with[0][0];
-    let m = DMatrix::from_fn(with.len(), 4, |i, j| {
-        let t = with[i][0];
-        [(omega * t).sin(), (omega * t).cos(), 1.0, t - t0][j]
-    });
-    let d = DVector::from_iterator(with.len(), with.iter().zip(&without).map(|(p, q)| p[1] - q[1]));
-    let c = (m.transpose() * &m).lu().solve(&(m.transpose() * d)).ok_or("the sine fit is singular")?;
-    // u = a sin(w t) -> p = a |H| sin(w t + phi) = a |H| (cos phi sin + sin phi cos).
+    let d: Vec<(f64, f64)> = with.iter().zip(&without).map(|(p, q)| (p[0], p[1] - q[1])).collect();
+    let c = fundamental(&d, omega)?;
     Ok(SineResponse {
         frequency_hz,
-        response: Complex::new(c[0], c[1]) / AMPLITUDE,
+        response: c / AMPLITUDE,
         stroke: without.iter().map(|s| s[2]).sum::<f64>() / without.len() as f64,
     })
+}
+
+/// The fundamental at `omega` of samples `(t, y)` over whole periods: the least-squares fit of
+/// `y = c1 sin(w t) + c2 cos(w t) + c3 + c4 (t - t0)` (a linear trend takes the drift), as the
+/// complex amplitude `c1 + j c2` of `sin(w t)`: `|c| sin(w t + arg c)`.
+pub fn fundamental(samples: &[(f64, f64)], omega: f64) -> Result<Complex<f64>, String> {
+    let t0 = samples.first().ok_or("no samples")?.0;
+    let m = DMatrix::from_fn(samples.len(), 4, |i, j| {
+        let t = samples[i].0;
+        [(omega * t).sin(), (omega * t).cos(), 1.0, t - t0][j]
+    });
+    let y = DVector::from_iterator(samples.len(), samples.iter().map(|s| s.1));
+    let c = (m.transpose() * &m).lu().solve(&(m.transpose() * y)).ok_or("the sine fit is singular")?;
+    Ok(Complex::new(c[0], c[1]))
 }
