@@ -117,3 +117,21 @@ def test_the_bode_figure_has_its_text_inside_and_the_sine_points(tmp_path):
     points = gain.lines[-1]
     for x, y in zip(points.get_xdata(), points.get_ydata()):
         assert y * 1e5 == pytest.approx(np.interp(np.log(x), np.log(f), g), rel=0.05), x
+
+
+def test_a_scenario_file_sets_the_point_and_the_filter():
+    """scripts/linearize_scenario.py: C2.1's filter (K_f 2e-11, omega_f 17.91, Table 7.3) closes
+    the loop at its final reference; U (controller off) at 5 s into its run stays open."""
+    import sys
+
+    def run(*args):
+        cmd = [sys.executable, str(ROOT / "scripts" / "linearize_scenario.py"), *args, "--", "--json"]
+        out = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        assert out.returncode == 0, out.stderr
+        return json.loads(out.stdout)
+
+    c21 = run("C2.1", "--boom", "rigid")
+    assert c21["feedback"]["K_f"] == 2e-11 and c21["feedback"]["omega_f"] == 17.91
+    assert c21["point"] == {"kind": "lowering", "u_ref": -0.05, "stroke_mm": 250.0}
+    u = run("U", "--boom", "rigid", "--at", "5")
+    assert u["feedback"] is None and u["point"] == {"kind": "time", "u_ref": -0.1, "start_mm": 480.0, "t": 5.0}

@@ -347,7 +347,7 @@ fn text(report: &Json, m: &LinearModel) -> String {
     );
     let _ = writeln!(
         s,
-        "{} states, {} inputs, {} outputs; operating point:",
+        "states {}, inputs {}, outputs {}; the operating point:",
         m.states.len(),
         m.inputs.len(),
         m.outputs.len()
