@@ -601,7 +601,7 @@ mod tests {
 
     /// The small-signal test ([`crate::analysis::sine_test`]): the nonlinear closed loop
     /// (experiment B's filter) from the steady lowering at 250 mm, its reference swinging by 2 %
-    /// of u_ref at 1, 2.5 and 5 Hz (around the closed loop's 2.1-2.4 Hz mode), against the
+    /// of u_ref at 1, 2.5 and 5 Hz (around the closed loop's 2.2 Hz pair), against the
     /// closed-loop linear model's response from `valve.u_ref` to p4. The boom lowers meanwhile
     /// (9 mm/s): the linear model is taken at the steady lowering through the mean stroke of the
     /// fitted window (~215 mm); at the start's 250 mm it is 1.4 % off at 2.5 and 5 Hz, for either

@@ -17,8 +17,8 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 /// The swing's amplitude in spool opening: 2 % of experiment B's reference.
 pub const AMPLITUDE: f64 = 1e-3;
-/// Settling time before the fit (s): the closed loop's slowest oscillatory mode at B's point
-/// decays at 6.5 1/s, by e^-20 in 3 s.
+/// Settling time before the fit (s): the closed loop's slowest oscillatory pair at B's point
+/// decays at 5.5 1/s (flexible arm; rigid 10 1/s), by e^-16 in 3 s.
 pub const SETTLE: f64 = 3.0;
 
 /// The plant closed with the feedback and driven by `u_ref + a sin(w t)`; the filter state last.
