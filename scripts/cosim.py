@@ -46,6 +46,7 @@ import tomllib
 
 import numpy as np
 
+import figures
 from metrics import CBV_OPEN
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -690,7 +691,7 @@ def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
         title += f"; p3 settles (2 %) at {ts:.2f} s" if ts is not None else "; p3 does not settle (2 %)"
     fig.suptitle(title, fontsize=10)
     axes[0, 0].figure.align_ylabels(axes[:, 0])
-    fig.savefig(path, dpi=90)
+    figures.save(fig, path, dpi=90)
     plt.close(fig)
 
 

@@ -39,6 +39,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
+import figures
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 FMU = ROOT / "target" / "fmu" / "HydraulicBoom.fmu"
 P_ATM = 101325.0
@@ -343,13 +345,13 @@ def main():
             t, p3, _ = boom.run(u, 0.48)
             ax[1].plot(t, p3 / 1e5, color=c, lw=0.6, label=f"u = {u}, from 480 mm")
         ax[0].axvline(crit[-0.05]["x_287"] * 1e3, color="k", ls="--", label="x_c eq. 2.87")
-        ax[0].set(xlabel="start stroke (mm)", ylabel="largest p3 peak-to-peak (bar)")
-        ax[1].set(xlabel="t (s)", ylabel="p3 (bar)")
+        ax[0].set(xlabel="start stroke [mm]", ylabel="largest p3 peak-to-peak [bar]")
+        ax[1].set(xlabel="t [s]", ylabel="p3 [bar]")
         for a_ in ax:
             a_.legend()
             a_.grid(alpha=0.3)
         fig.tight_layout()
-        fig.savefig(out / "instability.png", dpi=120)
+        figures.save(fig, out / "instability.png", dpi=120)
         print(f"wrote {out / 'instability.png'}")
 
 

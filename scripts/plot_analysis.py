@@ -14,6 +14,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import figures  # noqa: E402
+
 
 def read(path):
     with open(path, newline="") as f:
@@ -52,20 +54,20 @@ def main(out):
             title="Stability boundary over the flow (dotted: eq. 2.87)", ylim=(0, 500))
     ax2.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "stability_boundary.png", dpi=120)
+    figures.save(fig, out / "stability_boundary.png", dpi=120)
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
     for n_k, rows in grouped(read(out / "margins.csv"), "n_K"):
         w = [num(r, "n_omega") for r in rows]
         ax1.semilogx(w, [num(r, "gain_margin_db") for r in rows], label=f"n_K = {n_k:g}")
         ax2.semilogx(w, [num(r, "phase_margin_deg") for r in rows], label=f"n_K = {n_k:g}")
-    ax1.set(xlabel="n_omega", ylabel="gain margin [dB]", title="(a) Gain margin (Fig. 6.4a)")
-    ax2.set(xlabel="n_omega", ylabel="phase margin [deg]", title="(b) Phase margin (Fig. 6.4b)")
+    ax1.set(xlabel="n_omega [-]", ylabel="gain margin [dB]", title="(a) Gain margin (Fig. 6.4a)")
+    ax2.set(xlabel="n_omega [-]", ylabel="phase margin [deg]", title="(b) Phase margin (Fig. 6.4b)")
     for ax in (ax1, ax2):
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "margins.png", dpi=120)
+    figures.save(fig, out / "margins.png", dpi=120)
     print(out / "stability_boundary.png")
     print(out / "margins.png")
 

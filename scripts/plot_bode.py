@@ -19,6 +19,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import figures  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 BOOMSIM = ROOT / "target" / "release" / "boomsim"
 SINE_HZ = "0.5,1,1.5,2,2.5,3,4,5,7,10"
@@ -74,7 +76,7 @@ def main(path, boom="flexible", u_ref=-0.05, stroke=250.0, outputs=("p4",)):
                  f"steady lowering at u_ref = {u_ref:g} through {stroke:g} mm (boomsim linearize)", fontsize=11)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    figures.save(fig, path, dpi=110)
     return fig
 
 

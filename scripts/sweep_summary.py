@@ -22,9 +22,12 @@ from __future__ import annotations
 import itertools
 import math
 import pathlib
+import textwrap
 
 import numpy as np
 
+import cosim
+import figures
 import linear
 from metrics import DEFINITIONS
 
@@ -200,13 +203,27 @@ def outline(ax, region: np.ndarray, ex: np.ndarray, ey: np.ndarray):
                 ax.plot(xs, ys, color="r", lw=1.5)
 
 
+def axis_label(name: str) -> str:
+    """A swept parameter with its unit: the FMUs' declared one, "-" for the filter factors n_K,
+    n_omega and a dimensionless parameter, seconds for the communication step."""
+    if name == "step":
+        return "communication step [s]"
+    for identifier in ("HydraulicBoom", "PressureFeedbackController"):
+        v = cosim.FmuFile.get(identifier).vars.get(name)
+        if v is not None:
+            return f"{name} [{v.unit if v.unit not in (None, '', '1') else '-'}]"
+    return f"{name} [-]"
+
+
 def draw(sweep, grid: Grid, m: str, region, rec, linear: dict, fine_xy, path: pathlib.Path, plt):
     """One panel per panel value: the metric's worst value per cell (grey: not settled, white:
     failed), the settle region's cells outlined, the recommendation starred, the linear
     boundary drawn."""
     nr, nc = (len(grid.panel_values[1]) if len(grid.panel_values) > 1 else 1,
               len(grid.panel_values[0]) if grid.panel_values else 1)
-    fig, axs = plt.subplots(nr, nc, figsize=(3.6 * nc + 1.2, 3.2 * nr + 0.6), squeeze=False, sharex=True, sharey=True)
+    width = 3.6 * nc + 1.6
+    fig, axs = plt.subplots(nr, nc, figsize=(width, 3.2 * nr + 1.2), squeeze=False, sharex=True, sharey=True,
+                            layout="constrained")
     zs = [grid.worst(m, p) for p in grid.panels]
     finite = np.concatenate([z[np.isfinite(z)] for z in zs]) if zs else np.array([])
     vmin, vmax = (finite.min(), finite.max()) if len(finite) else (0.0, 1.0)
@@ -231,12 +248,14 @@ def draw(sweep, grid: Grid, m: str, region, rec, linear: dict, fine_xy, path: pa
                    yticks=range(len(grid.ys)), yticklabels=[f"{y:.3g}" for y in grid.ys])
         ax.set_title(grid.label(p), fontsize=9)
     for ax in axs[-1]:
-        ax.set_xlabel(grid.axes[0])
+        ax.set_xlabel(axis_label(grid.axes[0]))
     for ax in axs[:, 0]:
-        ax.set_ylabel(grid.axes[1])
-    fig.suptitle(f"{sweep['scenario']['id']}-{sweep['boom']}, {sweep['stop_time']:g} s: worst {m} "
-                 f"(grey: not settled; red: every point settles, star: recommended; white dashed: linear boundary)",
-                 fontsize=8)
+        ax.set_ylabel(axis_label(grid.axes[1]))
+    key = ("grey: not settled; red outline: every point settles; star: recommended; white dashed: linear "
+           "boundary")
+    # About 15 characters of 8 pt text per inch of width.
+    fig.suptitle(f"{sweep['scenario']['id']}-{sweep['boom']}, {sweep['stop_time']:g} s: worst {m}\n"
+                 + textwrap.fill(key, int(15 * width)), fontsize=8)
     fig.colorbar(im, ax=axs, label=f"{m} [{DEFINITIONS[m][0]}]")
-    fig.savefig(path, dpi=90)
+    figures.save(fig, path, dpi=90)
     plt.close(fig)

@@ -2,6 +2,7 @@
 recorded (fmpy's logger proxy formats the FMU's printf-style "%s" messages)."""
 
 import ctypes
+import os
 import pathlib
 
 import pytest
@@ -17,6 +18,10 @@ from fmpy import calloc, free
 from fmpy.logging import addLoggerProxy
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+# Every figure a script saves while the tests run, in this process or a child, is checked
+# (scripts/figures.py): text inside the canvas, every axis labelled with its unit.
+os.environ["BOOMSIM_STRICT_FIGURES"] = "1"
 FMU_DIR = ROOT / "target" / "fmu"
 
 

@@ -95,9 +95,9 @@ def test_the_circuit_has_the_ports_inputs(tmp_path):
     np.testing.assert_array_equal(mat["D"], np.array(report["D"]))
 
 
-def test_the_bode_figure_has_its_text_inside_and_the_sine_points(tmp_path):
-    """scripts/plot_bode.py (docs/linearize.md's figure): every text inside the canvas, both axes
-    labelled with units, the sine test's points on the closed-loop curve within 5 % (they are
+def test_the_bode_figure_has_the_sine_points_on_its_curve(tmp_path):
+    """scripts/plot_bode.py (docs/linearize.md's figure; scripts/figures.py checks its text and
+    units as it saves): the sine test's points on the closed-loop curve within 5 % (they are
     measured some 35 mm further down the stroke than the curve's point: about 1 %)."""
     import sys
 
@@ -106,12 +106,7 @@ def test_the_bode_figure_has_its_text_inside_and_the_sine_points(tmp_path):
 
     fig = plot_bode.main(tmp_path / "bode.png")
     assert (tmp_path / "bode.png").stat().st_size > 10_000
-    # The tight box of everything drawn (titles, legend, labels, tick labels) within the canvas.
-    tight = fig.get_tightbbox(fig.canvas.get_renderer())
-    width, height = fig.get_size_inches()
-    assert tight.x0 >= 0 and tight.y0 >= 0 and tight.x1 <= width and tight.y1 <= height, tight
-    gain, phase = fig.axes
-    assert "[bar" in gain.get_ylabel() and "[deg]" in phase.get_ylabel() and "[Hz]" in phase.get_xlabel()
+    gain, _ = fig.axes
     closed = json.loads(linearize("--boom", "flexible", "--output", "p4", "--feedback", "--bode", "--json"))
     f, g = closed["bode"]["frequency_hz"], closed["bode"]["channels"][0]["gain"]
     points = gain.lines[-1]

@@ -228,3 +228,16 @@ def test_the_native_runner_gives_fmpys_rows_bit_for_bit(scenario, boom, kw):
     assert (a.counts, a.feedback_on_at) == (b.counts, b.feedback_on_at)
     with pytest.raises(TimeoutError, match="exceeded the timeout of 0.0001 s"):
         cosim.run_native(sc, boom, stop_time=1.0, timeout=1e-4, **kw)
+
+
+def test_the_filter_sweeps_map_is_readable(tmp_path):
+    """scripts/sweeps/filter.toml's map (one narrow panel: its title was cut off at both ends and
+    its axes named without units) from made-up rows: scripts/figures.py's checks pass (text inside
+    the canvas, the K_f and omega_f axes and the colour bar with units), as for every figure the
+    tests write (BOOMSIM_STRICT_FIGURES)."""
+    s = sweep.load(cosim.ROOT / "scripts" / "sweeps" / "filter.toml")
+    rows = [{**p, "p3_pp_late": 1e11 * p["K_f"], "t_settle": 0.01 * p["omega_f"], "status": "ok", "error": "",
+             "wall_time": 0.0, "worker": "made up"} for p in s["points"]]
+    sweep_summary.write(s, rows, tmp_path)
+    assert sweep_summary.axis_label("K_f") == "K_f [m4.s2/kg]" and sweep_summary.axis_label("n_K") == "n_K [-]"
+    assert (tmp_path / "map-t_settle.png").exists()
