@@ -73,9 +73,16 @@ def test_eigenvalues_match_lapack(flexible):
 
 
 def test_feedback_adds_the_filter_state_and_margins():
-    report = json.loads(linearize("--boom", "rigid", "--feedback", "--json"))
+    report = json.loads(linearize("--boom", "rigid", "--feedback", "--bode", "--json"))
     assert [s["name"] for s in report["states"]][-1] == "filter.p_lp"
     assert report["margins"]["gain"] and report["margins"]["phase"]
+    # The loop transfer function crosses |L| = 1 at the reported gain crossovers (between the
+    # Bode grid's neighbours, 40 per decade).
+    f, gain = np.array(report["bode"]["frequency_hz"]), np.array(report["bode"]["open_loop"]["gain"])
+    crossings = f[1:][np.diff(np.sign(np.log(gain))) != 0]
+    for p in report["margins"]["phase"]:
+        if 0.1 < p["frequency_hz"] < 100:
+            assert np.min(np.abs(np.log10(crossings / p["frequency_hz"]))) < 1 / 40, p
     # Closed loop of experiment B at 250 mm: every eigenvalue but the stroke's neutral one
     # (|lambda| < 1e-3 1/s: a lowering through another stroke is as steady) in the left half
     # plane (Fig. 6.10: B settles); without the feedback a pair is in the right one (Fig. 7.1).

@@ -63,7 +63,8 @@ pub struct LinearizeArgs {
     pub set: Vec<String>,
     /// Add the frequency response of every output to valve.u_ref (0.1 to 100 Hz, 40 points per
     /// decade) to the JSON, and at a steady lowering that of p4 in section 2.3's reduced model
-    /// (eq. 2.76, 2.81, 6.4; with --feedback 6.8's loop) at the same point with the rigid boom.
+    /// (eq. 2.76, 2.81, 6.4; with --feedback 6.8's loop) at the same point with the rigid boom;
+    /// with --feedback also the loop transfer function L (the margins' open loop).
     #[arg(long)]
     pub bode: bool,
     /// With --feedback at a steady lowering: p4's response to a 2 % swing of the reference at
@@ -163,6 +164,15 @@ pub fn run(args: &LinearizeArgs) -> Result<(), String> {
         if args.bode {
             report["bode"]["reduced_p4"] = reduced_p4(&changes, stroke, &open, feedback.as_ref())?;
         }
+    }
+    if let (Some(f), true) = (&feedback, args.bode) {
+        // The loop transfer function whose margins are reported: L(jw) cut at the spool reference.
+        let l: Vec<Complex<f64>> = bode_frequencies()
+            .iter()
+            .map(|f_hz| open.open_loop(f, f_hz * std::f64::consts::TAU))
+            .collect::<Result<_, _>>()?;
+        report["bode"]["open_loop"] = json!({"gain": l.iter().map(|l| l.norm()).collect::<Vec<_>>(),
+            "phase_deg": unwrap(l.iter().map(|l| l.arg().to_degrees()))});
     }
     if let (Some(f), Some(o)) = (&feedback, &boom_point) {
         let mut sines = Vec::new();
