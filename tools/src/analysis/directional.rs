@@ -3,7 +3,7 @@
 //! HydraulicCircuit with its plain port (`boomsim linearize --model HydraulicCircuit`), whose
 //! inputs are the spool reference and the port's stroke and velocity.
 
-use super::linearize::{plant_point, LinearModel, Signal};
+use super::linearize::{plant_point, unit_of, LinearModel, Signal};
 use boomsim::fmu::{Causality, Model, Seeds, Value, Values};
 use boomsim::hydraulics::circuit::N_STATES as N_CIRCUIT;
 use boomsim::models::HydraulicCircuit;
@@ -22,11 +22,7 @@ fn signal<M: Model>(name: &str, causality: &[Causality]) -> Result<(u32, Signal)
         .iter()
         .find(|v| v.name == name && causality.contains(&v.causality))
         .ok_or_else(|| format!("{} has no {causality:?} variable \"{name}\"", M::INFO.identifier))?;
-    let unit = match v.kind {
-        boomsim::fmu::Kind::Real { unit, .. } if !unit.is_empty() => unit,
-        _ => "1",
-    };
-    Ok((v.vr, Signal { name: v.name.to_string(), unit: unit.to_string() }))
+    Ok((v.vr, Signal { name: v.name.to_string(), unit: unit_of(v) }))
 }
 
 /// The linear model of `model` at its continuous states and the inputs in `values`: one

@@ -253,7 +253,7 @@ fn seed(seeded: bool) -> f64 {
 }
 
 /// A Real variable's unit ("1" for none).
-fn unit_of(v: &boomsim::fmu::Variable) -> String {
+pub(crate) fn unit_of(v: &boomsim::fmu::Variable) -> String {
     match v.kind {
         Kind::Real { unit, .. } if !unit.is_empty() => unit.to_string(),
         _ => "1".to_string(),
