@@ -24,7 +24,7 @@ use super::sine_test::run_to;
 use boomsim::control::HighPassFeedback;
 use boomsim::fmu::variables::Kind;
 use boomsim::fmu::{Causality, Model, Value};
-use boomsim::hydraulics::circuit::{N_STATES as N_CIRCUIT, STATE_NAMES};
+use boomsim::hydraulics::circuit::{N_STATES as N_CIRCUIT, P2, P3, P4, STATE_NAMES};
 use boomsim::models::hydraulic_boom::{Boom, Plant};
 use boomsim::models::port::Ramp;
 use boomsim::models::HydraulicBoom;
@@ -127,11 +127,6 @@ impl LinearModel {
         let jw = Complex::new(0.0, omega);
         Ok(-jw * (f.k_f / f.q_rated) / (jw / f.omega_f + 1.0) * p)
     }
-
-    /// The index of the output `name`.
-    pub fn output(&self, name: &str) -> Result<usize, String> {
-        self.outputs.iter().position(|s| s.name == name).ok_or_else(|| format!("the model has no output \"{name}\""))
-    }
 }
 
 fn complex(x: f64) -> Complex<f64> {
@@ -226,7 +221,7 @@ pub fn time_point(
 pub const DEFAULT_OUTPUTS: [&str; 5] = ["p3", "p4", "cylinder.x", "cylinder.v", "boom.tip_deflection"];
 
 /// The names and units of the plant's native states (module doc).
-pub fn state_signals(plant: &Plant) -> Vec<Signal> {
+fn state_signals(plant: &Plant) -> Vec<Signal> {
     let unit = |name: &str| HydraulicBoom::VARIABLES.iter().find(|v| v.name == name).map_or("1".into(), unit_of);
     let mut s: Vec<Signal> = STATE_NAMES.iter().map(|n| Signal { name: n.to_string(), unit: unit(n) }).collect();
     match &plant.boom {
@@ -347,22 +342,22 @@ pub fn steady_lowering(plant: &Plant, u_ref: f64, stroke: f64) -> Result<Vec<f64
     let dof = plant.boom.mechanics().dof();
     let n = N_CIRCUIT + dof + 1;
     let scale = plant.state_scale();
-    let z_scale: Vec<f64> = scale[..N_CIRCUIT + dof].iter().copied().chain([scale[N_CIRCUIT + dof]]).collect();
-    let state = |z: &[f64]| -> Vec<f64> {
-        let mut s = z[..N_CIRCUIT + dof].to_vec();
-        s.extend(std::iter::repeat_n(z[n - 1], dof));
-        s
-    };
+    // The unknowns' scales: the states' up to the first rate, which the common rate takes.
+    let z_scale = &scale[..n];
+    // The plant state of the unknowns: every rate the common one.
+    fn state<T: Copy>(z: &[T], dof: usize) -> Vec<T> {
+        let (head, rate) = z.split_at(z.len() - 1);
+        head.iter().copied().chain(std::iter::repeat_n(rate[0], dof)).collect()
+    }
     // The residual in units of each unknown's scale (per second for the derivatives).
     let residual = |z: &[Dual64]| -> Vec<Dual64> {
-        let mut s = z[..N_CIRCUIT + dof].to_vec();
-        s.extend(std::iter::repeat_n(z[n - 1], dof));
+        let s = state(z, dof);
         let mut ds = vec![Dual64::from(0.0); s.len()];
         plant.rhs_with(Dual64::from(u_ref), &s, &mut ds);
         let mut r: Vec<Dual64> = ds[..N_CIRCUIT].to_vec();
         r.extend_from_slice(&ds[N_CIRCUIT + dof..]);
         r.push(plant.boom.kinetics().stroke(&s[N_CIRCUIT..N_CIRCUIT + dof]) - stroke);
-        r.iter_mut().zip(&z_scale).for_each(|(r, s)| *r = *r / *s);
+        r.iter_mut().zip(z_scale).for_each(|(r, s)| *r = *r / *s);
         r
     };
     let eval = |z: &[f64]| -> (Vec<f64>, DMatrix<f64>) {
@@ -385,9 +380,9 @@ pub fn steady_lowering(plant: &Plant, u_ref: f64, stroke: f64) -> Result<Vec<f64
             format!("no steady lowering at valve.u_ref = {u_ref} through {stroke} m: a singular Jacobian")
         })?;
         // The Newton step in units of each unknown's scale.
-        let size = step.iter().zip(&z_scale).map(|(d, s)| (d / s).abs()).fold(0.0, f64::max);
+        let size = step.iter().zip(z_scale).map(|(d, s)| (d / s).abs()).fold(0.0, f64::max);
         if size < STEP_TOLERANCE {
-            return cavitation_free(state(&z), u_ref, stroke);
+            return cavitation_free(state(&z, dof), u_ref, stroke);
         }
         let mut lambda = 1.0;
         loop {
@@ -417,8 +412,9 @@ const STEP_TOLERANCE: f64 = 1e-6;
 /// start at tank pressure, before the start below). Above half an atmosphere absolute the oil
 /// holds 97 % of its bulk modulus at the default air fraction.
 fn cavitation_free(state: Vec<f64>, u_ref: f64, stroke: f64) -> Result<Vec<f64>, String> {
-    for (k, p) in state[..N_CIRCUIT].iter().enumerate().take(3) {
-        if *p < -0.5 * P_ATM {
+    for k in [P2, P3, P4] {
+        let p = state[k];
+        if p < -0.5 * P_ATM {
             return Err(format!(
                 "the steady lowering at valve.u_ref = {u_ref} through stroke {} mm has {} at {:.3} bar: the line \
                  cavitates there, where the linearisation means nothing; linearise at a time point of the run \
