@@ -3,16 +3,14 @@
 
 import argparse
 import math
-import pathlib
 import sys
 import time
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
+from boomsim.errors import UsageError, cli
+from boomsim.paths import fmu
 
 
 def main(argv=None):
@@ -20,11 +18,8 @@ def main(argv=None):
     parser.add_argument("--cycles", type=int, default=20000, help="cycles to time (default 20000)")
     n = parser.parse_args(argv).cycles
     if n < 1:
-        raise cosim.UsageError(f"--cycles {n}: must be at least 1")
-    path = ROOT / "target" / "fmu" / "PressureFeedbackController.fmu"
-    if not path.exists():
-        raise cosim.UsageError(f"{path} is missing: run `cargo build --release && target/release/boomsim pack`")
-    path = str(path)
+        raise UsageError(f"--cycles {n}: must be at least 1")
+    path = str(fmu("PressureFeedbackController"))
     md = read_model_description(path)
     vr = {v.name: v.valueReference for v in md.modelVariables}
     s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier=md.coSimulation.modelIdentifier)
@@ -45,4 +40,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

@@ -1,10 +1,10 @@
 """Model Exchange against Co-Simulation, the comparison a user makes before choosing an interface:
 cases U and B (10 s, as `boomsim bench`), rigid and flexible boom, plant and controller
 
-    CS: fmpy drives both FMUs' fmi2DoStep at 1 ms (scripts/cosim.py `run`, the internal Radau IIA
+    CS: fmpy drives both FMUs' fmi2DoStep at 1 ms (boomsim.cosim `run`, the internal Radau IIA
         solver at rtol 1e-6, the controller fed p4 with its slope over each step);
     ME: fmpy's CVode (BDF, rtol 1e-6, atol = rtol x nominals) integrates both FMUs as one ODE
-        (scripts/cosim.py `run_me`: no communication step, no delay in the loop);
+        (boomsim.model_exchange `run_me`: no communication step, no delay in the loop);
 
 with wall time, real-time factor, the plant's right-hand-side evaluations, and the error against a
 reference: ME at rtol 1e-9, the continuous loop without a communication step. A second table
@@ -22,14 +22,15 @@ Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only | --flexible-o
 """
 
 import argparse
-import pathlib
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).parent))
-import cosim  # noqa: E402
+from boomsim import cosim, paths
+from boomsim.errors import cli, parse_params
+from boomsim.model_exchange import run_me
+from boomsim.scenarios import load_scenario
 
 STOP = 10.0
 CASES = [("U", "rigid"), ("B", "rigid"), ("U", "flexible"), ("B", "flexible")]
@@ -47,12 +48,12 @@ def interface_rows(cases, params: dict) -> list:
     rows = []
     start = time.perf_counter()
     for k, (sid, boom) in enumerate(cases, 1):
-        sc = cosim.load_scenario(sid)
+        sc = load_scenario(sid)
         print(f"[{k}/{len(cases)} {time.perf_counter() - start:.0f} s] {sid} {boom}: reference (ME, rtol 1e-9) ...",
               flush=True)
-        ref = cosim.run_me(sc, boom, stop_time=STOP, tolerance=1e-9, params=params)
+        ref = run_me(sc, boom, stop_time=STOP, tolerance=1e-9, params=params)
         for interface, run in (("CS 1 ms", lambda: cosim.run(sc, boom, stop_time=STOP, params=params)),
-                               ("ME CVode", lambda: cosim.run_me(sc, boom, stop_time=STOP, params=params))):
+                               ("ME CVode", lambda: run_me(sc, boom, stop_time=STOP, params=params))):
             res, wall = timed(run)
             d, r = res.data, ref.data
             rows.append((sid, boom, interface, wall, STOP / wall, res.counts["rhs"],
@@ -66,10 +67,10 @@ def event_rows() -> list:
     print("Event indicators (rigid boom, 15 s, against ME at rtol 1e-9 with events) ...", flush=True)
     rows = []
     for sid in ("B", "C1.3"):
-        sc = cosim.load_scenario(sid)
-        ref = cosim.run_me(sc, "rigid", tolerance=1e-9)
+        sc = load_scenario(sid)
+        ref = run_me(sc, "rigid", tolerance=1e-9)
         for events in (True, False):
-            res, wall = timed(cosim.run_me, sc, "rigid", events=events)
+            res, wall = timed(run_me, sc, "rigid", events=events)
             rows.append((sid, "on" if events else "off", res.counts["events"], res.counts["rhs"], wall,
                          np.abs(res.data["p3"] - ref.data["p3"]).max() / 1e5))
     return rows
@@ -80,7 +81,7 @@ def tolerance_case(flexible: bool = False):
     simulate_fmu arguments and the reference (CS at rtol 1e-9)."""
     from fmpy import simulate_fmu
 
-    fmu = str(cosim.FMU_DIR / "HydraulicBoom.fmu")
+    fmu = str(paths.fmu("HydraulicBoom"))
     kw = dict(stop_time=1.0, output_interval=1e-3, output=["p1", "p2", "p3", "p4"],
               start_values={"boom.flexible": flexible, "valve.u_ref": -0.3})
     return fmu, kw, simulate_fmu(fmu, fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
@@ -227,7 +228,7 @@ def main(argv=None):
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                     help="a parameter of the interfaces table's runs (repeatable), e.g. boom.damping=1")
     args = ap.parse_args(argv)
-    params = cosim.parse_params(ap, args.param)
+    params = parse_params(ap, args.param)
     cases = [c for c in CASES if not (args.rigid_only and c[1] == "flexible")
              and not (args.flexible_only and c[1] == "rigid")]
     if args.only in (None, "interfaces"):
@@ -259,4 +260,4 @@ def print_table(columns: tuple, rows: list) -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

@@ -1,5 +1,5 @@
 """Wall time per sweep point of the runners: cosim.run through fmpy (fresh instances, and
-instances reused with fmi2Reset as the sweep's workers do) and cosim.run_native (`boomsim cosim`),
+instances reused with fmi2Reset as the sweep's workers do) and run_native (`boomsim cosim`),
 for U and B with the rigid and the flexible boom, with the metrics. A benchmark: it prints, it
 asserts nothing. Run after `cargo build --release && target/release/boomsim pack`.
 
@@ -7,19 +7,19 @@ asserts nothing. Run after `cargo build --release && target/release/boomsim pack
 """
 
 import argparse
-import pathlib
 import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
-import metrics  # noqa: E402
+from boomsim import cosim
+from boomsim.errors import UsageError, cli
+from boomsim.native import run_native
+from boomsim.scenarios import load_scenario
+from boomsim import metrics
 
 RUNNERS = {
     "fmpy": lambda sc, boom, t: cosim.run(sc, boom, stop_time=t),
     "fmpy reused": lambda sc, boom, t: cosim.run(sc, boom, stop_time=t, reuse=True),
-    "native": lambda sc, boom, t: cosim.run_native(sc, boom, stop_time=t),
+    "native": lambda sc, boom, t: run_native(sc, boom, stop_time=t),
 }
 
 
@@ -29,10 +29,10 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5, help="runs per case and runner; the median counts (default 5)")
     args = ap.parse_args(argv)
     if not (args.duration > 0 and args.repeat >= 1):
-        raise cosim.UsageError("--duration must be > 0 and --repeat at least 1")
+        raise UsageError("--duration must be > 0 and --repeat at least 1")
     print(f"{'case':<12} " + " ".join(f"{r + ' [ms]':>17}" for r in RUNNERS) + "  fmpy / native")
     for sid in ("U", "B"):
-        sc = cosim.load_scenario(sid)
+        sc = load_scenario(sid)
         for boom in ("rigid", "flexible"):
             med = {}
             for name, run in RUNNERS.items():
@@ -47,4 +47,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

@@ -1,16 +1,17 @@
-"""Demo: the coupled co-simulation of the two FMUs (scripts/cosim.py) for experiment U (no
+"""Demo: the coupled co-simulation of the two FMUs (boomsim.cosim) for experiment U (no
 compensation, step 0.10: the boom oscillates) and experiment B (corrected filter, step 0.05:
 stabilised), each with the feedback from t = 0 (thesis conditions) and from the CBV opening.
 Writes out/<variant>.csv, out/<variant>.png and out/summary.md."""
 
-import pathlib
 import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import cosim  # noqa: E402
-import metrics as mx  # noqa: E402
-
-OUT = cosim.ROOT / "out"
+from boomsim import cosim
+from boomsim.paths import OUT
+from boomsim.errors import cli
+from boomsim.plots import plot
+from boomsim.result import write_csv
+from boomsim.scenarios import load_scenario
+from boomsim import metrics as mx
 
 
 def fmt(x, unit=""):
@@ -21,12 +22,12 @@ def main():
     OUT.mkdir(exist_ok=True)
     rows = []
     for sid in ("U", "B"):
-        sc = cosim.load_scenario(sid)
+        sc = load_scenario(sid)
         for start in sc["starts"]:
             res = cosim.run(sc, "rigid", feedback_start=start)
             m = mx.compute(res)
-            cosim.write_csv(res, OUT / f"{res.name}.csv")
-            cosim.plot(res, OUT / f"{res.name}.png", m)
+            write_csv(res, OUT / f"{res.name}.csv")
+            plot(res, OUT / f"{res.name}.png", m)
             rows.append((res.name, sc, m))
             print(f"{res.name}: load moves at {fmt(m['t_motion'], ' s')}, p3 settles at {fmt(m['t_settle'], ' s')}, "
                   f"p3 peak-to-peak 10-15 s {m['p3_pp_late']:.3g} bar, v {m['v_steady']:.2f} mm/s "
@@ -43,11 +44,11 @@ def main():
                      f"{m['p3_pp_late']:.3g} | {f} | {m['v_steady']:.2f} | {m['v_expected']:.2f} |")
     lines += ["", "U oscillates without end (thesis 7.1); B settles and lowers at the rated flow (9.1). "
               "With the feedback from t = 0 the high-pass filter also answers the rod-side pressure build-up "
-              "and holds the load for about 2.8 s (scripts/README.md, \"Motion start\").", ""]
+              "and holds the load for about 2.8 s (docs/python.md, \"Motion start\").", ""]
     lines += [f"![{name}]({name}.png)" for name, _, _ in rows]
     (OUT / "summary.md").write_text("\n".join(lines) + "\n")
     print("demo: plots, CSVs and summary.md in out/")
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

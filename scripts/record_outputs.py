@@ -6,7 +6,7 @@ Model Exchange under fmpy's CVode (FMI 2.0 and 3.0, rigid boom, 1 s), with the w
 run, and the counts of `boomsim bench --json` (steps, right-hand sides, Jacobians; not its
 times).
 
-    python scripts/record_outputs.py OUT.npz          record (the FMUs of this checkout: pack first)
+    python scripts/record_outputs.py OUT.npz          record (the boomsim package and FMUs on the path: pack first)
     python scripts/record_outputs.py --compare A.npz B.npz
                                                       every array bit for bit; exit 1 on a difference
 
@@ -24,13 +24,17 @@ import sys
 
 import numpy as np
 
-import cosim
-import regress
+from boomsim import cosim, regression
+from boomsim.model_exchange import run_me
+from boomsim.native import run_native
+from boomsim.paths import boomsim_binary
+from boomsim.result import Result
+from boomsim.scenarios import load_scenario, variant_name
 
 STEPS = [1e-4, 1e-3, 2e-3, 3e-3, 4e-3, 5e-3, 6e-3, 8e-3, 1e-2, 2e-2]
 
 
-def put(out: dict, name: str, res: cosim.Result) -> None:
+def put(out: dict, name: str, res: Result) -> None:
     for column, values in res.data.items():
         out[f"{name}/{column}"] = np.asarray(values)
     for key, value in res.counts.items():
@@ -39,20 +43,20 @@ def put(out: dict, name: str, res: cosim.Result) -> None:
 
 def record(path: pathlib.Path) -> None:
     out: dict[str, np.ndarray] = {}
-    runs = [(f"regress/{cosim.variant_name(sc, boom, fb)}", lambda sc=sc, boom=boom, fb=fb:
-             cosim.run(sc, boom, feedback_start=fb)) for sc, boom, fb in regress.variants()]
-    b = cosim.load_scenario("B")
+    runs = [(f"regress/{variant_name(sc, boom, fb)}", lambda sc=sc, boom=boom, fb=fb:
+             cosim.run(sc, boom, feedback_start=fb)) for sc, boom, fb in regression.variants()]
+    b = load_scenario("B")
     runs += [(f"step/{h:g}", lambda h=h: cosim.run(b, "rigid", step=h)) for h in STEPS]
     for sid in ("U", "B"):
-        sc = cosim.load_scenario(sid)
+        sc = load_scenario(sid)
         runs.append((f"fmi3/{sid}", lambda sc=sc: cosim.run(sc, "rigid", fmi=3, interpolate=False)))
-        runs.append((f"native/{sid}", lambda sc=sc: cosim.run_native(sc, "rigid")))
+        runs.append((f"native/{sid}", lambda sc=sc: run_native(sc, "rigid")))
         for fmi in (2, 3):
-            runs.append((f"me{fmi}/{sid}", lambda sc=sc, fmi=fmi: cosim.run_me(sc, "rigid", stop_time=1.0, fmi=fmi)))
+            runs.append((f"me{fmi}/{sid}", lambda sc=sc, fmi=fmi: run_me(sc, "rigid", stop_time=1.0, fmi=fmi)))
     for k, (name, run) in enumerate(runs, 1):
         print(f"[{k}/{len(runs)}] {name}", flush=True)
         put(out, name, run())
-    bench = subprocess.run([str(cosim.ROOT / "target/release/boomsim"), "bench", "--json", "--duration", "2"],
+    bench = subprocess.run([str(boomsim_binary()), "bench", "--json", "--duration", "2"],
                            check=True, capture_output=True, text=True).stdout
     for case in json.loads(bench):
         for key in ("steps", "rhs_evals", "jac_evals"):

@@ -1,4 +1,4 @@
-"""Coupled co-simulation (scripts/cosim.py): the thesis' experiments through fmpy, checked against
+"""Coupled co-simulation (boomsim.cosim): the thesis' experiments through fmpy, checked against
 physics that does not come from the simulation itself.
 
 - U (no compensation, 0.10) oscillates, sustained (thesis 7.1, Fig. 7.1).
@@ -16,16 +16,17 @@ Runtime: ~30 co-simulations of 15 s at 1 ms or 0.25 ms (0.5-4 s each) and two of
 
 import math
 import pathlib
-import sys
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
-import metrics as mx  # noqa: E402
+from boomsim import cosim
+from boomsim.result import Result
+from boomsim.scenarios import load_scenario
+from boomsim import metrics as mx
 
 from conftest import fmu_path  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 OUT = ROOT / "out" / "cosim-tests"
 SETTLING = ["A", "B", "C1.1", "C2.1", "C3.2"]
@@ -39,7 +40,7 @@ def run():
     def get(sid, feedback_start="t0", step=None, stop_time=None):
         key = (sid, feedback_start, step, stop_time)
         if key not in cache:
-            res = cosim.run(cosim.load_scenario(sid), "rigid", step=step, stop_time=stop_time,
+            res = cosim.run(load_scenario(sid), "rigid", step=step, stop_time=stop_time,
                             feedback_start=feedback_start)
             cache[key] = (res, mx.compute(res))
         return cache[key]
@@ -83,7 +84,7 @@ def test_steady_velocity_spans_whole_cycles(phase):
     moving = t >= 0.3
     data = {"time": t, "cylinder.x": x, "cylinder.v": v, "u_comp": 0 * t, "cbv.u_cbv": 1.0 * moving,
             "p3": 100e5 + 100e5 * np.sin(w * t + phase - 1.0), "Q3": np.where(moving, -1e-3, 0.0)}
-    m = mx.compute(cosim.Result(cosim.load_scenario("U"), "rigid", 1e-3, True, data, 0.0))
+    m = mx.compute(Result(load_scenario("U"), "rigid", 1e-3, True, data, 0.0))
     assert m["f_dom_amp"] >= mx.OSCILLATING
     assert m["v_steady"] == pytest.approx(v_bar * 1e3, rel=1e-4)
     plain = [float(np.mean(v_bar + amp * np.sin(w * t[t >= 10] + ph))) for ph in np.linspace(0, 2 * math.pi, 9)]
@@ -175,7 +176,7 @@ def test_feedback_from_cbv_opening_keeps_the_uncompensated_start(run):
 
 
 def test_report_c_ranking(run):
-    """Reported, not asserted: the C experiments ranked (see scripts/README.md for the
+    """Reported, not asserted: the C experiments ranked (see docs/python.md for the
     comparison with thesis 8.1-8.2)."""
     import regress
 

@@ -5,8 +5,8 @@
   mechanics' holding force;
 - equivalence: the split system (+ controller) reproduces the monolithic HydraulicBoom's
   regression metrics of U and B within 2 % (plus the absolute floor of
-  scripts/baselines/tolerances.toml where 2 % of a near-zero value is below its resolution);
-- stability of each coupling against the communication step (LIFT scenario of scripts/split.py);
+  the package's baselines/tolerances.toml where 2 % of a near-zero value is below its resolution);
+- stability of each coupling against the communication step (LIFT scenario of boomsim.split);
 - SSP: BoomSystem.ssp / BoomSystemSplit.ssp validate against the SSP 1.0 schema and run in
   fmpy's SSP simulator, libcosimpy and ecospy with the fmpy runner's metrics; with the FMI 3.0
   FMUs they run in ecospy with the FMI 2.0 SSP's record bit for bit (fmpy's SSP simulator and
@@ -15,15 +15,14 @@
 
 import math
 import pathlib
-import sys
 
 import pytest
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scripts"))
-import cosim  # noqa: E402
-import metrics as mx  # noqa: E402
-import split  # noqa: E402
-import ssp  # noqa: E402
+from boomsim import cosim
+from boomsim.scenarios import load_scenario
+from boomsim import metrics as mx
+from boomsim import split
+from boomsim import ssp
 
 
 def params(fmu):
@@ -95,7 +94,7 @@ def monolithic():
 
     def get(sid, boom):
         if (sid, boom) not in cache:
-            cache[sid, boom] = mx.compute(cosim.run(cosim.load_scenario(sid), boom))
+            cache[sid, boom] = mx.compute(cosim.run(load_scenario(sid), boom))
         return cache[sid, boom]
 
     return get
@@ -106,7 +105,7 @@ def test_split_reproduces_the_monolithic_metrics(monolithic, sid, boom, coupling
     """HydraulicCircuit + BoomMechanics + controller against HydraulicBoom + controller (1 ms):
     every regression metric within 2 % (+ the absolute floor of tolerances.toml)."""
     mono = monolithic(sid, boom)
-    got = mx.compute(split.run(cosim.load_scenario(sid), boom, coupling, step))
+    got = mx.compute(split.run(load_scenario(sid), boom, coupling, step))
     bad = {k: (m, s) for k, (m, s, ok) in split.compare(mono, got).items() if not ok}
     assert not bad, f"{sid}-{boom} {coupling} h = {step}: monolithic vs split {bad}"
 
@@ -163,7 +162,7 @@ def ssp_files(tmp_path_factory):
     out = tmp_path_factory.mktemp("ssp")
     files = {}
     for sid in SSP_SCENARIOS:
-        sc = cosim.load_scenario(sid)
+        sc = load_scenario(sid)
         files[sid] = (sc, {s: ssp.write(s, sc, "rigid", "tlm", out / sid) for s in ("monolithic", "split")})
     return files
 

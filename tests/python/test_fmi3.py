@@ -4,7 +4,6 @@ FMI 2.0 .fmu of the same binary: Co-Simulation bit-identical (with p4 held over 
 has no input derivatives, so the FMI 2.0 run holds it too), Model Exchange bit-identical to FMI
 2.0 Model Exchange and within 2 % of the Co-Simulation regression metrics."""
 
-import sys
 import zipfile
 
 import numpy as np
@@ -12,12 +11,15 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from conftest import FMU_DIR, ROOT, fmu_path
+from conftest import FMU_DIR, fmu_path
 
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
-import metrics  # noqa: E402
-import regress  # noqa: E402
+from boomsim import cosim
+from boomsim.errors import UsageError
+from boomsim.model_exchange import run_me
+from boomsim.result import COLUMNS
+from boomsim.scenarios import load_scenario
+from boomsim import metrics
+from boomsim import regression
 
 IDS = ["PressureFeedbackController", "HydraulicBoom", "HydraulicCircuit", "BoomMechanics"]
 
@@ -65,13 +67,13 @@ def test_simulates_in_both_interfaces_as_in_fmi2(identifier):
 
 @pytest.mark.parametrize("scenario", ["U", "B"])
 def test_scenarios_in_fmi3_co_simulation_are_bit_identical_to_fmi2(scenario):
-    sc = cosim.load_scenario(scenario)
+    sc = load_scenario(scenario)
     for boom in sc["booms"]:
         two = cosim.run(sc, boom, interpolate=False, fmi=2)
         three = cosim.run(sc, boom, interpolate=False, fmi=3)
-        for c in cosim.COLUMNS:
+        for c in COLUMNS:
             assert np.array_equal(two.data[c], three.data[c]), f"{scenario}-{boom} {c}"
-    with pytest.raises(cosim.UsageError, match="--hold"):
+    with pytest.raises(UsageError, match="--hold"):
         cosim.run(sc, "rigid", stop_time=0.01, fmi=3)
 
 
@@ -80,8 +82,8 @@ def test_scenarios_in_fmi3_model_exchange_match_co_simulation(scenario):
     """Rigid boom (the flexible one takes 6 and 2 minutes under CVode without event indicators;
     measured once: every metric within 2 % as well). The rules of test_model_exchange.py: every
     regression metric within 2 % of FMI 2.0 CS (with slope), with the suite's absolute floors."""
-    sc = cosim.load_scenario(scenario)
-    me = metrics.compute(cosim.run_me(sc, "rigid", fmi=3))
+    sc = load_scenario(scenario)
+    me = metrics.compute(run_me(sc, "rigid", fmi=3))
     cs = metrics.compute(cosim.run(sc, "rigid"))
-    rules = {k: {**r, "rel": 0.02} for k, r in regress.load_tolerances().items()}
-    assert regress.compare(f"{scenario}-rigid FMI 3.0 ME", me, cs, rules) == []
+    rules = {k: {**r, "rel": 0.02} for k, r in regression.load_tolerances().items()}
+    assert regression.compare(f"{scenario}-rigid FMI 3.0 ME", me, cs, rules) == []

@@ -24,7 +24,6 @@ are tested."""
 
 import ctypes
 import math
-import pathlib
 import xml.etree.ElementTree as ET
 import zipfile
 

@@ -326,7 +326,7 @@ def test_limit_cycle_above_the_critical_stroke_only(boom, x0, large):
     small (< 50 bar; ~19 bar at 4.5 Hz measured, which hardly decays: the full criterion 2.84 with
     the hose compliance of eq. 5.2 is violated down to ~10 mm, so a small oscillation is expected
     there too). Window 3-5 s (at 8.8 mm/s the lower start reaches the bottom stop after ~8 s).
-    scripts/instability.py bisects the boundary: 124 mm."""
+    boomsim-instability bisects the boundary: 124 mm."""
     t, r = simulate(boom, -0.05, 5.0, h=1e-3, **start(x0))
     w = t >= 3.0
     p2p = np.ptp(r["p3"][w])

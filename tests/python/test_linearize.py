@@ -103,15 +103,12 @@ def test_the_circuit_has_the_ports_inputs(tmp_path):
 
 
 def test_the_bode_figure_has_the_sine_points_on_its_curve(tmp_path):
-    """scripts/plot_bode.py (docs/linearize.md's figure; scripts/figures.py checks its text and
+    """boomsim.plot_bode (docs/linearize.md's figure; boomsim.figures checks its text and
     units as it saves): the sine test's points on the closed-loop curve within 5 % (they are
     measured some 35 mm further down the stroke than the curve's point: about 1 %)."""
-    import sys
+    from boomsim import plot_bode
 
-    sys.path.insert(0, str(ROOT / "scripts"))
-    import plot_bode
-
-    fig = plot_bode.main(tmp_path / "bode.png")
+    fig = plot_bode.plot(tmp_path / "bode.png")
     assert (tmp_path / "bode.png").stat().st_size > 10_000
     gain, _ = fig.axes
     closed = json.loads(linearize("--boom", "flexible", "--output", "p4", "--feedback", "--bode", "--json"))
@@ -122,12 +119,12 @@ def test_the_bode_figure_has_the_sine_points_on_its_curve(tmp_path):
 
 
 def test_a_scenario_file_sets_the_point_and_the_filter():
-    """scripts/linearize_scenario.py: C2.1's filter (K_f 2e-11, omega_f 17.91, Table 7.3) closes
+    """boomsim-linearize-scenario: C2.1's filter (K_f 2e-11, omega_f 17.91, Table 7.3) closes
     the loop at its final reference; U (controller off) at 5 s into its run stays open."""
     import sys
 
     def run(*args):
-        cmd = [sys.executable, str(ROOT / "scripts" / "linearize_scenario.py"), *args, "--", "--json"]
+        cmd = [sys.executable, "-m", "boomsim.linearize_scenario", *args, "--", "--json"]
         out = subprocess.run(cmd, capture_output=True, text=True, check=False)
         assert out.returncode == 0, out.stderr
         return json.loads(out.stdout)

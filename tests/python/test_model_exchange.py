@@ -5,18 +5,18 @@ CVode settings (fmpy 0.3.32): BDF, dense Newton with a difference-quotient Jacob
 rtol 1e-6 (the FMUs' default tolerance, as the CS runs), atol = rtol x the FMUs' nominal values.
 """
 
-import sys
 
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from conftest import ROOT, fmu_path
+from conftest import fmu_path
 
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
-import metrics  # noqa: E402
-import regress  # noqa: E402
+from boomsim import cosim
+from boomsim.model_exchange import run_me
+from boomsim.scenarios import load_scenario
+from boomsim import metrics
+from boomsim import regression
 
 
 def _both(identifier, stop_time, **kw):
@@ -63,7 +63,7 @@ def test_every_fmu_simulates_as_model_exchange(identifier, start, signal, output
 
 @pytest.fixture(scope="module")
 def tolerances():
-    return regress.load_tolerances()
+    return regression.load_tolerances()
 
 
 @pytest.mark.parametrize("scenario", ["U", "B"])
@@ -71,13 +71,13 @@ def tolerances():
 def test_scenarios_as_model_exchange_match_co_simulation(scenario, boom, tolerances):
     """Plant and controller as one ME system under CVode (no communication step: the loop has no
     delay) against the CS runner at 1 ms: every regression metric within 2 % of the CS value,
-    with the regression suite's absolute floors (scripts/baselines/tolerances.toml: 10 ms for the
+    with the regression suite's absolute floors (the package's baselines/tolerances.toml: 10 ms for the
     times sampled at 1 ms, 0.2 bar for a settled p3's drift, 5e-4 for u_comp's numerical noise),
     and a missing metric (never settles) missing in both."""
-    sc = cosim.load_scenario(scenario)
-    me, cs = metrics.compute(cosim.run_me(sc, boom)), metrics.compute(cosim.run(sc, boom))
+    sc = load_scenario(scenario)
+    me, cs = metrics.compute(run_me(sc, boom)), metrics.compute(cosim.run(sc, boom))
     rules = {k: {**r, "rel": 0.02} for k, r in tolerances.items()}
-    assert regress.compare(f"{scenario}-{boom} ME", me, cs, rules) == []
+    assert regression.compare(f"{scenario}-{boom} ME", me, cs, rules) == []
 
 
 @pytest.mark.parametrize("flexible", [False, True])
@@ -103,14 +103,14 @@ def test_model_exchange_at_an_importers_tolerance(flexible):
 def test_compensated_lowering_at_an_importers_tolerance(tolerances):
     """Scenario B (rigid boom, plant and controller as one ME system) under CVode at rtol 1e-4:
     every regression metric within the regression suite's own tolerances of the CS run
-    (scripts/baselines/tolerances.toml). Not covered, as measured (README, Model Exchange
+    (the package's baselines/tolerances.toml). Not covered, as measured (README, Model Exchange
     tolerance): U rigid fails at 3.9 s (CVode sets p4 below absolute vacuum, which the
     controller refuses), B flexible's u_comp_rms is 2.6 times the CS value, U flexible passes
     but takes 2.6 million RHS (8 minutes)."""
-    sc = cosim.load_scenario("B")
-    me = metrics.compute(cosim.run_me(sc, "rigid", tolerance=1e-4))
+    sc = load_scenario("B")
+    me = metrics.compute(run_me(sc, "rigid", tolerance=1e-4))
     cs = metrics.compute(cosim.run(sc, "rigid"))
-    assert regress.compare("B-rigid ME 1e-4", me, cs, tolerances) == []
+    assert regression.compare("B-rigid ME 1e-4", me, cs, tolerances) == []
 
 
 def test_directional_derivatives_through_fmpy():

@@ -1,24 +1,23 @@
 """The experiments at the rig's 5 ms control loop (thesis 4.2.2) with the two models of the valve
 electronics (README, model notes, "Valve electronics"): the first-order spool lag of eq. 2.45
 relays through the dead band and loses speed, the PVES position loop lowers at the rated speed;
-and the README's table is what scripts/rig_loop.py computes. Rigid boom, about 1 s per run."""
+and the README's table is what boomsim.rig_loop computes. Rigid boom, about 1 s per run."""
 
 import pathlib
 import re
-import sys
 
 import numpy as np
 import pytest
 
+from boomsim.scenarios import load_scenario
+from boomsim import metrics
+from boomsim import rig_loop
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
-import metrics  # noqa: E402
-import rig_loop  # noqa: E402
 
 
 def run(sid: str, model: str):
-    return rig_loop.run(cosim.load_scenario(sid), model)
+    return rig_loop.run(load_scenario(sid), model)
 
 
 @pytest.mark.parametrize("sid", ["B", "C1.1", "C2.1"])
@@ -57,7 +56,7 @@ def readme_rows() -> dict:
 
 @pytest.mark.parametrize("sid", ["B", "C2.1", "C3.3"])
 def test_the_readme_table_is_what_rig_loop_computes(sid):
-    sc = cosim.load_scenario(sid)
+    sc = load_scenario(sid)
     results = {sid: {m: rig_loop.row(sc, m, rig_loop.RIG_STEP, "rigid", None) for m in rig_loop.MODELS}}
     computed = rig_loop.table(results, {sid: sc}).splitlines()[-1]
     stated = readme_rows()[sid]

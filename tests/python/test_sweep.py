@@ -1,4 +1,4 @@
-"""scripts/sweep.py: a sweep on a LocalCluster gives the metrics of the same points run serially
+"""boomsim.parameter_sweep: a sweep on a LocalCluster gives the metrics of the same points run serially
 in-process, a failing point is a row with fmpy's error, --resume runs only the missing points, and
 a bad sweep file is refused in one line before anything runs; the filter factors n_K / n_omega
 follow eq. 6.6 / 6.7, a point beyond its timeout is a failed row, reused FMU instances give the
@@ -13,12 +13,15 @@ import sys
 import numpy as np
 import pytest
 
+from boomsim import cosim
+from boomsim.native import run_native
+from boomsim.result import COLUMNS
+from boomsim.scenarios import load_scenario
+from boomsim import metrics
+from boomsim import parameter_sweep as sweep
+from boomsim import sweep_summary
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
-import cosim  # noqa: E402
-import metrics  # noqa: E402
-import sweep  # noqa: E402
-import sweep_summary  # noqa: E402
 
 METRICS = ["p3_pp_max", "p3_pp_late", "u_comp_max", "v_steady"]
 
@@ -30,7 +33,7 @@ def sweep_file(tmp_path, parameters: str, head: str = 'scenario = "B"\nstop_time
 
 
 def cli(*args):
-    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "sweep.py"), *map(str, args)],
+    r = subprocess.run([sys.executable, "-m", "boomsim.parameter_sweep", *map(str, args)],
                        capture_output=True, text=True)
     return r.returncode, r.stderr
 
@@ -170,7 +173,7 @@ def test_reused_instances_give_the_fresh_results_bit_for_bit():
     before (fluid.beta, cbv.mu_p, the filter) is back at its start value. A sequence of runs on
     reused instances, a failing one (fmi2Error) and a timed-out one among them, against the same
     runs on fresh instances: every recorded value equal."""
-    sc = cosim.load_scenario("B")
+    sc = load_scenario("B")
     sequence = [{"fluid.beta": 1.4e9, "K_f": 1.0e-11}, {}, {"cbv.mu_p": 5.0, "omega_f": 50.0, "payload.m": 200.0},
                 {"fluid.beta": 5e9}, "timeout", {"u_max": 0.5}, {}]
     for params in sequence:
@@ -184,7 +187,7 @@ def test_reused_instances_give_the_fresh_results_bit_for_bit():
             continue
         reused = cosim.run(sc, stop_time=1.0, params=params, reuse=True)
         fresh = cosim.run(sc, stop_time=1.0, params=params)
-        for c in cosim.COLUMNS:
+        for c in COLUMNS:
             assert np.array_equal(reused.data[c], fresh.data[c]), (params, c)
         assert metrics.compute(reused) == metrics.compute(fresh)
 
@@ -221,21 +224,21 @@ def test_summary_finds_the_region_and_the_recommendation_of_a_known_grid(tmp_pat
 def test_the_native_runner_gives_fmpys_rows_bit_for_bit(scenario, boom, kw):
     """`boomsim cosim` makes the calls of cosim.run in the same order with the same arguments,
     the FMUs' code in-process: every recorded value, the RHS count and the feedback start equal."""
-    sc = cosim.load_scenario(scenario)
-    a, b = cosim.run(sc, boom, stop_time=1.0, **kw), cosim.run_native(sc, boom, stop_time=1.0, **kw)
-    for c in cosim.COLUMNS:
+    sc = load_scenario(scenario)
+    a, b = cosim.run(sc, boom, stop_time=1.0, **kw), run_native(sc, boom, stop_time=1.0, **kw)
+    for c in COLUMNS:
         assert np.array_equal(a.data[c], b.data[c]), c
     assert (a.counts, a.feedback_on_at) == (b.counts, b.feedback_on_at)
     with pytest.raises(TimeoutError, match="exceeded the timeout of 0.0001 s"):
-        cosim.run_native(sc, boom, stop_time=1.0, timeout=1e-4, **kw)
+        run_native(sc, boom, stop_time=1.0, timeout=1e-4, **kw)
 
 
 def test_the_filter_sweeps_map_is_readable(tmp_path):
-    """scripts/sweeps/filter.toml's map (one narrow panel: its title was cut off at both ends and
-    its axes named without units) from made-up rows: scripts/figures.py's checks pass (text inside
+    """The packaged sweep "filter"'s map (one narrow panel: its title was cut off at both ends and
+    its axes named without units) from made-up rows: boomsim.figures' checks pass (text inside
     the canvas, the K_f and omega_f axes and the colour bar with units), as for every figure the
     tests write (BOOMSIM_STRICT_FIGURES)."""
-    s = sweep.load(cosim.ROOT / "scripts" / "sweeps" / "filter.toml")
+    s = sweep.load("filter")
     rows = [{**p, "p3_pp_late": 1e11 * p["K_f"], "t_settle": 0.01 * p["omega_f"], "status": "ok", "error": "",
              "wall_time": 0.0, "worker": "made up"} for p in s["points"]]
     sweep_summary.write(s, rows, tmp_path)

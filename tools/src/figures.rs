@@ -101,7 +101,7 @@ pub(crate) fn run<M: Model>(
 }
 
 /// The reference of experiment U (thesis 7.1: a step of the spool reference to 0.10, lowering;
-/// scripts/scenarios/U.toml).
+/// python/boomsim/scenarios/U.toml).
 pub(crate) const U_REFERENCE: f64 = -0.10;
 
 /// The variable of `M` with value reference `r`.
@@ -310,7 +310,7 @@ mod tests {
     #[test]
     fn the_lowering_plot_uses_experiment_u() {
         let toml =
-            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/scenarios/U.toml")).unwrap();
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../python/boomsim/scenarios/U.toml")).unwrap();
         let line = toml.lines().find(|l| l.starts_with("reference")).unwrap();
         assert_eq!(
             line.split(['[', ']', ',']).filter_map(|x| x.trim().parse::<f64>().ok()).nth(1),

@@ -151,19 +151,19 @@ pub fn run(args: &AnalyzeArgs, root: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Runs `scripts/plot_analysis.py` with the project's venv (or `python3`) to draw the PNGs.
+/// Runs the Python package's `boomsim.plot_analysis` with the project's venv (or `python3`) to draw the PNGs.
 fn plot(root: &Path, dir: &Path) -> Result<(), String> {
     let venv = root.join(".venv/bin/python");
     let python = if venv.exists() { venv } else { PathBuf::from("python3") };
     let status = Command::new(&python)
-        .arg(root.join("scripts/plot_analysis.py"))
+        .args(["-m", "boomsim.plot_analysis"])
         .arg(dir)
         .status()
         .map_err(|e| format!("cannot run {}: {e} (the CSV files are written)", python.display()))?;
     if status.success() {
         Ok(())
     } else {
-        Err(format!("plot_analysis.py failed ({status}); the CSV files are written"))
+        Err(format!("boomsim.plot_analysis failed ({status}); the CSV files are written"))
     }
 }
 

@@ -1,6 +1,6 @@
 //! `boomsim analyze --sweep`: the stability boundary along the stroke for every valve of
 //! Table 4.3 and the margin maps of Fig. 6.4, as CSV tables (plotted by
-//! `scripts/plot_analysis.py`).
+//! `python -m boomsim.plot_analysis`).
 //!
 //! The valves are compared at the *same load and lowering flow* as the base operating point
 //! (same spool opening, pressure compensated): each valve's `p4` follows from its `mu_p` and

@@ -2,13 +2,13 @@
 one task per point, rows appended to Parquet as points finish.
 
 Usage:
-    .venv/bin/python scripts/sweep.py scripts/sweeps/filter.toml [--workers N]
+    boomsim-sweep filter|robustness|FILE.toml [--workers N]
         [--scheduler ADDRESS] [--resume] [--out DIR]
 writes DIR/results/*.parquet (one file per batch of finished points), DIR/summary.md and, when
-two or more parameters vary on a grid, maps DIR/map-<metric>.png (scripts/sweep_summary.py).
+two or more parameters vary on a grid, maps DIR/map-<metric>.png (boomsim.sweep_summary).
 
 Sweep file (TOML):
-    scenario = "B"            # an id of scripts/scenarios/ (or a .toml path), as cosim.py takes
+    scenario = "B"            # a scenario id (or a .toml path), as boomsim.run takes
     boom = "rigid"            # default rigid
     stop_time = 15.0          # default: the scenario's
     metrics = ["p3_pp_late", "t_settle"]        # names of metrics.compute
@@ -24,7 +24,7 @@ The points are the product of the grids with the `samples` Monte Carlo draws (nu
 default_rng(seed), parameters in file order). A point is identified by a hash of the scenario,
 boom, stop time and its parameter values, which `--resume` uses to skip finished points.
 With fmpy each worker keeps its two FMU instances from point to point (fmi2Reset, cosim.run's
-`reuse`); the native runner is one `boomsim cosim` process per point (cosim.run_native).
+`reuse`); the native runner is one `boomsim cosim` process per point (run_native).
 """
 
 from __future__ import annotations
@@ -41,11 +41,15 @@ import tomllib
 
 import numpy as np
 
-import cosim
-import linear
-import metrics as metrics_mod
-import sweep_summary
-from cosim import UsageError
+from . import cosim
+from .errors import UsageError, cli
+from .fmus import FmuFile
+from .native import run_native
+from .paths import OUT, SWEEP_DIR
+from .scenarios import load_scenario, scenario_ids
+from . import linear
+from . import metrics as metrics_mod
+from . import sweep_summary
 
 DISTS = {"uniform": ("low", "high"), "normal": ("mean", "sd")}
 #: Filter factors relative to the linear analysis at the point's operating point and the
@@ -55,27 +59,35 @@ FACTORS = {"n_K": "K_f", "n_omega": "omega_f"}
 #: Sweepable settings of the co-simulation itself, passed to the runner by keyword.
 SETTINGS = {"step": "communication step [s]; the stop time must be a multiple of it"}
 #: How a point is co-simulated: fmpy on instances reused from point to point, or `boomsim cosim`.
-RUNNERS = {"fmpy": lambda *a, **k: cosim.run(*a, **k, reuse=True), "native": cosim.run_native}
+RUNNERS = {"fmpy": lambda *a, **k: cosim.run(*a, **k, reuse=True), "native": run_native}
 
 
 # --------------------------------------------------------------------------- sweep file
 
 
+def sweep_names() -> list[str]:
+    """The sweep files the package carries (sweeps/*.toml), by name."""
+    return sorted(p.stem for p in SWEEP_DIR.glob("*.toml"))
+
+
 def load(path) -> dict:
-    """The validated sweep: scenario, boom, stop time, metrics, parameters and points. Every
-    mistake is a UsageError naming the item and the valid choices, before anything runs."""
+    """The validated sweep of a .toml file or of a packaged sweep's name (sweep_names): scenario,
+    boom, stop time, metrics, parameters and points. Every mistake is a UsageError naming the
+    item and the valid choices, before anything runs."""
+    if not pathlib.Path(path).exists() and (SWEEP_DIR / f"{path}.toml").exists():
+        path = SWEEP_DIR / f"{path}.toml"
     try:
         with open(path, "rb") as f:
             doc = tomllib.load(f)
     except (OSError, tomllib.TOMLDecodeError) as e:
         raise UsageError(f"{path}: {e}") from None
     if "scenario" not in doc:
-        raise UsageError(f"{path}: no scenario: give scenario = one of {', '.join(cosim.scenario_ids())}")
-    scenario = cosim.load_scenario(doc["scenario"])
+        raise UsageError(f"{path}: no scenario: give scenario = one of {', '.join(scenario_ids())}")
+    scenario = load_scenario(doc["scenario"])
     boom = doc.get("boom", "rigid")
     if boom not in ("rigid", "flexible"):
         raise UsageError(f"unknown boom \"{boom}\": rigid or flexible")
-    names = {**cosim.FmuFile.get("PressureFeedbackController").vars, **cosim.FmuFile.get("HydraulicBoom").vars}
+    names = {**FmuFile.get("PressureFeedbackController").vars, **FmuFile.get("HydraulicBoom").vars}
     sweepable = sorted(n for n, v in names.items() if v.causality == "parameter" and v.type != "Boolean")
     keep = doc.get("metrics", [])
     for m in keep:
@@ -214,17 +226,15 @@ def read_rows(sweep: dict, out: pathlib.Path) -> list[dict]:
 # --------------------------------------------------------------------------- execution
 
 
-def client_for(args):
+def client_for(workers: int | None, scheduler: str | None):
     from distributed import Client, LocalCluster
 
-    if args.scheduler:
+    if scheduler:
         try:
-            return Client(args.scheduler, timeout=10)
+            return Client(scheduler, timeout=10)
         except (OSError, TimeoutError, ValueError) as e:
-            raise UsageError(f"cannot connect to the scheduler \"{args.scheduler}\": {e}") from None
-    # the worker processes import this module and cosim by name
-    os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(cosim.ROOT / "scripts"), os.environ.get("PYTHONPATH")]))
-    n = args.workers or os.cpu_count()
+            raise UsageError(f"cannot connect to the scheduler \"{scheduler}\": {e}") from None
+    n = workers or os.cpu_count()
     return Client(LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None))
 
 
@@ -235,13 +245,13 @@ def progress(done: int, failed: int, total: int, t0: float, tty: bool):
           end="\r" if tty and done < total else "\n", file=sys.stderr, flush=True)
 
 
-def execute(sweep: dict, todo: list[dict], out: pathlib.Path, args):
+def execute(sweep: dict, todo: list[dict], out: pathlib.Path, workers: int | None, scheduler: str | None):
     from distributed import as_completed
 
     if not todo:
         return
     t0, done, failed, tty = time.monotonic(), 0, 0, sys.stderr.isatty()
-    with client_for(args) as client:
+    with client_for(workers, scheduler) as client:
         # the sweep once to every worker, without its list of points (the tasks carry theirs)
         task_sweep = client.scatter({k: v for k, v in sweep.items() if k != "points"}, broadcast=True)
         futures = client.map(run_point, [task_sweep] * len(todo), todo, pure=False)
@@ -257,32 +267,42 @@ def execute(sweep: dict, todo: list[dict], out: pathlib.Path, args):
             if not isinstance(missing, ModuleNotFoundError):
                 raise
             raise UsageError(f"the scheduler or a worker cannot import {missing.name}: start them from the "
-                             "checkout with PYTHONPATH=scripts") from None
+                             "environment where the boomsim package is installed") from None
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("file")
+    ap.add_argument("file", help=f"a sweep file (.toml) or a packaged sweep: {', '.join(sweep_names())}")
     ap.add_argument("--workers", type=int, help="LocalCluster worker processes (default: the CPU count)")
     ap.add_argument("--scheduler", help="address of an existing Dask scheduler instead of a LocalCluster")
     ap.add_argument("--resume", action="store_true", help="run only the points DIR/results lacks")
     ap.add_argument("--out", default=None, help="output directory (default out/sweep/<file stem>)")
     args = ap.parse_args(argv)
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers {args.workers} must be at least 1")
-    sweep = load(args.file)
-    out = pathlib.Path(args.out or cosim.ROOT / "out" / "sweep" / pathlib.Path(args.file).stem)
-    if (out / "results").exists() and not args.resume:
+    run_sweep(args.file, args.workers, args.scheduler, args.resume, args.out)
+
+
+def run_sweep(file, workers: int | None = None, scheduler: str | None = None, resume: bool = False,
+              out=None) -> list[dict]:
+    """Runs the sweep of `file` (a .toml path or a packaged sweep's name) on a LocalCluster of
+    `workers` processes (default: the CPU count) or an existing scheduler, writes the rows to
+    out/results (default out/sweep/<name>) with the summary and maps, and returns every row."""
+    if workers is not None and workers < 1:
+        raise UsageError(f"--workers {workers} must be at least 1")
+    sweep = load(file)
+    out = pathlib.Path(out or OUT / "sweep" / pathlib.Path(file).stem)
+    if (out / "results").exists() and not resume:
         raise UsageError(f"{out / 'results'} exists: give --resume to continue it or another --out")
     have = {r["id"] for r in read_rows(sweep, out)}
     todo = [p for p in sweep["points"] if p["id"] not in have]
     print(f"sweep: {len(sweep['points'])} points, {len(have)} already done, {len(todo)} to run", file=sys.stderr)
-    execute(sweep, todo, out, args)
-    sweep_summary.write(sweep, read_rows(sweep, out), out)
+    execute(sweep, todo, out, workers, scheduler)
+    rows = read_rows(sweep, out)
+    sweep_summary.write(sweep, rows, out)
     print(f"sweep: wrote {out / 'summary.md'}", file=sys.stderr)
+    return rows
 
 
 if __name__ == "__main__":
-    import sweep as module  # the tasks pickle run_point by reference to this module, not __main__
+    from boomsim import parameter_sweep as module  # the tasks pickle run_point by reference to this module, not __main__
 
-    sys.exit(cosim.cli(module.main))
+    sys.exit(cli(module.main))

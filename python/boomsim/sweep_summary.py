@@ -26,10 +26,10 @@ import textwrap
 
 import numpy as np
 
-import cosim
-import figures
-import linear
-from metrics import DEFINITIONS
+from .fmus import FmuFile
+from . import figures
+from . import linear
+from .metrics import DEFINITIONS
 
 #: The maps' metrics, when the sweep has them.
 MAPPED = ("p3_pp_late", "t_settle")
@@ -209,7 +209,7 @@ def axis_label(name: str) -> str:
     if name == "step":
         return "communication step [s]"
     for identifier in ("HydraulicBoom", "PressureFeedbackController"):
-        v = cosim.FmuFile.get(identifier).vars.get(name)
+        v = FmuFile.get(identifier).vars.get(name)
         if v is not None:
             return f"{name} [{v.unit if v.unit not in (None, '', '1') else '-'}]"
     return f"{name} [-]"

@@ -1,26 +1,26 @@
 """SSP 1.0 packages of the boom systems and their runs in three SSP importers.
 
-    .venv/bin/python scripts/ssp.py [--scenario B] [--boom rigid] [--coupling tlm] [--fmi 2|3] [--out target/ssp]
+    boomsim-ssp [--scenario B] [--boom rigid] [--coupling tlm] [--fmi 2|3] [--out out/ssp]
 
 writes
-    target/ssp/BoomSystem.ssp       HydraulicBoom + PressureFeedbackController (two FMUs)
-    target/ssp/BoomSystemSplit.ssp  HydraulicCircuit + BoomMechanics + PressureFeedbackController
+    out/ssp/BoomSystem.ssp       HydraulicBoom + PressureFeedbackController (two FMUs)
+    out/ssp/BoomSystemSplit.ssp  HydraulicCircuit + BoomMechanics + PressureFeedbackController
 each a zip of SystemStructure.ssd (components, connectors, connections, inline parameter bindings
 of the scenario, default experiment) and resources/<FMU>.fmu; then runs both in fmpy's SSP
 simulator, libcosimpy (CosimExecution.from_ssp_file) and ecospy (EcosSimulation(ssp_path=...))
 and compares the regression metrics with the fmpy runner (cosim.py / split.py, Jacobi for the
 split system, as these masters step all FMUs from the same values). The controller is bound with
 p.extrapolation = true: these masters pass no input derivatives and read its command before they
-pass the new p4, so it extrapolates p4 from its last two samples (scripts/README.md, "Coupling").
+pass the new p4, so it extrapolates p4 from its last two samples (docs/python.md, "Coupling").
 
-`--fmi 3` embeds the FMI 3.0 .fmu files of target/fmu/fmi3 instead (written to target/ssp/fmi3)
+`--fmi 3` embeds the FMI 3.0 .fmu files of target/fmu/fmi3 instead (written to out/ssp/fmi3)
 and tries them in the same three importers; where one runs them (ecospy), the run is compared with
 the FMI 2.0 SSP in the same importer as well (expected: the same record, bit for bit); NOT_FMI3
 has the errors of the others (fmpy's SSP simulator, libcosimpy) and why.
 
 The operator reference of the scenario must be constant (U, B, ...): it is bound as the start value
 of the controller's u_ref input. Masters that start the connections at 0 (fmpy's simulate_ssp) get
-the documented first-step deviation; see scripts/README.md, "SSP".
+the documented first-step deviation; see docs/python.md, "SSP".
 """
 
 from __future__ import annotations
@@ -35,10 +35,14 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import cosim  # noqa: E402
-import metrics as mx  # noqa: E402
-import split  # noqa: E402
+from . import cosim
+from .errors import cli
+from .fmus import FmuFile
+from .paths import OUT
+from .result import Result
+from .scenarios import load_scenario
+from . import metrics as mx
+from . import split
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -68,7 +72,7 @@ def components(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) ->
         raise ValueError(f"{sc['id']}: the SSP binds a constant operator reference; this one varies")
     ctrl["u_ref"] = u_ref
     # the importers are Jacobi masters (no input derivatives, u read before p4 of the step end is
-    # passed): the controller extrapolates p4 from its last two samples (scripts/README.md, "SSP")
+    # passed): the controller extrapolates p4 from its last two samples (docs/python.md, "SSP")
     ctrl["p.extrapolation"] = True
     flexible = boom == "flexible"
     if system == "monolithic":
@@ -96,7 +100,7 @@ def components(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) ->
 def start_force(mech: dict, fmi: int = 2) -> float:
     """BoomMechanics' start.F for these parameters (the circuit's start.F binding), through the
     FMI `fmi` .fmu."""
-    f = cosim.FmuFile.get("BoomMechanics", fmi)
+    f = FmuFile.get("BoomMechanics", fmi)
     s = f.slave("start_force")
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
@@ -118,12 +122,12 @@ def ssd(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> str:
         kinds.setdefault(b, {})[inp] = "input"
     for comp, var, _ in RECORD[system]:
         kinds.setdefault(comp, {})[var] = "output"
-    lines = [f'<?xml version="1.0" encoding="UTF-8"?>',
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              f'<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" '
              f'version="1.0" name="{NAMES[system]}">',
              f'  <ssd:System name="{NAMES[system]}">', "    <ssd:Elements>"]
     for name, (fmu, params) in comps.items():
-        md = cosim.FmuFile.get(fmu, fmi)
+        md = FmuFile.get(fmu, fmi)
         lines.append(f'      <ssd:Component name="{name}" type="application/x-fmu-sharedlibrary" '
                      f'source="resources/{fmu}.fmu">')
         lines.append("        <ssd:Connectors>")
@@ -150,7 +154,7 @@ def ssd(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> str:
 
 def write(system: str, sc: dict, boom: str = "rigid", coupling: str = "tlm", out=None, fmi: int = 2):
     """Writes <out>/<BoomSystem|BoomSystemSplit>.ssp with the FMI `fmi` .fmu files (default out:
-    target/ssp, target/ssp/fmi3 for FMI 3.0); returns its path."""
+    out/ssp, out/ssp/fmi3 for FMI 3.0); returns its path."""
     out = pathlib.Path(out or default_out(fmi))
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"{NAMES[system]}.ssp"
@@ -158,12 +162,12 @@ def write(system: str, sc: dict, boom: str = "rigid", coupling: str = "tlm", out
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("SystemStructure.ssd", ssd(system, sc, boom, coupling, fmi))
         for fmu, _ in comps.values():
-            z.write(cosim.FmuFile.get(fmu, fmi).path, f"resources/{fmu}.fmu")
+            z.write(FmuFile.get(fmu, fmi).path, f"resources/{fmu}.fmu")
     return path
 
 
 def default_out(fmi: int) -> pathlib.Path:
-    return cosim.ROOT / "target" / "ssp" / ("fmi3" if fmi == 3 else "")
+    return OUT / "ssp" / ("fmi3" if fmi == 3 else "")
 
 
 # --------------------------------------------------------------------------- importers
@@ -265,11 +269,11 @@ NOT_FMI3 = {
 }
 
 
-def as_result(data: dict, sc: dict, boom: str, step: float) -> cosim.Result:
-    """The importer's record as a cosim.Result for metrics.compute (u_ref constant)."""
+def as_result(data: dict, sc: dict, boom: str, step: float) -> Result:
+    """The importer's record as a Result for metrics.compute (u_ref constant)."""
     d = dict(data)
     d["u_ref"] = np.full_like(d["time"], sc["reference"][0, 1])
-    return cosim.Result(sc, boom, step, False, d, 0.0)
+    return Result(sc, boom, step, False, d, 0.0)
 
 
 def reference(system: str, sc: dict, boom: str, coupling: str, step: float) -> dict:
@@ -300,10 +304,10 @@ def main(argv=None):
     ap.add_argument("--step", type=float, default=1e-3)
     ap.add_argument("--fmi", type=int, choices=(2, 3), default=2,
                     help="FMI version of the embedded FMUs: 2 (target/fmu) or 3 (target/fmu/fmi3)")
-    ap.add_argument("--out", default=None, help="output folder (default target/ssp, target/ssp/fmi3 with --fmi 3)")
+    ap.add_argument("--out", default=None, help="output folder (default out/ssp, out/ssp/fmi3 with --fmi 3)")
     ap.add_argument("--no-run", action="store_true", help="only write the .ssp files")
     args = ap.parse_args(argv)
-    sc = cosim.load_scenario(args.scenario)
+    sc = load_scenario(args.scenario)
     for system in ("monolithic", "split"):
         path = write(system, sc, args.boom, args.coupling, args.out, args.fmi)
         print(path)
@@ -330,4 +334,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

@@ -25,24 +25,23 @@ script
    reached (p3 peak-to-peak > 150 bar in some 0.5 s window);
 3. bisects the start stroke where the behaviour changes (to 1 mm) and compares it with x_c.
 
-Usage: .venv/bin/python scripts/instability.py [--csv] [--png] [--quick]
+Usage: boomsim-instability [--csv] [--png] [--quick]
 (--csv/--png write out/instability.csv, out/instability.png; --quick skips the bisection).
 Needs target/fmu/HydraulicBoom.fmu (cargo build --release && target/release/boomsim pack).
 """
 
 import argparse
 import math
-import pathlib
 import sys
 
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-import figures
+from . import figures
+from .errors import cli
+from .paths import OUT, fmu
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU = ROOT / "target" / "fmu" / "HydraulicBoom.fmu"
 P_ATM = 101325.0
 G = 9.807
 LARGE = 150e5  # p3 peak-to-peak of the large limit cycle (vacuum .. ~p_set)
@@ -51,9 +50,8 @@ LARGE = 150e5  # p3 peak-to-peak of the large limit cycle (vacuum .. ~p_set)
 class Boom:
     """The FMU, its parameters (start values) and a lowering run."""
 
-    def __init__(self, path=FMU):
-        if not path.exists():
-            sys.exit(f"{path} is missing: cargo build --release && target/release/boomsim pack")
+    def __init__(self, path=None):
+        path = path or fmu("HydraulicBoom")
         self.md = read_model_description(str(path))
         self.dir = extract(str(path))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
@@ -266,12 +264,12 @@ def boundary(boom, u, lo, hi, tol=1e-3):
     return lo, hi
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--csv", action="store_true", help="write out/instability.csv")
     ap.add_argument("--png", action="store_true", help="write out/instability.png")
     ap.add_argument("--quick", action="store_true", help="skip the boundary bisection")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     boom = Boom()
     par = boom.par
     a, b = areas(par)
@@ -323,7 +321,7 @@ def main():
                   f"criterion 2.87: {mm(c['x_287'])}, 2.86 with volumes: {mm(c['x_286'])}, "
                   f"2.84 full: {mm(c['x_284'])}")
 
-    out = ROOT / "out"
+    out = OUT
     if args.csv or args.png:
         out.mkdir(exist_ok=True)
     if args.csv:
@@ -356,4 +354,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cli(main))

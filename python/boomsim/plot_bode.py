@@ -19,22 +19,22 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-import figures  # noqa: E402
+from . import figures
+from .errors import cli
+from .paths import CHECKOUT, OUT, boomsim_binary
 
-ROOT = Path(__file__).resolve().parents[1]
-BOOMSIM = ROOT / "target" / "release" / "boomsim"
 SINE_HZ = "0.5,1,1.5,2,2.5,3,4,5,7,10"
 
 
 def linearize(point, *args):
-    cmd = [str(BOOMSIM), "linearize", *point, "--bode", "--json", *args]
+    cmd = [str(boomsim_binary()), "linearize", *point, "--bode", "--json", *args]
     out = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if out.returncode != 0:
         sys.exit(f"{' '.join(cmd)}: {out.stderr.strip()}")
     return json.loads(out.stdout)
 
 
-def main(path, boom="flexible", u_ref=-0.05, stroke=250.0, outputs=("p4",)):
+def plot(path, boom="flexible", u_ref=-0.05, stroke=250.0, outputs=("p4",)):
     point = ["--boom", boom, "--u-ref", repr(u_ref), "--stroke", repr(stroke), *(a for o in outputs for a in ("--output", o))]
     open_loop = linearize(point)
     closed = linearize(point, "--feedback", *(["--sine", SINE_HZ] if "p4" in outputs else []))
@@ -80,12 +80,16 @@ def main(path, boom="flexible", u_ref=-0.05, stroke=250.0, outputs=("p4",)):
     return fig
 
 
-if __name__ == "__main__":
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("out", nargs="?", type=Path, default=ROOT / "docs" / "figures" / "linearize_bode.png")
+    ap.add_argument("out", nargs="?", type=Path, default=(CHECKOUT / "docs" / "figures" if CHECKOUT else OUT) / "linearize_bode.png")
     ap.add_argument("--boom", choices=["rigid", "flexible"], default="flexible")
     ap.add_argument("--u-ref", type=float, default=-0.05)
     ap.add_argument("--stroke", type=float, default=250.0, metavar="MM")
     ap.add_argument("--output", action="append", metavar="NAME", help="an output (repeatable; default p4)")
-    a = ap.parse_args()
-    main(a.out, a.boom, a.u_ref, a.stroke, tuple(a.output or ["p4"]))
+    a = ap.parse_args(argv)
+    plot(a.out, a.boom, a.u_ref, a.stroke, tuple(a.output or ["p4"]))
+
+
+if __name__ == "__main__":
+    sys.exit(cli(main))

@@ -1,4 +1,4 @@
-"""The linear analysis of a sweep point (scripts/sweep.py): its operating point and `boomsim
+"""The linear analysis of a sweep point (boomsim.parameter_sweep): its operating point and `boomsim
 analyze` there, shared by the sweep (filter factors n_K, n_omega) and its summary (the stability
 boundary)."""
 
@@ -8,8 +8,9 @@ import functools
 import json
 import subprocess
 
-import cosim
-from cosim import UsageError
+from .errors import UsageError
+from .fmus import FmuFile
+from .paths import boomsim_binary
 
 
 def operating_point(sweep: dict, values: dict) -> dict:
@@ -19,7 +20,7 @@ def operating_point(sweep: dict, values: dict) -> dict:
     pressure-compensated spool). Each from the point, else the scenario, else the FMU's start
     value."""
     sc = sweep["scenario"]
-    plant = cosim.FmuFile.get("HydraulicBoom")
+    plant = FmuFile.get("HydraulicBoom")
 
     def value(name: str) -> float:
         if name in values:
@@ -37,9 +38,7 @@ def operating_point(sweep: dict, values: dict) -> dict:
 def analyze(op: tuple, n_k: tuple = (1.0,), n_omega: tuple = (1.0,)) -> dict:
     """`boomsim analyze --json` at the operating point `op` (the items of `operating_point`)
     for the filters n_k x n_omega."""
-    exe = cosim.BOOMSIM
-    if not exe.exists():
-        raise UsageError(f"{exe} is missing: run `cargo build --release` (n_K and n_omega need `boomsim analyze`)")
+    exe = boomsim_binary()
     args = [f"--{k}={v!r}" for k, v in op] + ["--n-k", ",".join(map(repr, n_k)), "--n-omega", ",".join(map(repr, n_omega))]
     r = subprocess.run([str(exe), "analyze", "--json", *args], capture_output=True, text=True)
     if r.returncode:

@@ -1,6 +1,6 @@
 """Regression of the scenario catalogue: runs every scenario variant (scenario x boom x feedback
 start), computes the metrics, compares them with the committed baselines within the tolerances of
-scripts/baselines/tolerances.toml and writes a Markdown report with the plots.
+the package's baselines/tolerances.toml and writes a Markdown report with the plots.
 
     scripts/regress                 compare; exit 1 on a regression or a missing baseline
     scripts/regress --update        re-baseline (explicit, never automatic)
@@ -23,15 +23,23 @@ import sys
 import time
 import tomllib
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import cosim  # noqa: E402
-import metrics as mx  # noqa: E402
+from . import cosim
+from .errors import Skip, cli, parse_params
+from .fmus import FmuFile
+from .paths import BASELINE_DIR as BASELINES, OUT as OUT_ROOT, PACKAGE
+from .plots import plot
+from .result import write_csv
+from .scenarios import all_scenarios, load_scenario, scenario_ids, variant_name
+from . import metrics as mx
 
-ROOT = cosim.ROOT
-BASELINES = ROOT / "scripts" / "baselines"
-OUT = ROOT / "out" / "regress"
+OUT = OUT_ROOT / "regress"
 ORDER = ["p3_pp_max", "p3_pp_late", "t_settle", "t_settle_motion", "t_motion", "t_cbv_open", "v_expected",
          "v_mean", "v_steady", "f_dom", "f_dom_amp", "u_comp_rms", "u_comp_max"]
+
+
+def shown(path: pathlib.Path, base: pathlib.Path) -> str:
+    """`path` relative to `base` where it lies below it, else whole."""
+    return str(path.relative_to(base) if path.is_relative_to(base) else path)
 
 
 def load_tolerances() -> dict:
@@ -80,13 +88,13 @@ def fmt(x, digits=4) -> str:
 def fmu_info() -> dict:
     out = {}
     for ident in ("HydraulicBoom", "PressureFeedbackController"):
-        f = cosim.FmuFile.get(ident)
+        f = FmuFile.get(ident)
         out[ident] = {"guid": f.md.guid, "version": f.md.version}
     return out
 
 
 def variants(only=None):
-    for sc in cosim.all_scenarios():
+    for sc in all_scenarios():
         if only and sc["id"] not in only:
             continue
         for boom in sc["booms"]:
@@ -98,7 +106,7 @@ def step_sweep(sid: str, steps, feedback_start: str) -> list[dict]:
     """Metrics of scenario `sid` (rigid) for each communication step, with a verdict: settles =
     p3 settles (2 %) and the steady velocity is within 2 % of the expected one (a limit cycle of
     the coupling can leave p3 nearly flat while it chokes the valve)."""
-    sc = cosim.load_scenario(sid)
+    sc = load_scenario(sid)
     rows = []
     for h in steps:
         r = cosim.run(sc, "rigid", step=h, feedback_start=feedback_start)
@@ -130,7 +138,7 @@ def c_ranking(results: dict) -> list[str]:
                      "| p3 p-p max [bar] | v_steady / expected | u_comp RMS |")
         lines.append("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
         for i, (sid, m) in enumerate(rows, 1):
-            sc = cosim.load_scenario(sid)
+            sc = load_scenario(sid)
             c = sc["controller"]
             lines.append(f"| {i} | {sid} | {c['K_f']:.3g} | {c['omega_f']:g} | {fmt(m['t_motion'])} | "
                          f"{fmt(m['t_settle'])} | {fmt(m['t_settle_motion'])} | {m['p3_pp_max']:.3g} | "
@@ -151,16 +159,16 @@ def main(argv=None) -> int:
                     help="compare every metric within this relative tolerance (plus its abs floor) "
                          "instead of tolerances.toml's")
     args = ap.parse_args(argv)
-    params = cosim.parse_params(ap, args.param)
+    params = parse_params(ap, args.param)
     if args.update and (params or args.rel is not None):
         ap.error("--update writes the baselines of the default FMUs: no --param or --rel with it")
     only = {s for s in args.only.split(",") if s}
-    unknown = sorted(only - set(cosim.scenario_ids()))
+    unknown = sorted(only - set(scenario_ids()))
     if unknown:  # a filter that matches nothing must not pass (nor overwrite the report)
         ap.error(f"--only {args.only}: unknown scenario {', '.join(unknown)}; "
-                 f"the scenarios are {', '.join(cosim.scenario_ids())}")
-    if args.step_sweep and args.step_sweep not in cosim.scenario_ids():
-        ap.error(f"--step-sweep {args.step_sweep}: unknown scenario; the scenarios are {', '.join(cosim.scenario_ids())}")
+                 f"the scenarios are {', '.join(scenario_ids())}")
+    if args.step_sweep and args.step_sweep not in scenario_ids():
+        ap.error(f"--step-sweep {args.step_sweep}: unknown scenario; the scenarios are {', '.join(scenario_ids())}")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tol = load_tolerances()
@@ -172,7 +180,7 @@ def main(argv=None) -> int:
     t_start = time.time()
     todo = list(variants(only))
     for k, (sc, boom, fb) in enumerate(todo, 1):
-        name = cosim.variant_name(sc, boom, fb)
+        name = variant_name(sc, boom, fb)
 
         def progress():
             """n of N and the elapsed time, for the line of a finished variant."""
@@ -180,22 +188,22 @@ def main(argv=None) -> int:
 
         try:
             res = cosim.run(sc, boom, feedback_start=fb, params=params)
-        except cosim.Skip as e:
+        except Skip as e:
             skipped.append(f"{name}: {e}")
             print(f"{progress()} {name:18s} skipped: {e}")
             continue
         m = mx.compute(res)
         results[name] = m
-        cosim.write_csv(res, out / f"{name}.csv")
-        cosim.plot(res, out / f"{name}.png", m)
+        write_csv(res, out / f"{name}.csv")
+        plot(res, out / f"{name}.png", m)
         base_file = BASELINES / f"{name}.json"
         if args.update:
-            base_file.write_text(json.dumps({"scenario": sc["file"].split("scripts/")[-1], "boom": boom,
+            base_file.write_text(json.dumps({"scenario": shown(pathlib.Path(sc["file"]), PACKAGE), "boom": boom,
                                              "feedback_start": fb, "step": res.step, "fmus": info,
                                              "metrics": m}, indent=2) + "\n")
             verdict = "baselined"
         elif not base_file.exists():
-            failures.append(f"{name}: no baseline {base_file.relative_to(ROOT)} (run scripts/regress --update)")
+            failures.append(f"{name}: no baseline {shown(base_file, PACKAGE)} (run scripts/regress --update)")
             verdict = "NO BASELINE"
         else:
             bad = compare(name, m, json.loads(base_file.read_text())["metrics"], tol)
@@ -213,9 +221,9 @@ def main(argv=None) -> int:
             sweep.append((fb, step_sweep(args.step_sweep, steps, fb)))
 
     write_report(out / "report.md", lines, results, failures, skipped, sweep, args, info, time.time() - t_start)
-    print(f"report: {(out / 'report.md').relative_to(ROOT) if out.is_relative_to(ROOT) else out / 'report.md'}")
+    print(f"report: {shown(out / 'report.md', pathlib.Path.cwd())}")
     if args.update:
-        print(f"baselines written to {BASELINES.relative_to(ROOT)}/ ({len(results)} variants)")
+        print(f"baselines written to {BASELINES}/ ({len(results)} variants)")
         return 0
     if failures:
         print(f"\n{len(failures)} regression(s):")
@@ -232,7 +240,7 @@ def write_report(path, lines, results, failures, skipped, sweep, args, info, wal
     if args.param or args.rel is not None:
         r.append(f"Parameters: {', '.join(args.param) or 'none'}; tolerance: "
                  f"{'tolerances.toml' if args.rel is None else f'{args.rel:g} relative + the abs floors of tolerances.toml'}.")
-    r.append(f"Mode: {'re-baseline (--update)' if args.update else 'compare with scripts/baselines/'}; "
+    r.append(f"Mode: {'re-baseline (--update)' if args.update else 'compare with the baselines'}; "
              f"{len(results)} variants run, {len(skipped)} skipped, {len(failures)} regression(s); {wall:.0f} s.")
     r.append("")
     if failures:
@@ -252,7 +260,7 @@ def write_report(path, lines, results, failures, skipped, sweep, args, info, wal
     r += ["", "## Ranking of the C experiments", ""] + c_ranking(results)
     r += ["", "Thesis 8.1-8.2: the gain matters more than the filter frequency; C1.1, C2.1 and C3.2 gave the "
           "most stable pressures (C2.1 the most oscillating of the three); in C3 the gain of C3.1 is too low, "
-          "C3.2 appropriate, C3.3 too high (poor compensation). See scripts/README.md for the comparison."]
+          "C3.2 appropriate, C3.3 too high (poor compensation). See docs/python.md for the comparison."]
     for fb, rows in sweep:
         r += ["", f"## Communication-step sweep: {args.step_sweep}, feedback start {fb}", "",
               "| step [ms] | settles | load moves at [s] | p3 settles at [s] | v_steady [mm/s] | f_dom [Hz] (p3 peak >= 0.5 bar) | u_comp RMS |",
@@ -274,4 +282,4 @@ def write_report(path, lines, results, failures, skipped, sweep, args, info, wal
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(cli(main))

@@ -1,11 +1,11 @@
-"""Plots the CSV tables of `boomsim analyze --sweep` (called by it; usage: plot_analysis.py DIR).
+"""Plots the CSV tables of `boomsim analyze --sweep` (called by it; usage: python -m boomsim.plot_analysis DIR).
 
 stability_boundary.png: largest closed-loop pole real part of eq. 2.82 along the stroke and the
 critical stroke over the lowering flow, per pilot ratio (Table 4.3).
 margins.png: stability-relevant gain and phase margins over n_omega per n_K (Fig. 6.4).
 """
+import argparse
 import csv
-import sys
 from collections import defaultdict
 from pathlib import Path
 
@@ -14,7 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-import figures  # noqa: E402
+from . import figures
 
 
 def read(path):
@@ -33,7 +33,7 @@ def num(r, k):
     return float(r[k]) if r[k] not in ("", None) else float("nan")
 
 
-def main(out):
+def plot(out):
     out = Path(out)
     flow = grouped(read(out / "boundary_flow.csv"), "mu_p")
     simplified = {mu_p: num(rows[0], "xc_crit_simplified_mm") for mu_p, rows in flow}
@@ -72,5 +72,11 @@ def main(out):
     print(out / "margins.png")
 
 
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("dir", help="the folder of boomsim analyze --sweep's CSV tables")
+    plot(ap.parse_args(argv).dir)
+
+
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main()

@@ -1,6 +1,6 @@
-"""Metrics of one co-simulation result (definitions in scripts/README.md, section Metrics).
+"""Metrics of one co-simulation result (definitions in docs/python.md, section Metrics).
 
-All metrics are computed from the recorded rows of cosim.Result.data (SI units in, display units
+All metrics are computed from the recorded rows of Result.data (SI units in, display units
 out: bar, mm/s, s, Hz, spool units).
 """
 
@@ -104,7 +104,7 @@ def whole_cycles(t: np.ndarray, y: np.ndarray, hysteresis: float = HYSTERESIS):
 
 
 def compute(res) -> dict:
-    """The regression metrics of one result (see scripts/README.md)."""
+    """The regression metrics of one result (see docs/python.md)."""
     d = res.data
     t, p3, u_comp = d["time"], d["p3"], d["u_comp"]
     u_ss = float(res.scenario["reference"][-1, 1])

@@ -1,7 +1,7 @@
 """Scenario B (rigid boom, feedback from t0): Gauss-Seidel vs Jacobi masters, with and without
 an extrapolated slope of valve.u_ref passed to HydraulicBoom (canInterpolateInputs, order 1).
 
-  a   Gauss-Seidel reference, scripts/cosim.py run() (plant first; controller gets the p4 slope)
+  a   Gauss-Seidel reference, boomsim.cosim.run() (plant first; controller gets the p4 slope)
   b   Jacobi, plant input held: both FMUs get the other's outputs at t_k, then both doStep;
       controller p.extrapolation = true, no slopes passed
   c   Jacobi as b, plus plant.setRealInputDerivatives(valve.u_ref, 1, (u_k - u_k-1)/h) (0 at k=0)
@@ -10,24 +10,26 @@ an extrapolated slope of valve.u_ref passed to HydraulicBoom (canInterpolateInpu
 Measures what HydraulicBoom's interpolation of valve.u_ref changes for a Jacobi master (PyFMI's
 extrapolates inputs this way); the README's HydraulicBoom section quotes its table.
 
-    .venv/bin/python scripts/jacobi.py [--jobs 2] [--sweep]     # about 1 s (--sweep: 8 s)
+    .venv/bin/python -m boomsim.jacobi [--jobs 2] [--sweep]     # about 1 s (--sweep: 8 s)
 
 Uses the packed FMUs of target/fmu (boomsim pack); writes out/jacobi/results.npz.
 """
 from __future__ import annotations
 
 import argparse
-import pathlib
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-MAIN = pathlib.Path(__file__).resolve().parent.parent
-OUT = MAIN / "out" / "jacobi"
-sys.path.insert(0, str(MAIN / "scripts"))
-import cosim  # noqa: E402
+from . import cosim
+from .errors import cli
+from .fmus import FmuFile
+from .paths import OUT as OUT_ROOT
+from .scenarios import load_scenario, reference
+
+OUT = OUT_ROOT / "jacobi"
 
 BAR = 1e5
 V_MOVE = -1e-3  # m/s
@@ -35,11 +37,11 @@ V_MOVE = -1e-3  # m/s
 
 def fmus():
     """The packed plant and controller."""
-    return cosim.FmuFile.get("HydraulicBoom"), cosim.FmuFile.get("PressureFeedbackController")
+    return FmuFile.get("HydraulicBoom"), FmuFile.get("PressureFeedbackController")
 
 
 def scenario():
-    return cosim.load_scenario(MAIN / "scripts" / "scenarios" / "B.toml")
+    return load_scenario("B")
 
 
 def run_gs(step: float) -> dict:
@@ -76,7 +78,7 @@ def run_jacobi(step: float, slope_to_plant: bool) -> dict:
                 ctrl_f.set(ctrl, name, ctrl_cfg[name])
         ctrl_f.set(ctrl, "enable", bool(ctrl_cfg["enable"]))
         ctrl_f.set(ctrl, "p.extrapolation", True)
-        ctrl.setReal([vc["p"], vc["u_ref"]], [p4, cosim.reference(table, 0.0)])
+        ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, 0.0)])
         ctrl.exitInitializationMode()
         u_prev = None
         for k in range(n + 1):
@@ -92,7 +94,7 @@ def run_jacobi(step: float, slope_to_plant: bool) -> dict:
             if slope_to_plant:
                 du = 0.0 if u_prev is None else (u - u_prev) / step
                 plant.setRealInputDerivatives([vp["valve.u_ref"]], [1], [du])
-            ctrl.setReal([vc["p"], vc["u_ref"]], [p4, cosim.reference(table, t)])
+            ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, t)])
             u_prev = u
             plant.doStep(t, step)
             ctrl.doStep(t, step)
@@ -209,4 +211,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

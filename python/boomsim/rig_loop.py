@@ -1,10 +1,10 @@
 """The experiments at the rig's control-loop period, with either model of the valve electronics.
 
-    .venv/bin/python scripts/rig_loop.py [--step 5e-3] [--boom rigid] [--p4 BAR] [--only B,C2.1]
+    boomsim-rig-loop [--step 5e-3] [--boom rigid] [--p4 BAR] [--only B,C2.1]
         [--out out/rig_loop]
 
 The rig's real-time controller runs its loops at 5 ms and slower (thesis 4.2.2), so the
-feedback's command is held for 5 ms. Every compensated scenario of scripts/scenarios/ (A, B, C)
+feedback's command is held for 5 ms. Every compensated scenario of the catalogue (A, B, C)
 runs at that step twice: with the first-order spool lag of eq. 2.45 (the thesis' model and the
 FMU's default) and with the PVES position loop (`valve.omega_loop`, speeds of Table 4.2). The
 table (stdout and <out>/summary.md) gives, per run, the lowering speed against the rated one
@@ -19,8 +19,11 @@ import argparse
 import pathlib
 import sys
 
-import cosim
-import metrics
+from . import cosim
+from .errors import cli
+from .paths import OUT
+from .scenarios import load_scenario
+from . import metrics
 
 #: The rig's loop period: the real-time controller's cycle times start at 5 ms (thesis 4.2.2).
 RIG_STEP = 5e-3
@@ -74,10 +77,10 @@ def main(argv=None) -> int:
     ap.add_argument("--boom", choices=["rigid", "flexible"], default="rigid")
     ap.add_argument("--p4", type=float, help="pre-charged rod side at the start [bar] (start.p4)")
     ap.add_argument("--only", help="comma-separated scenario ids (default: A, B and C)")
-    ap.add_argument("--out", type=pathlib.Path, default=cosim.ROOT / "out" / "rig_loop")
+    ap.add_argument("--out", type=pathlib.Path, default=OUT / "rig_loop")
     args = ap.parse_args(argv)
     ids = args.only.split(",") if args.only else CATALOGUE
-    scenarios = {sid: cosim.load_scenario(sid) for sid in ids}
+    scenarios = {sid: load_scenario(sid) for sid in ids}
     results, k, n = {}, 0, len(ids) * len(MODELS)
     for sid, sc in scenarios.items():
         results[sid] = {}
@@ -96,4 +99,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

@@ -1,9 +1,9 @@
 """The split system through fmpy: HydraulicCircuit + BoomMechanics + PressureFeedbackController,
-the same scenarios and recorded columns as scripts/cosim.py (which runs the monolithic
+the same scenarios and recorded columns as boomsim.cosim (which runs the monolithic
 HydraulicBoom), and the sweep of the communication step that finds each coupling's stable limit.
 
-    .venv/bin/python scripts/split.py U --coupling tlm [--boom rigid] [--step 1e-3]
-    .venv/bin/python scripts/split.py --sweep [--boom flexible]
+    boomsim-split U --coupling tlm [--boom rigid] [--step 1e-3]
+    boomsim-split --sweep [--boom flexible]
 
 Couplings (the port is documented in the FMUs and in the README, "Coupling your own mechanics"):
     plain    Gauss-Seidel: mechanics.doStep with F_k held -> x_k+1, v_k+1 -> the circuit steps
@@ -17,38 +17,41 @@ from __future__ import annotations
 
 import argparse
 import math
-import pathlib
 import sys
 
 import numpy as np
 from fmpy.fmi1 import FMICallException
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import cosim  # noqa: E402
-import metrics as mx  # noqa: E402
+from . import cosim
+from .errors import cli
+from .fmus import FmuFile
+from .result import COLUMNS, PLANT_OUT, Result
+from .scenarios import load_scenario, reference
+from . import metrics as mx
+from . import regression
 
 COUPLINGS = ("plain", "jacobi", "tlm", "tlm-jacobi")
-#: Circuit outputs recorded (cosim.PLANT_OUT without the stroke and velocity, which come from
+#: Circuit outputs recorded (PLANT_OUT without the stroke and velocity, which come from
 #: the mechanics).
-CIRCUIT_OUT = [c for c in cosim.PLANT_OUT if not c.startswith("cylinder.")]
+CIRCUIT_OUT = [c for c in PLANT_OUT if not c.startswith("cylinder.")]
 
 
 class Unstable(Exception):
     """The coupled run diverged (a step was refused or the motion left the stroke)."""
 
 
-def own_params(fmu: cosim.FmuFile, plant: dict) -> dict:
+def own_params(fmu: FmuFile, plant: dict) -> dict:
     """The entries of a scenario's [plant] table that `fmu` has."""
     return {k: v for k, v in plant.items() if k in fmu.vars}
 
 
 def run(scenario: dict, boom: str = "rigid", coupling: str = "tlm", step: float | None = None,
-        stop_time: float | None = None, tolerance: float | None = None) -> cosim.Result:
+        stop_time: float | None = None, tolerance: float | None = None) -> Result:
     """Co-simulate one scenario with the split plant (feedback from t = 0). Raises Unstable when
     the coupled system diverges."""
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {COUPLINGS}")
-    circ_f, mech_f, ctrl_f = (cosim.FmuFile.get(i) for i in ("HydraulicCircuit", "BoomMechanics",
+    circ_f, mech_f, ctrl_f = (FmuFile.get(i) for i in ("HydraulicCircuit", "BoomMechanics",
                                                                "PressureFeedbackController"))
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     step = scenario["step"] if step is None else step
@@ -83,7 +86,7 @@ def run(scenario: dict, boom: str = "rigid", coupling: str = "tlm", step: float 
             if name in ctrl_cfg:
                 ctrl_f.set(ctrl, name, ctrl_cfg[name])
         ctrl_f.set(ctrl, "enable", enable)
-        ctrl.setReal([vc["p"], vc["u_ref"]], [p4, cosim.reference(table, 0.0)])
+        ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, 0.0)])
         ctrl.exitInitializationMode()
 
         data = _loop((circ, circ_f), (mech, mech_f), (ctrl, ctrl_f), scenario, coupling, step, n, (x, v, p4))
@@ -96,12 +99,12 @@ def run(scenario: dict, boom: str = "rigid", coupling: str = "tlm", step: float 
             except Exception:  # noqa: BLE001 - terminate after an error may be refused
                 pass
             s.freeInstance()
-    return cosim.Result(scenario, boom, step, True, {c: data[:, i] for i, c in enumerate(cosim.COLUMNS)}, 0.0)
+    return Result(scenario, boom, step, True, {c: data[:, i] for i, c in enumerate(COLUMNS)}, 0.0)
 
 
 def _loop(circuit, mechanics, controller, scenario, coupling, step, n, start) -> np.ndarray:
     """The communication steps of `run` from the initialised (slave, FmuFile) pairs and the start
-    values (x, v, p4): the recorded rows (cosim.COLUMNS)."""
+    values (x, v, p4): the recorded rows (COLUMNS)."""
     (circ, circ_f), (mech, mech_f), (ctrl, ctrl_f) = circuit, mechanics, controller
     vh, vm, vc = circ_f.vr, mech_f.vr, ctrl_f.vr
     x, v, p4 = start
@@ -111,7 +114,7 @@ def _loop(circuit, mechanics, controller, scenario, coupling, step, n, start) ->
     i_p4 = CIRCUIT_OUT.index("p4")
     rows = []
     y = circ.getReal(out_h)
-    u_ref = cosim.reference(table, 0.0)
+    u_ref = reference(table, 0.0)
     stroke = circ.getReal([vh["cylinder.stroke"]])[0]
     for k in range(n + 1):
         t = k * step
@@ -119,7 +122,7 @@ def _loop(circuit, mechanics, controller, scenario, coupling, step, n, start) ->
         circ.setReal([vh["valve.u_ref"]], [u])
         if k % record_every == 0:
             rec = dict(zip(CIRCUIT_OUT, y), **{"cylinder.x": x, "cylinder.v": v})
-            rows.append([t, u_ref, u_comp, u, *(rec[c] for c in cosim.PLANT_OUT)])
+            rows.append([t, u_ref, u_comp, u, *(rec[c] for c in PLANT_OUT)])
         if k == n:
             break
         if not (-0.05 < x < stroke + 0.05) or not all(map(math.isfinite, y)):
@@ -154,7 +157,7 @@ def _loop(circuit, mechanics, controller, scenario, coupling, step, n, start) ->
         ctrl.setRealInputDerivatives([vc["p"]], [1], [(p4_next - p4) / step])
         ctrl.doStep(t, step)
         p4 = p4_next
-        u_ref = cosim.reference(table, t + step)
+        u_ref = reference(table, t + step)
         ctrl.setReal([vc["p"], vc["u_ref"]], [p4, u_ref])
     return np.array(rows)
 
@@ -171,7 +174,7 @@ LIFT = {"id": "lift", "stop_time": 3.0, "start_stroke": 0.25, "plant": {}, "step
 REST_PTP = 0.1e5
 
 
-def rings_down(r: cosim.Result) -> tuple[bool, str]:
+def rings_down(r: Result) -> tuple[bool, str]:
     """Whether p3 of a LIFT run comes to rest: its swing over the last 0.5 s is below REST_PTP or
     below 80 % of the swing over the 0.5 s before (a decaying ring-down); a sustained or growing
     oscillation fails."""
@@ -208,13 +211,11 @@ def sweep(boom: str, couplings=COUPLINGS, steps=SWEEP_STEPS, alpha: float = 0.0)
 
 def compare(a: dict, b: dict, rel: float = 0.02) -> dict:
     """{metric: (monolithic, split, ok)}: ok when |split - mono| <= rel |mono| + the absolute floor
-    of scripts/baselines/tolerances.toml (a 2 % band around a near-zero value, e.g. the residual
+    of the package's baselines/tolerances.toml (a 2 % band around a near-zero value, e.g. the residual
     p3 swing of a settled run, is below the metric's own resolution)."""
-    import regress
-
-    tol = regress.load_tolerances()
+    tol = regression.load_tolerances()
     out = {}
-    for k in regress.ORDER:
+    for k in regression.ORDER:
         if k not in a:
             continue
         m, s = a[k], b.get(k)
@@ -239,7 +240,7 @@ def main(argv=None):
     ap.add_argument("--sweep", action="store_true", help="largest stable step of each coupling")
     ap.add_argument("--alpha", type=float, default=0.0, help="TLM wave damping port.alpha of the sweep")
     args = ap.parse_args(argv)
-    sc = cosim.load_scenario(args.scenario)
+    sc = load_scenario(args.scenario)
     if args.sweep:
         couplings = COUPLINGS if args.alpha == 0 else ("tlm", "tlm-jacobi")
         for c, (largest, rows) in sweep(args.boom, couplings, alpha=args.alpha).items():
@@ -258,4 +259,4 @@ def regress_fmt(x) -> str:
 
 
 if __name__ == "__main__":
-    sys.exit(cosim.cli(main))
+    sys.exit(cli(main))

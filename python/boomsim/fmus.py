@@ -1,0 +1,162 @@
+"""The fmpy adapter: an extracted .fmu with its variables by name, its Co-Simulation and Model
+Exchange instances (FMI 3.0 ones behind the FMI 2.0 method names), typed setting by name, the
+boom switch, and the set-up of a plant and its controller before a run of either interface."""
+
+from __future__ import annotations
+
+from .errors import Skip, UsageError
+from .paths import fmu
+from .scenarios import plant_start
+
+#: Names the flexible-boom switch may get in HydraulicBoom (structural parameter, Integer or
+#: Boolean). Until one of them exists the FMU has the rigid boom only.
+FLEXIBLE_SWITCH = ("boom.flexible", "boom.model", "boom.type")
+
+
+class Fmi3:
+    """An fmpy FMI 3.0 instance (FMU3Slave or FMU3Model) under the FMI 2.0 names this runner
+    calls: the experiment goes with enterInitializationMode, Real is Float64, Integer is Int32."""
+
+    def __init__(self, instance):
+        self.m = instance
+        self._experiment = {}
+
+    def __getattr__(self, name):
+        return getattr(self.m, name)
+
+    def setupExperiment(self, tolerance=None, startTime=0.0, stopTime=None):
+        self._experiment = dict(tolerance=tolerance, startTime=startTime, stopTime=stopTime)
+
+    def enterInitializationMode(self):
+        return self.m.enterInitializationMode(**self._experiment)
+
+    def getReal(self, vrs):
+        return self.m.getFloat64(vrs)
+
+    def setReal(self, vrs, values):
+        return self.m.setFloat64(vrs, values)
+
+    def setInteger(self, vrs, values):
+        return self.m.setInt32(vrs, values)
+
+    def doStep(self, t, h):
+        return self.m.doStep(t, h)
+
+    def setRealInputDerivatives(self, *_):
+        raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
+
+    def getDerivatives(self, p, n):
+        return self.m.getContinuousStateDerivatives(p, n)
+
+    def newDiscreteStates(self):
+        return self.m.updateDiscreteStates()
+
+
+class FmuFile:
+    """An extracted FMU (FMI `fmi` 2 or 3): model description and value references by name."""
+
+    _cache: dict[tuple[str, int], "FmuFile"] = {}
+
+    def __init__(self, identifier: str, fmi: int = 2):
+        from fmpy import extract, read_model_description
+
+        self.fmi = fmi
+        self.path = str(fmu(identifier, fmi))
+        self.md = read_model_description(self.path)
+        self.dir = extract(self.path)
+        self.vars = {v.name: v for v in self.md.modelVariables}
+        self.vr = {n: v.valueReference for n, v in self.vars.items()}
+        self._idle = []  # Co-Simulation instances handed back for reuse
+
+    def reused_slave(self, name: str):
+        """A Co-Simulation instance handed back by `give_back`, fmi2Reset to the state after
+        instantiation (every parameter at its start value), or a new one."""
+        if not self._idle:
+            return self.slave(name)
+        s = self._idle.pop()
+        s.reset()
+        return s
+
+    def give_back(self, slave):
+        """Keeps an instance of a finished run for `reused_slave`."""
+        self._idle.append(slave)
+
+    @classmethod
+    def get(cls, identifier: str, fmi: int = 2) -> "FmuFile":
+        if (identifier, fmi) not in cls._cache:
+            cls._cache[identifier, fmi] = FmuFile(identifier, fmi=fmi)
+        return cls._cache[identifier, fmi]
+
+    def _instance(self, interface: str, name: str):
+        """An instantiated fmpy instance of `interface` ("CoSimulation" or "ModelExchange"),
+        FMI 3.0 ones behind the FMI 2.0 method names (class Fmi3)."""
+        from fmpy import fmi2, fmi3
+
+        kind = "Slave" if interface == "CoSimulation" else "Model"
+        cls = getattr(fmi3, f"FMU3{kind}") if self.fmi == 3 else getattr(fmi2, f"FMU2{kind}")
+        description = self.md.coSimulation if interface == "CoSimulation" else self.md.modelExchange
+        i = cls(guid=self.md.guid, unzipDirectory=self.dir,
+                modelIdentifier=description.modelIdentifier, instanceName=name)
+        i.instantiate()
+        return Fmi3(i) if self.fmi == 3 else i
+
+    def slave(self, name: str):
+        """A Co-Simulation instance."""
+        return self._instance("CoSimulation", name)
+
+    def model(self, name: str):
+        """A Model Exchange instance."""
+        return self._instance("ModelExchange", name)
+
+    def set(self, slave, name: str, value):
+        v = self.vars[name]
+        if v.type in ("Real", "Float64"):
+            slave.setReal([v.valueReference], [float(value)])
+        elif v.type == "Boolean":
+            slave.setBoolean([v.valueReference], [bool(value)])
+        elif v.type in ("Integer", "Int32", "Enumeration"):
+            slave.setInteger([v.valueReference], [int(value)])
+        else:
+            raise TypeError(f"{name}: unsupported type {v.type}")
+
+
+def boom_switch(plant: FmuFile, boom: str):
+    """(name, value) of the structural parameter selecting `boom`, or None for the rigid boom of
+    an FMU without the switch; raises Skip when the FMU cannot give `boom`."""
+    name = next((n for n in FLEXIBLE_SWITCH if n in plant.vars), None)
+    if boom == "rigid":
+        return None if name is None else (name, 0 if plant.vars[name].type != "Boolean" else False)
+    if boom == "flexible":
+        if name is None:
+            raise Skip("HydraulicBoom has the rigid boom only (no flexible-boom switch "
+                       f"{' / '.join(FLEXIBLE_SWITCH)} in its modelDescription yet)")
+        return name, (1 if plant.vars[name].type != "Boolean" else True)
+    raise ValueError(f"unknown boom {boom!r} (rigid or flexible)")
+
+
+def release(*instances):
+    """Terminates (where the state allows) and frees FMU instances."""
+    for m in instances:
+        try:
+            m.terminate()
+        except Exception:  # noqa: BLE001 - terminate after an error may be refused
+            pass
+        m.freeInstance()
+
+
+def initialize_plant(plant_f: FmuFile, plant, ctrl, scenario: dict, switch, tolerance, t_end: float):
+    """Sets both instances up and into Initialization Mode, and initialises the plant with the
+    scenario's start stroke, boom and parameters (either interface)."""
+    for m in (plant, ctrl):
+        m.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
+        m.enterInitializationMode()
+    for name, value in plant_start(scenario, switch).items():
+        plant_f.set(plant, name, value)
+    plant.exitInitializationMode()
+
+
+def with_params(scenario: dict, plant_f: FmuFile, params: dict | None) -> tuple[dict, dict]:
+    """The scenario with the plant's `params` among its start values, and the controller's."""
+    params = params or {}
+    plant = {k: v for k, v in params.items() if k in plant_f.vars}
+    return {**scenario, "plant": {**scenario["plant"], **plant}}, {k: v for k, v in params.items() if k not in plant}

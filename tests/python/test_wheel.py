@@ -1,0 +1,125 @@
+"""The installed package (issue 28): the wheel of `scripts/wheel` installed into a fresh venv, used
+from a folder outside the repository, without Rust, the checkout or its FMUs on any path.
+
+- experiments U and B through the public API (`boomsim.run`) give the committed baselines'
+  metrics within the regression's tolerances (python/boomsim/baselines/);
+- a 4-point sweep on a LocalCluster (`boomsim.sweep`, the `sweeps` extra) gives the metrics of the
+  same points run one by one;
+- every FMU in the wheel (FMI 2.0 and 3.0) passes fmpy's validation and instantiates in both
+  interfaces with fmpy.
+
+One venv for the module (about a minute: pip installs the pinned versions of
+scripts/requirements.txt as constraints, from pip's cache after the first time)."""
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from boomsim import regression
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+VERSION = next(line.split('"')[1] for line in (ROOT / "python" / "pyproject.toml").read_text().splitlines()
+               if line.startswith("version = "))
+WHEEL = ROOT / "dist" / f"boomsim-{VERSION}-py3-none-any.whl"
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """(python of a fresh venv with the wheel and its `sweeps` extra, a working folder outside the
+    repository)."""
+    assert WHEEL.exists(), f"{WHEEL} is missing: run `bash scripts/wheel`"
+    venv = tmp_path_factory.mktemp("venv")
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    python = venv / "bin" / "python"
+    subprocess.run([str(python), "-m", "pip", "install", "-q", "--disable-pip-version-check",
+                    "-c", str(ROOT / "scripts" / "requirements.txt"), f"{WHEEL}[sweeps]"], check=True)
+    return python, tmp_path_factory.mktemp("user")
+
+
+def outside(installed, code: str):
+    """Runs `code` in the fresh venv from the folder outside the repository, with an environment
+    that names nothing of the checkout; returns what it prints as JSON."""
+    python, cwd = installed
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "BOOMSIM_FMU_DIR", "VIRTUAL_ENV")}
+    r = subprocess.run([str(python), "-c", textwrap.dedent(code)], cwd=cwd, env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_the_package_is_the_installed_one(installed):
+    where = outside(installed, """
+        import json, boomsim
+        print(json.dumps([boomsim.__file__, str(boomsim.paths.CHECKOUT), boomsim.__version__,
+                          str(boomsim.fmu("HydraulicBoom", fmi=3))]))
+    """)
+    assert not where[0].startswith(str(ROOT)) and where[1] == "None" and where[2] == VERSION
+    assert "site-packages/boomsim/fmus/fmi3/HydraulicBoom.fmu" in where[3]
+
+
+def test_u_and_b_reproduce_the_baselines(installed):
+    """The regression's metrics of U and B (rigid boom, feedback from t = 0) within its tolerances
+    (python/boomsim/baselines/tolerances.toml, each with its reason there)."""
+    got = outside(installed, """
+        import json, boomsim
+        print(json.dumps({sid: boomsim.run(sid, boom="rigid").metrics for sid in ("U", "B")}))
+    """)
+    tol = regression.load_tolerances()
+    for sid, metrics in got.items():
+        base = json.loads((ROOT / "python" / "boomsim" / "baselines" / f"{sid}-rigid.json").read_text())
+        assert regression.compare(sid, metrics, base["metrics"], tol) == []
+
+
+def test_a_sweep_on_a_local_cluster_equals_the_points_run_one_by_one(installed):
+    """Four points (K_f x omega_f, B rigid, 1 s) on two worker processes; each row's metrics equal
+    those of boomsim.run at the point in the same venv, bit for bit (the same FMU binaries)."""
+    rows, serial = outside(installed, """
+        import json, pathlib, boomsim
+        pathlib.Path("four.toml").write_text('''scenario = "B"
+        stop_time = 1.0
+        metrics = ["p3_pp_max", "u_comp_max", "v_steady"]
+        [parameters]
+        K_f = {grid = [1.0e-11, 1.24e-11]}
+        omega_f = {grid = [5.0, 10.0]}
+        '''.replace("\\n        ", "\\n"))
+        rows = boomsim.sweep("four.toml", workers=2, out="sweep")
+        serial = [boomsim.run("B", stop_time=1.0, params={"K_f": r["K_f"], "omega_f": r["omega_f"]}).metrics
+                  for r in rows]
+        print(json.dumps([rows, serial]))
+    """)
+    assert len(rows) == 4 and {(r["K_f"], r["omega_f"]) for r in rows} == {
+        (k, w) for k in (1.0e-11, 1.24e-11) for w in (5.0, 10.0)}
+    for row, ref in zip(rows, serial):
+        assert row["status"] == "ok", row["error"]
+        assert {k: row[k] for k in ("p3_pp_max", "u_comp_max", "v_steady")} == {
+            k: ref[k] for k in ("p3_pp_max", "u_comp_max", "v_steady")}
+
+
+def test_every_fmu_in_the_wheel_validates_and_instantiates(installed):
+    """fmpy's validation reports nothing (the issue's acceptance for boomsim.fmu(..., fmi=3)), and
+    each interface instantiates and frees (the linux64 binary in the wheel's .fmu)."""
+    problems = outside(installed, """
+        import json, boomsim
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import FMU2Model, FMU2Slave
+        from fmpy.fmi3 import FMU3Model, FMU3Slave
+        from fmpy.validation import validate_fmu
+        out = {}
+        for fmi in (2, 3):
+            for model in boomsim.MODELS:
+                path = str(boomsim.fmu(model, fmi=fmi))
+                found = list(validate_fmu(path))
+                md, unzipped = read_model_description(path), extract(path)
+                kinds = (FMU2Slave, FMU2Model) if fmi == 2 else (FMU3Slave, FMU3Model)
+                for kind, interface in zip(kinds, (md.coSimulation, md.modelExchange)):
+                    i = kind(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=interface.modelIdentifier)
+                    i.instantiate()
+                    i.freeInstance()
+                out[f"{model} FMI {fmi}"] = found
+        print(json.dumps(out))
+    """)
+    assert len(problems) == 8 and all(p == [] for p in problems.values()), problems
