@@ -221,7 +221,7 @@ fn a_tolerance_out_of_range_is_clamped_with_a_warning() {
 
 /// FMI 2.0, 2.1.6: in Model Exchange, fmi2SetupExperiment's tolerance is the one the importer's
 /// integrator controls its steps with. Looser than the model's `MODEL_EXCHANGE_TOLERANCE` (the
-/// circuit's 1e-6: with the controller, scenario U fails under CVode at 1e-4, the README's
+/// circuit's 1e-6: with the controller, scenario U fails under CVode at 1e-4, docs/interfaces.md's
 /// tolerance section), it is kept with fmi2Warning and a message naming it and the one the model
 /// needs. The same tolerance in
 /// Co-Simulation, where the FMU's own Radau IIA integrates, 1e-6 in Model Exchange, and any for

@@ -49,7 +49,7 @@ fn a_pre_charged_rod_side_holds_the_load_and_bleeds_to_tank() {
         let balance = load + mu_c * p4;
         assert!(p3 > balance - 1e3 && p3 < p3_0 + 1e3, "p3 = {p3} Pa outside [{balance}, {p3_0}] at step {k}");
     }
-    // About a minute's time constant (README, "Pre-charged starts"): 1 s takes 0.5-5 % of it.
+    // About a minute's time constant (docs/models.md, "Pre-charged starts"): 1 s takes 0.5-5 % of it.
     let drop = (p4_0 - p4) / p4_0;
     assert!((0.005..0.05).contains(&drop), "{drop}");
 }

@@ -76,7 +76,7 @@ fn real_time_holds_the_load_at_rest() {
 /// Lowering (cases U and B, rigid boom, 6 s) in real-time mode with the smallest budget against
 /// the adaptive mode: the stroke travelled within 1 % and, in B, where p3 has settled, p3 within
 /// 1 bar (U's p3 is a cavitating limit cycle: a phase shift of a few ms moves it by bars; the
-/// regression's metrics compare it, README "Real-time mode"). Where the budget
+/// regression's metrics compare it, docs/realtime.md). Where the budget
 /// suffices the steps are the adaptive ones; the closing steps (a single Radau IIA step over
 /// at most the 1 ms communication step, whose error the indicator reports) move the result by
 /// about their local error. 1 % of the travel is the regression's tolerance of the mean
@@ -125,19 +125,19 @@ fn bad_solver_settings_are_refused() {
     }
 }
 
-/// The README's table of the real-time mode states the RHS evaluations per doStep of `boomsim
+/// docs/realtime.md's table of the real-time mode states the RHS evaluations per doStep of `boomsim
 /// bench --realtime` (10 identical runs of 10 s; their quantiles are those of one run) and its
 /// count of inaccurate closing steps: they must be this code's.
 #[test]
-fn readme_states_the_counts_of_the_benchmark() {
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
+fn the_docs_state_the_counts_of_the_benchmark() {
+    let page = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/realtime.md")).unwrap();
     for d in boomsim_tools::bench::step_distributions(1, 10.0).unwrap() {
         let rhs = d.rhs.map(|x| format!("{x}")).join(" / ");
         let row = format!("| {} | {} | {} | {rhs} |", d.case, d.boom, d.mode);
-        assert!(readme.contains(&row), "README, Real-time mode: no row {row}");
+        assert!(page.contains(&row), "docs/realtime.md: no row {row}");
         if d.inaccurate > 0 {
             let says = format!("{} closing steps above the tolerance in 10^5 doSteps", 10 * d.inaccurate);
-            assert!(readme.contains(&says), "README, Real-time mode: {says} ({} {})", d.case, d.boom);
+            assert!(page.contains(&says), "docs/realtime.md: {says} ({} {})", d.case, d.boom);
         }
     }
 }

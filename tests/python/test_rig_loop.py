@@ -47,7 +47,7 @@ def test_the_lag_relays_through_the_dead_band_at_5_ms():
 def readme_rows() -> dict:
     """The README's rig-loop table: scenario id -> its cells."""
     rows = {}
-    for line in (ROOT / "README.md").read_text().splitlines():
+    for line in (ROOT / "docs" / "models.md").read_text().splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
         if line.strip().startswith("|") and len(cells) == len(rig_loop.MODELS) + 2 and cells[0] in rig_loop.CATALOGUE:
             rows[cells[0]] = cells

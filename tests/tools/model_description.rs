@@ -90,7 +90,7 @@ fn the_page_states_generated_facts() {
     let i = Pfc::INFO;
     assert!(page.contains(&format!("{} to {} s", i.start_time, i.stop_time)));
     // The Model Exchange tolerance the model needs: any for the controller's linear filter, the
-    // circuit's 1e-6 for HydraulicBoom (the README's tolerance table), the one its warning names.
+    // circuit's 1e-6 for HydraulicBoom (docs/interfaces.md's tolerance table), the one its warning names.
     assert!(page.contains("<th>Model Exchange tolerance</th><td>any</td>"), "controller: any tolerance");
     let page = boomsim_tools::pack::documentation::<boomsim::models::HydraulicBoom>(Version::Fmi2, platforms);
     assert!(page.contains("<th>Model Exchange tolerance</th><td>1e-6 or tighter"), "HydraulicBoom: 1e-6");

@@ -224,7 +224,7 @@ impl<M: Model> Instance<M> {
             if tol > needed {
                 let looser = format!(
                     "tolerance = {} is looser than the {} this model needs in Model Exchange: BDF integrators such as \
-                     CVode give wrong, even non-physical, pressures at looser ones (the README's tolerance table); set \
+                     CVode give wrong, even non-physical, pressures at looser ones (boomsim's docs/interfaces.md); set \
                      the tolerance to {} or less",
                     num(tol),
                     num(needed),

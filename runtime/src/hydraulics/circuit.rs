@@ -201,7 +201,7 @@ impl Circuit {
     /// closed does it leak down over 37 ms, 0.03 cm^3 of compressed oil that the spool's next
     /// opening passes in microseconds. Integrated, it made BDF integrators at importers'
     /// tolerances (CVode, rtol 1e-4) overshoot p1 by thousands of bar through the compensator's
-    /// kinks (the README's tolerance table); its quasi-static limit is the same circuit without
+    /// kinks (docs/interfaces.md's tolerance table); its quasi-static limit is the same circuit without
     /// that mode, and `line.v_l1` is no parameter any more.
     ///
     /// The root is unique: the net flow falls with p1 (the compensator closes and its drop
@@ -346,7 +346,7 @@ mod tests {
         let c_w = c.lines.hose_compliance(c.lines.v_l4);
         let expected = -leak / ((v4 + c_w * p4) / c.fluid.bulk_modulus(p4) + c_w);
         assert!((e.dx[P4] / expected - 1.0).abs() < 1e-12, "{} vs {expected}", e.dx[P4]);
-        // The time constant of that drift: about a minute (README, "Pre-charged starts").
+        // The time constant of that drift: about a minute (docs/models.md, "Pre-charged starts").
         let tau = -(p4 - c.supply.p_t) / e.dx[P4];
         assert!((20.0..200.0).contains(&tau), "{tau} s");
     }

@@ -76,7 +76,7 @@ impl Dcv {
     ///   reaction time, as eq. 2.45's settling time assumes, while a small correction is
     ///   followed within a few `1 / omega_loop`, where eq. 2.45 lags it by `1 / omega_v` = 30 ms.
     ///   Neither the thesis nor the data sheet gives the loop's gain; from about 1000 rad/s on
-    ///   the speed limits decide (README, model notes, "Valve electronics").
+    ///   the speed limits decide (docs/models.md, "Valve electronics").
     pub fn spool_rate<T: Scalar>(&self, x_v: T, u_ref: T) -> T {
         let error = self.spool_reference(u_ref) - x_v;
         if self.omega_loop == 0.0 {

@@ -38,7 +38,7 @@ impl Fluid {
     ///
     /// Deviation from the thesis (constant `beta`): the air term models cavitation/air release
     /// physically. It softens the oil most at low pressure: by [`AIR_PRESSURES`]'s amounts,
-    /// which the README's model notes quote (checked by a test); as `p_abs -> 0` the free air
+    /// which docs/models.md quotes (checked by a test); as `p_abs -> 0` the free air
     /// expands without bound and `beta_e -> p_abs`, so `dp/dt -> 0` smoothly and a pressure
     /// never reaches absolute zero (vapour pressure of the oil is neglected against it). With
     /// `x0 = 0` it is exactly `beta`.
@@ -64,7 +64,7 @@ impl Fluid {
     }
 }
 
-/// Gauge pressures (Pa) at which the README states how much the default air softens the oil.
+/// Gauge pressures (Pa) at which docs/models.md states how much the default air softens the oil.
 pub const AIR_PRESSURES: [f64; 4] = [45e5, 10e5, 1e5, 0.0];
 
 /// `exp(x)`, by its Taylor polynomial of degree 8 for `|x| <= 1/16` (truncation below
@@ -147,14 +147,14 @@ mod tests {
         assert!((f.bulk_modulus(-P_ATM + p_abs) / p_abs - 1.0).abs() < 1e-3);
     }
 
-    /// The README's model notes state the default air's effect at [`AIR_PRESSURES`]: each
-    /// number there is `1 - beta_e(p) / beta` of the law, rounded as printed (the sentence once
+    /// The model notes (docs/models.md) state the default air's effect at [`AIR_PRESSURES`]:
+    /// each number there is `1 - beta_e(p) / beta` of the law, rounded as printed (the sentence once
     /// said 1 % at 10 bar, a tenth of what the law gives).
     #[test]
-    fn the_readme_states_what_the_air_law_gives() {
+    fn the_model_notes_state_what_the_air_law_gives() {
         let f = crate::hydraulics::circuit::Circuit::default().fluid;
-        let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
-        let line = readme.lines().find(|l| l.contains("softens the oil by")).expect("the Cavitation note");
+        let notes = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/models.md")).unwrap();
+        let line = notes.lines().find(|l| l.contains("softens the oil by")).expect("the Cavitation note");
         let stated: Vec<f64> = line
             .split("softens the oil by ")
             .nth(1)
@@ -172,7 +172,7 @@ mod tests {
             assert_eq!(stated[AIR_PRESSURES.len() + k], p / 1e5);
         }
         // the comparison with Simscape's default air content, 0.5 %
-        let line = readme.lines().find(|l| l.contains("0.5 % would soften it by")).expect("the 0.5 % comparison");
+        let line = notes.lines().find(|l| l.contains("0.5 % would soften it by")).expect("the 0.5 % comparison");
         let stated: f64 = line.split("soften it by ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
         let simscape = Fluid { air_fraction: 5e-3, ..f };
         let reduction = 100.0 * (1.0 - simscape.bulk_modulus(AIR_PRESSURES[0]) / f.beta);

@@ -419,7 +419,10 @@ pub const PARAMS: &[Param] = &[
         "%",
         [1e-7, 0.2],
         "Free air per oil volume at atmospheric pressure (cavitation model)",
-        "not in the thesis (constant bulk modulus); a fifth of Simscape's 0.5 % for the same law: README, Cavitation"
+        concat!(
+            "not in the thesis (constant bulk modulus); a fifth of Simscape's 0.5 % for the same law: ",
+            "docs/models.md, Cavitation"
+        )
     ),
     param!(
         "line.v_l2",
@@ -479,7 +482,10 @@ pub const PARAMS: &[Param] = &[
         "",
         [0.0, 1e4],
         "Gain of the PVES spool position loop; 0 = the first-order lag of eq. 2.45 (valve.omega_v)",
-        "4.2.1 (internal spool position control); gain not in the thesis or data sheet: README, Valve electronics"
+        concat!(
+            "4.2.1 (internal spool position control); gain not in the thesis or data sheet: ",
+            "docs/models.md, Valve electronics"
+        )
     ),
     param!(
         "valve.v_open",

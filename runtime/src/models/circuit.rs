@@ -25,7 +25,7 @@ pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
 
 /// The loosest relative tolerance a BDF integrator needs for the circuit in Model Exchange
 /// ([`crate::fmu::Model::MODEL_EXCHANGE_TOLERANCE`]): HydraulicBoom, rigid, u_ref -0.3 from rest,
-/// 1 s under fmpy's CVode (`scripts/bench_interfaces.py --only tolerance`, the README's table)
+/// 1 s under fmpy's CVode (`scripts/bench_interfaces.py --only tolerance`, docs/interfaces.md)
 /// keeps p3 within 0.05 bar of the rtol 1e-9 reference at 1e-6, 0.3 bar at 1e-5, 1.4 bar at
 /// 1e-4 and 6 bar at 1e-3; with the controller, scenario U at 1e-4 fails (CVode sets p4 below
 /// absolute vacuum). 1e-6 is also the DefaultExperiment's tolerance.

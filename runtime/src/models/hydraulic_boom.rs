@@ -76,7 +76,7 @@ arm of sections 2.1.4 and 3.1.2 (<code>boom.n2</code> + <code>boom.n3</code> sec
 2.16-2.19) as one degree of freedom in the cylinder stroke. A stiff Radau IIA (order 5) integrator advances the
 circuit's five states and the boom's coordinates and velocities (rigid: the stroke; flexible: one angle per section)
 inside fmi2DoStep with the tolerance of fmi2SetupExperiment; the flexible arm costs about ten times the rigid
-boom's time (see the README's speed table).</p>
+boom's time (see the speed table of boomsim's docs/performance.md).</p>
 <p>The simulation starts at rest at <code>start.x</code> with the load held by the closed CBV and all pressures in
 static equilibrium, so a closed spool gives no start-up transient. Outputs do not depend directly on the input (the
 spool has dynamics), so the FMU can be coupled to a controller without an algebraic loop.</p>

@@ -83,8 +83,8 @@ impl Coupling {
 }
 
 /// How to couple HydraulicCircuit with BoomMechanics or mechanics of one's own: the section both
-/// FMUs' pages carry (the README's "Coupling your own mechanics" has the derivations). A macro,
-/// so that `concat!` appends it to each page at compile time.
+/// FMUs' pages carry (docs/coupling.md has the derivations). A macro, so that `concat!` appends
+/// it to each page at compile time.
 macro_rules! coupling_recipe {
     () => {
         r#"<h2>Coupling recipe</h2>
@@ -102,7 +102,9 @@ the mechanics first, pass <code>cylinder.x</code>, <code>cylinder.v</code> (with
 <code>cylinder.F</code> back; keep the communication step small against the oil column's stiffest mode (2 ms or less
 for the thesis' rigid boom).</li>
 <li>The end stops act in the mechanics (BoomMechanics has them; mechanics of your own keep the stroke within
-[0, <code>cylinder.stroke</code>]).</li></ol>"#
+[0, <code>cylinder.stroke</code>]).</li></ol>
+<p>The derivations, the measured largest stable communication steps and the equivalence with HydraulicBoom:
+<code>docs/coupling.md</code> in boomsim's sources.</p>"#
     };
 }
 pub(crate) use coupling_recipe;
@@ -142,7 +144,7 @@ pub const ALPHA: ParamSpec = ParamSpec {
     min: 0.0,
     max: 0.9,
     description: "TLM wave damping (low-pass factor of each emitted wave per step); > 0 damps the numerical line mode at half the communication frequency",
-    source: "signal damping of TLM wave variables (Hopsan C-type components); see the README, Coupling your own mechanics",
+    source: "signal damping of TLM wave variables (Hopsan C-type components); see docs/coupling.md",
     integer: false,
 };
 
@@ -209,7 +211,7 @@ mod tests {
     /// the 480 mm start stroke, with the oil's bulk modulus (the thesis' constant beta, eq.
     /// 2.70-2.71) in both chambers. The model's entrained air is not in it: at p3 ~ 70 bar it
     /// changes the piston side little, but at p4 ~ 0 it takes most of the rod side's stiffness
-    /// (README, "Cavitation", whose numbers a test checks). 5 %: the default is rounded.
+    /// (docs/models.md, "Cavitation", whose numbers a test checks). 5 %: the default is rounded.
     /// The oil column's stiffness `k = A^2 / C_3 + A_B^2 / C_4` at stroke `x` (C = V / beta +
     /// hose compliance, eq. 5.2) with bulk moduli `beta3`, `beta4` in the two chambers.
     fn oil_column_stiffness(c: &Circuit, x: f64, beta3: f64, beta4: f64) -> f64 {
@@ -233,8 +235,8 @@ mod tests {
     /// Z_C's default with the model's own stiffness, entrained air included, where the TLM port
     /// works: a lowering, whose rod side sits between the CBV's cracking and full opening (eq.
     /// 2.73 with p3 = mu_c p4 + F / A of eq. 2.85, the rigid boom's static force at 480 mm),
-    /// above 30 bar, where the air softens the oil by about 1 % (README, "Cavitation"). 5 %: the
-    /// default is rounded.
+    /// above 30 bar, where the air softens the oil by about 1 % (docs/models.md, "Cavitation").
+    /// 5 %: the default is rounded.
     #[test]
     fn default_impedance_holds_with_the_models_own_stiffness_while_lowering() {
         let c = Circuit::default();

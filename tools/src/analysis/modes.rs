@@ -206,13 +206,13 @@ mod tests {
     use boomsim::mechanics::flexible_boom::FlexibleBoom;
     use boomsim::mechanics::params::{BeamParams, BoomParams};
 
-    /// The README's model note that starts with `start` ("- **Eigenfrequency**"), up to the
-    /// next one, its whitespace runs made single spaces (line breaks fall anywhere).
-    fn readme_note(start: &str) -> String {
-        let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md")).unwrap();
-        let at = readme.find(start).unwrap_or_else(|| panic!("the README's note {start}"));
-        let end = at + readme[at..].find("\n- **").unwrap();
-        readme[at..end].split_whitespace().collect::<Vec<_>>().join(" ")
+    /// The model note of docs/models.md that starts with `start` ("- **Eigenfrequency**"), up to
+    /// the next one, its whitespace runs made single spaces (line breaks fall anywhere).
+    fn model_note(start: &str) -> String {
+        let page = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/models.md")).unwrap();
+        let at = page.find(start).unwrap_or_else(|| panic!("docs/models.md's note {start}"));
+        let end = at + page[at..].find("\n- **").unwrap();
+        page[at..end].split_whitespace().collect::<Vec<_>>().join(" ")
     }
 
     /// The default arm with n2 + n3 sections (the stroke only has to be valid: the arm's
@@ -234,8 +234,8 @@ mod tests {
     #[test]
     fn structural_damping_sits_at_the_arms_bending_mode() {
         let f_b = arm(4, 5).bending_frequency().unwrap() / std::f64::consts::TAU;
-        let note = readme_note("- **Flexible arm");
-        assert!(note.contains(&format!("cylinder locked ({f_b:.1} Hz,")), "the README's model note states {f_b:.1} Hz");
+        let note = model_note("- **Flexible arm");
+        assert!(note.contains(&format!("cylinder locked ({f_b:.1} Hz,")), "docs/models.md's note states {f_b:.1} Hz");
         let stiff = [
             ("fluid.beta", Value::Real(1e15)),
             ("fluid.air_fraction", Value::Real(1e-7)),
@@ -277,7 +277,7 @@ mod tests {
         // the mode's frequency and shape still move by a few tenths of a percent).
         let ratio = second(4, 5).damping_ratio / second(12, 15).damping_ratio;
         assert!((ratio / 9.0 - 1.0).abs() < 0.05, "zeta(4 + 5) / zeta(12 + 15) = {ratio}");
-        // The README's figures, as this law gives them.
+        // docs/models.md's figures, as this law gives them.
         let stated = [((1, 2), "1.4"), ((4, 5), "0.21"), ((12, 15), "0.023")]; // percent
         for ((n2, n3), percent) in stated {
             let zeta = percent.parse::<f64>().unwrap() / 100.0;
@@ -287,9 +287,9 @@ mod tests {
             assert!((m.frequency_hz / 47.5 - 1.0).abs() < 0.01, "{n2} + {n3}: {m:?}");
         }
         let f_b = |n2, n3| arm(n2, n3).bending_frequency().unwrap();
-        let note = readme_note("- **Flexible arm");
+        let note = model_note("- **Flexible arm");
         for (_, percent) in stated {
-            assert!(note.contains(&format!("{percent} %")), "the README's flexible arm note states {percent} %");
+            assert!(note.contains(&format!("{percent} %")), "docs/models.md's flexible arm note: {percent} %");
         }
         let fine = f_b(16, 16);
         let error: Vec<f64> =
@@ -297,12 +297,12 @@ mod tests {
         assert!(error[0] > error[1] && error[1] > error[2] && error[1] < 0.02 && error[2] < 5e-3, "{error:?}");
     }
 
-    /// The rig's mode (thesis 5.1.3) as the README states it, and its physics: trapping the rod
+    /// The rig's mode (thesis 5.1.3) as docs/models.md states it, and its physics: trapping the rod
     /// side at 1 bar compresses its air (isothermal: the gas stiffness grows with p_abs^2), so
     /// the mode lies above the 0 bar one and below the one without air; each softening removed
     /// (air, hose compliance) raises it; the flexible arm is softer than the rigid boom.
     #[test]
-    fn the_rig_mode_is_what_the_readme_says() {
+    fn the_rig_mode_is_what_the_model_notes_say() {
         let rig = rig().unwrap();
         let f = |what: &str| rig.sensitivity.iter().find(|(w, _)| w.starts_with(what)).unwrap().1.frequency_hz;
         let fl = rig.flexible.frequency_hz;
@@ -311,7 +311,7 @@ mod tests {
         );
         assert!(fl < f("rigid hoses") && f("rigid hoses") < f("no air and rigid"));
         assert!(fl < rig.rigid.frequency_hz);
-        let note = readme_note("- **Eigenfrequency**");
+        let note = model_note("- **Eigenfrequency**");
         let hz: Vec<f64> = note.split(" Hz").filter_map(|w| w.rsplit(' ').next()?.parse().ok()).collect();
         let expected: Vec<f64> = [rig.measured_hz, fl, rig.rigid.frequency_hz]
             .into_iter()
