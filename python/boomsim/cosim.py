@@ -6,7 +6,7 @@ with --fmi 3).
     PressureFeedbackController.u --> HydraulicBoom.valve.u_ref
 
 Usage:
-    .venv/bin/python scripts/cosim.py scripts/scenarios/B.toml [--boom rigid] [--step 1e-3]
+    .venv/bin/boomsim-cosim B [--boom rigid] [--step 1e-3]
         [--stop-time 15] [--hold] [--interface cs|me] [--fmi 2|3] [--out out/cosim]
 writes <out>/<scenario>-<boom>.csv and .png (p3, p4, cylinder velocity, u_ref / u_comp / u).
 
@@ -24,13 +24,13 @@ known, not guessed): no extrapolation is needed, and the filter state is exact f
 piecewise-linear p4. What the coupling cannot remove is the hold of u: the command applied over
 [t_k, t_k+1] is computed from p4(t_k), i.e. the feedback acts with up to one communication step of
 delay (h/2 on average, a phase lag of omega*h/2). That limits the usable step (see
-scripts/README.md and `scripts/regress --step-sweep`).
+docs/python.md and `scripts/regress --step-sweep`).
 
 FMI 3.0 (`--fmi 3`, the .fmu files of target/fmu/fmi3: the same binaries) has no input
 derivatives, so its Co-Simulation runs with `--hold`; with the same hold, FMI 2.0 and FMI 3.0
 give bit-identical results (tests/python/test_fmi3.py).
 
-The scenario files (scripts/scenarios/*.toml) are documented in scripts/scenarios/README.md.
+The scenario files (python/boomsim/scenarios/*.toml) are documented in python/boomsim/scenarios/README.md.
 """
 
 from __future__ import annotations

@@ -120,7 +120,7 @@ RUNS = {
 } | {"fine": (MASTERS[None], 1e-4, None)}
 MAIN_RUNS = ["a", "b", "c", "a5", "d", "e"]
 SWEEP_RUNS = ["fine", "a05", "b05", "c05", "a2", "b2", "c2"]
-#: project motion start (scripts/metrics.py): CBV outflow -Q3 above 10 % of the expected steady flow
+#: project motion start (python/boomsim/metrics.py): CBV outflow -Q3 above 10 % of the expected steady flow
 Q_MOTION = 0.1 * (25e-3 / 60 * 0.05 / (np.pi / 4 * (0.065**2 - 0.035**2))) * (np.pi / 4 * 0.065**2)
 
 
@@ -150,7 +150,7 @@ def metrics(d: dict, ref: dict, fine: dict | None) -> dict:
     last = t >= t[-1] - 5.0 - 1e-9
     m = {
         "t_v1mm": first(t, d["v"] < V_MOVE),  # the brief's definition
-        "t_motion": first(t, -d["Q3"] > Q_MOTION),  # scripts/metrics.py's definition
+        "t_motion": first(t, -d["Q3"] > Q_MOTION),  # python/boomsim/metrics.py's definition
         "p3_pp": float(np.ptp(d["p3"][last])) / BAR,
         "v_mean": float(np.mean(d["v"][last])) * 1e3,
     }
@@ -202,7 +202,7 @@ def main(argv=None):
     np.savez(OUT / "results.npz", **{f"{k}_{c}": v for k, (d, _) in results.items() for c, v in d.items()})
     print("Scenario B, rigid boom (boom.flexible = false), feedback from t0, 15 s. p3pp and v: last 5 s (10-15 s).")
     print("RMSdp3 [bar], max|dp3| [bar], RMSdx [mm]: whole run vs run a (Gauss-Seidel, 1 ms), on the coarser of the two grids.")
-    print("t_motion: scripts/metrics.py's motion start (CBV outflow -Q3 > 10 % of the expected steady flow).")
+    print("t_motion: python/boomsim/metrics.py's motion start (CBV outflow -Q3 > 10 % of the expected steady flow).")
     table(MAIN_RUNS, results, ref, fine, "")
     if args.sweep:
         print("\nExtras; '|fine' columns: against Gauss-Seidel at 0.1 ms (proxy for the continuous coupling)")

@@ -1,4 +1,4 @@
-"""The outputs of a sweep (scripts/sweep.py): DIR/summary.md (points, failures, the metrics'
+"""The outputs of a sweep (python/boomsim/parameter_sweep.py): DIR/summary.md (points, failures, the metrics'
 min / median / max over the points that ran) and maps of p3_pp_late and t_settle (else the first
 metric) over two grid parameters, DIR/map-<metric>.png: over (n_K, n_omega) when both are grids,
 else over the first two parameters that vary on a grid.

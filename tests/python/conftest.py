@@ -20,7 +20,7 @@ from fmpy.logging import addLoggerProxy
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 # Every figure a script saves while the tests run, in this process or a child, is checked
-# (scripts/figures.py): text inside the canvas, every axis labelled with its unit.
+# (python/boomsim/figures.py): text inside the canvas, every axis labelled with its unit.
 os.environ["BOOMSIM_STRICT_FIGURES"] = "1"
 FMU_DIR = ROOT / "target" / "fmu"
 

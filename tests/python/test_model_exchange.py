@@ -61,6 +61,10 @@ def test_every_fmu_simulates_as_model_exchange(identifier, start, signal, output
         assert worst < 1e-3, f"{identifier}.{name}: ME differs from CS by {worst:.2e} of its range"
 
 
+#: The flexible boom's Model Exchange records [s] (test_scenarios_as_model_exchange_match_co_simulation).
+FLEXIBLE_STOP = 4.0
+
+
 @pytest.fixture(scope="module")
 def tolerances():
     return regression.load_tolerances()
@@ -73,9 +77,13 @@ def test_scenarios_as_model_exchange_match_co_simulation(scenario, boom, toleran
     delay) against the CS runner at 1 ms: every regression metric within 2 % of the CS value,
     with the regression suite's absolute floors (the package's baselines/tolerances.toml: 10 ms for the
     times sampled at 1 ms, 0.2 bar for a settled p3's drift, 5e-4 for u_comp's numerical noise),
-    and a missing metric (never settles) missing in both."""
+    and a missing metric (never settles) missing in both. The flexible boom over the first 4 s
+    (its metrics over that record: U's limit cycle is established from 1 s, B lowers from 2.8 s):
+    CVode needs 2 M right-hand sides for its 15 s of U (issue 27), 10 minutes of the test command;
+    the full records are compared by `scripts/bench_interfaces.py --only interfaces`."""
     sc = load_scenario(scenario)
-    me, cs = metrics.compute(run_me(sc, boom)), metrics.compute(cosim.run(sc, boom))
+    stop = None if boom == "rigid" else FLEXIBLE_STOP
+    me, cs = metrics.compute(run_me(sc, boom, stop)), metrics.compute(cosim.run(sc, boom, stop_time=stop))
     rules = {k: {**r, "rel": 0.02} for k, r in tolerances.items()}
     assert regression.compare(f"{scenario}-{boom} ME", me, cs, rules) == []
 

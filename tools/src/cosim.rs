@@ -1,4 +1,4 @@
-//! `boomsim cosim`: the co-simulation of `scripts/cosim.py`'s `run` (HydraulicBoom and
+//! `boomsim cosim`: the co-simulation of `python/boomsim/cosim.py`'s `run` (HydraulicBoom and
 //! PressureFeedbackController, FMI 2.0 Co-Simulation, Gauss-Seidel, p4 interpolated in the
 //! controller) with the FMI layer called in-process instead of through fmpy: the native runner of
 //! the sweeps. The Python runner is the reference; this loop makes the same calls with the same

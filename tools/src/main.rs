@@ -94,7 +94,7 @@ enum Cmd {
         json: bool,
     },
     /// Co-simulate HydraulicBoom with the PressureFeedbackController in-process, as
-    /// scripts/cosim.py's `run` does through fmpy (the sweeps' native runner): a JSON request on
+    /// python/boomsim/cosim.py's `run` does through fmpy (the sweeps' native runner): a JSON request on
     /// stdin, a JSON header line and the rows as little-endian f64 on stdout.
     Cosim,
     /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).

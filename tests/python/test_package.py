@@ -1,0 +1,92 @@
+"""The package's shape (issue 28): no module reaches another through sys.path, the modules import
+each other without a circle, the package's version is the project's, and the public API refuses
+wrong input with a UsageError naming the value."""
+
+import ast
+import pathlib
+import re
+import subprocess
+
+import pytest
+
+import boomsim
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+PACKAGE = ROOT / "python" / "boomsim"
+
+
+def tracked_python_files():
+    out = subprocess.run(["git", "ls-files", "*.py"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    return [ROOT / f for f in out.split()]
+
+
+def test_nothing_reaches_a_module_through_sys_path():
+    files = tracked_python_files()
+    assert len(files) > 40
+    offenders = [str(f.relative_to(ROOT)) for f in files if "sys.path.insert" in f.read_text()
+                 and f != pathlib.Path(__file__)]
+    assert offenders == []
+
+
+def imports(module: pathlib.Path) -> set[str]:
+    """The package's modules that `module` imports (relative or absolute, at any depth of the file)."""
+    found = set()
+    for node in ast.walk(ast.parse(module.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level == 1 or base.split(".")[0] == "boomsim":
+                base = base.removeprefix("boomsim").lstrip(".")
+                names = [base] if base else [a.name for a in node.names]
+                found |= {n.split(".")[0] for n in names}
+        elif isinstance(node, ast.Import):
+            found |= {a.name.split(".")[1] for a in node.names if a.name.startswith("boomsim.")}
+    modules = {p.stem for p in PACKAGE.glob("*.py")}
+    return (found & modules) - {module.stem}
+
+
+def test_the_modules_import_each_other_without_a_circle():
+    """Depth-first search of the import graph (the package's __init__ aside: it is the facade
+    that imports the rest, and no module imports it)."""
+    graph = {p.stem: imports(p) for p in PACKAGE.glob("*.py") if p.stem != "__init__"}
+    assert all("__init__" not in deps for deps in graph.values())
+    state = {}
+
+    def visit(m, path):
+        state[m] = "open"
+        for d in sorted(graph[m]):
+            assert state.get(d) != "open", " -> ".join(path + [m, d])
+            if d not in state:
+                visit(d, path + [m])
+        state[m] = "done"
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [])
+    assert len(graph) > 20
+
+
+def test_the_package_has_the_project_version():
+    cargo = re.search(r'^version = "(.*)"', (ROOT / "Cargo.toml").read_text(), re.M).group(1)
+    assert boomsim.__version__ == cargo
+
+
+@pytest.mark.parametrize("call,says", [
+    (lambda: boomsim.fmu("Crane"), 'unknown model "Crane"'),
+    (lambda: boomsim.fmu("HydraulicBoom", fmi=1), "fmi=1: 2 (FMI 2.0) or 3 (FMI 3.0)"),
+    (lambda: boomsim.run("Q"), 'unknown scenario "Q"'),
+    (lambda: boomsim.run("B", interface="me", step=1e-3), 'interface "me" has no communication step'),
+    (lambda: boomsim.run("B", interface="native", fmi=3), "the native runner runs FMI 2.0"),
+    (lambda: boomsim.run("B", interface="simulink"), 'interface="simulink": one of cs, me, native'),
+])
+def test_the_api_refuses_wrong_input_in_one_line(call, says):
+    with pytest.raises(boomsim.UsageError, match=re.escape(says)):
+        call()
+
+
+def test_a_result_is_numpy_columns_and_a_dataframe():
+    """B's first 0.2 s: the columns by name and as a DataFrame indexed by time hold the same values."""
+    r = boomsim.run("B", stop_time=0.2)
+    frame = r.to_pandas()
+    assert list(frame.columns) == [c for c in r.data if c != "time"]
+    assert (frame.index.to_numpy() == r.time).all() and (frame["p3"].to_numpy() == r["p3"]).all()
+    assert len(r.time) == 201  # one row per millisecond, both ends
