@@ -332,8 +332,6 @@ def main(argv=None):
                 f.write(",".join(str(r[k]) for k in keys) + "\n")
         print(f"\nwrote {out / 'instability.csv'}")
     if args.png:
-        import matplotlib
-        matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(1, 2, figsize=(11, 4))
         for u, c in ((-0.05, "C0"), (-0.1, "C1")):

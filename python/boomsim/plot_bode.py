@@ -14,10 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 from . import figures
 from .errors import cli
@@ -35,6 +32,8 @@ def linearize(point, *args):
 
 
 def plot(path, boom="flexible", u_ref=-0.05, stroke=250.0, outputs=("p4",)):
+    """The Bode figure of `outputs` at the steady lowering (u_ref, stroke [mm]) saved to `path`."""
+    path = Path(path)
     point = ["--boom", boom, "--u-ref", repr(u_ref), "--stroke", repr(stroke), *(a for o in outputs for a in ("--output", o))]
     open_loop = linearize(point)
     closed = linearize(point, "--feedback", *(["--sine", SINE_HZ] if "p4" in outputs else []))

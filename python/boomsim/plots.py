@@ -35,9 +35,6 @@ def series(res: Result) -> list[tuple[int, str, np.ndarray]]:
 def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
     """p3/p4, cylinder velocity and spool openings over time, like thesis Fig. 6.7-6.12
     (simulation) and 7.1-7.6 (rig), in the FMUs' signs ([`series`]: lowering < 0)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     d = res.data

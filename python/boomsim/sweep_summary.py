@@ -137,9 +137,6 @@ def edges(v: list[float]) -> np.ndarray:
 
 
 def maps(sweep: dict, rows: list[dict], axes: list[str], out: pathlib.Path) -> list[str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     grid = Grid(sweep, rows, axes)
