@@ -30,7 +30,7 @@ FMI 3.0 (`--fmi 3`, the .fmu files of target/fmu/fmi3: the same binaries) has no
 derivatives, so its Co-Simulation runs with `--hold`; with the same hold, FMI 2.0 and FMI 3.0
 give bit-identical results (tests/python/test_fmi3.py).
 
-The scenario files (python/boomsim/scenarios/*.toml) are documented in python/boomsim/scenarios/README.md.
+The scenario files (scenarios/*.toml beside this module) are documented in docs/python.md, "Scenario files".
 """
 
 from __future__ import annotations

@@ -90,3 +90,16 @@ def test_a_result_is_numpy_columns_and_a_dataframe():
     assert list(frame.columns) == [c for c in r.data if c != "time"]
     assert (frame.index.to_numpy() == r.time).all() and (frame["p3"].to_numpy() == r["p3"]).all()
     assert len(r.time) == 201  # one row per millisecond, both ends
+
+
+def test_the_readme_is_read_in_five_minutes():
+    """At most 200 lines (issue 28): what boomsim is in its first three lines, then the two
+    commands; every page it links exists."""
+    readme = (ROOT / "README.md").read_text()
+    lines = readme.splitlines()
+    assert len(lines) <= 200
+    assert lines[0] == "# boomsim" and "FMU" in " ".join(lines[1:4])
+    commands = [k for k, line in enumerate(lines) if line.startswith("bash scripts/")]
+    assert [lines[k].split()[1] for k in commands[:2]] == ["scripts/demo", "scripts/test"]
+    links = re.findall(r"\]\(([^)#]+)[^)]*\)", readme)
+    assert links and [link for link in links if not (ROOT / link).exists()] == []
