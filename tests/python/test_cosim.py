@@ -23,6 +23,7 @@ from boomsim import cosim
 from boomsim.result import Result
 from boomsim.scenarios import load_scenario
 from boomsim import metrics as mx
+from boomsim import regression
 
 from conftest import fmu_path  # noqa: E402
 
@@ -178,13 +179,11 @@ def test_feedback_from_cbv_opening_keeps_the_uncompensated_start(run):
 def test_report_c_ranking(run):
     """Reported, not asserted: the C experiments ranked (see docs/python.md for the
     comparison with thesis 8.1-8.2)."""
-    import regress
-
     results = {}
     for sid in ["C1.1", "C1.2", "C1.3", "C2.1", "C2.2", "C2.3", "C3.1", "C3.2", "C3.3"]:
         for start, suffix in (("t0", ""), ("cbv_open", "-cbv")):
             results[f"{sid}-rigid{suffix}"] = run(sid, start)[1]
-    lines = regress.c_ranking(results)
+    lines = regression.c_ranking(results)
     OUT.mkdir(parents=True, exist_ok=True)
     (OUT / "ranking.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -37,7 +37,7 @@ def test_cosim_refuses_bad_arguments_in_one_line(args, says):
 
 def test_regress_refuses_a_filter_that_matches_nothing(tmp_path):
     """`--only Q` used to pass with "all 0 variants within tolerance" and overwrite the report."""
-    code, last = run("regress", "--only", "Q", "--out", str(tmp_path))
+    code, last = run("regression", "--only", "Q", "--out", str(tmp_path))
     assert code == 2 and "unknown scenario Q" in last and "U, A, S, B" in last, last
     assert not (tmp_path / "report.md").exists()
 
@@ -49,7 +49,7 @@ def test_regress_refuses_a_filter_that_matches_nothing(tmp_path):
 ])
 def test_regress_refuses_bad_parameters_in_one_line(tmp_path, args, says):
     """A variant with FMU parameters (the real-time mode's accuracy) never re-baselines."""
-    code, last = run("regress", *args, "--out", str(tmp_path))
+    code, last = run("regression", *args, "--out", str(tmp_path))
     assert code == 2 and all(s in last for s in says), last
     assert not (tmp_path / "report.md").exists()
 
