@@ -36,13 +36,13 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from . import cosim
-from .errors import cli
+from .errors import UsageError, cli
 from .fmus import FmuFile
 from .paths import OUT
 from .result import Result
 from .scenarios import load_scenario
 from . import metrics as mx
-from . import split
+from . import split, terminals
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -64,7 +64,8 @@ SSP_TYPE = {"Float64": "Real", "Int32": "Integer"}
 
 
 def components(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> tuple[dict, list]:
-    """({component: (FMU id, {parameter: value})}, [(from comp, output, to comp, input)])."""
+    """({component: (FMU id, {parameter: value})}, [(from comp, output, to comp, input)]): the
+    connections are those of the FMUs' terminals (boomsim.terminals)."""
     ctrl = {k: sc["controller"][k] for k in ("K_f", "omega_f") if k in sc["controller"]}
     ctrl["enable"] = bool(sc["controller"]["enable"])
     u_ref = float(sc["reference"][0, 1])
@@ -78,8 +79,7 @@ def components(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) ->
     if system == "monolithic":
         plant = {"start.x": sc["start_stroke"], "boom.flexible": flexible, **sc["plant"]}
         comps = {"Plant": ("HydraulicBoom", plant), "Controller": ("PressureFeedbackController", ctrl)}
-        conns = [("Plant", "p4", "Controller", "p"), ("Controller", "u", "Plant", "valve.u_ref")]
-        return comps, conns
+        return comps, wired(comps, [("Plant", "Controller", ["pressure", "valve"])])
     mode = 1 if coupling.startswith("tlm") else 0
     mech = {"start.x": sc["start_stroke"], "boom.flexible": flexible, "port.coupling": mode}
     f_start = start_force(mech, fmi)
@@ -88,13 +88,28 @@ def components(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) ->
     mech["port.c_h"] = mech["cylinder.F"] = f_start
     comps = {"Circuit": ("HydraulicCircuit", circ), "Mechanics": ("BoomMechanics", mech),
              "Controller": ("PressureFeedbackController", ctrl)}
-    conns = [("Circuit", "p4", "Controller", "p"), ("Controller", "u", "Circuit", "valve.u_ref")]
-    if mode:
-        conns += [("Circuit", "port.c_h", "Mechanics", "port.c_h"), ("Mechanics", "port.c_m", "Circuit", "port.c_m")]
-    else:
-        conns += [("Circuit", "cylinder.F", "Mechanics", "cylinder.F"), ("Mechanics", "cylinder.x", "Circuit", "cylinder.x"),
-                  ("Mechanics", "cylinder.v", "Circuit", "cylinder.v")]
-    return comps, conns
+    return comps, wired(comps, [("Circuit", "Controller", ["pressure", "valve"]),
+                                ("Circuit", "Mechanics", ["rod_tlm" if mode else "rod"])])
+
+
+def wired(comps: dict, terminal_pairs: list) -> list:
+    """The connections of the components' terminals: for each (component a, component b, terminal
+    names), the members of each terminal connected by `terminals.connect`; a parameter member must
+    have the same value on both sides (the binding, else the FMU's start value)."""
+    def value(comp: str, name: str) -> float:
+        fmu, params = comps[comp]
+        return float(params.get(name, FmuFile.get(fmu).vars[name].start))
+
+    conns = []
+    for a, b, names in terminal_pairs:
+        for name in names:
+            c, params = terminals.connect((a, comps[a][0]), (b, comps[b][0]), name)
+            conns += c
+            for pa, pb in params:
+                if value(a, pa) != value(b, pb):
+                    raise UsageError(f"terminal \"{name}\": {a}.{pa} = {value(a, pa):g} and {b}.{pb} = "
+                                     f"{value(b, pb):g} must be equal")
+    return conns
 
 
 def start_force(mech: dict, fmi: int = 2) -> float:

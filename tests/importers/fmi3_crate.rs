@@ -116,3 +116,64 @@ fn plant_model_exchange_in_the_fmi_crate_equals_fmi2() {
     assert!(z3.iter().all(|z| z.is_finite()), "{z3:?}");
     assert_eq!(bits(&z3), bits(&z2));
 }
+
+/// The terminals of each FMI 3.0 .fmu (terminalsAndIcons/terminalsAndIcons.xml), read by the `fmi`
+/// crate's schema: every terminal satisfies its matching rule (`plug`: a unique memberName per
+/// member, FMI 3.0 section 2.4.9) and every member variable resolves in the model description.
+/// Then each pair of FMUs the project connects, through the terminals of the same name: the same
+/// terminalKind and member names, and per member an output on one side and an input on the other,
+/// or a parameter on both (a `signal` member, section 2.4.9, "Terminal Member Variable").
+#[test]
+fn the_terminals_connect_the_fmus_member_by_member() {
+    use fmi::schema::fmi3::{resolve_terminals, Causality, Fmi3TerminalsAndIcons};
+    use std::collections::BTreeMap;
+
+    /// name -> (kind, member name -> causality)
+    type Ports = BTreeMap<String, (Option<String>, BTreeMap<String, Causality>)>;
+    let ports = |id: &str| -> Ports {
+        let import = fmu::<Fmi3Import>(id);
+        let path = import.archive_path().join("terminalsAndIcons/terminalsAndIcons.xml");
+        let xml = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{id}: {}: {e}", path.display()));
+        let terminals: Fmi3TerminalsAndIcons = fmi::schema::deserialize(&xml).expect("the schema reads it");
+        assert_eq!(terminals.fmi_version, "3.0");
+        let resolved = resolve_terminals(&terminals, import.model_description()).expect("every member resolves");
+        resolved
+            .terminals
+            .iter()
+            .map(|t| {
+                t.terminal.validate_matching_rule().expect("plug: unique member names");
+                assert_eq!(t.terminal.matching_rule, "plug");
+                let members =
+                    t.members.iter().map(|m| (m.member.member_name.clone().unwrap(), m.variable.causality())).collect();
+                (t.terminal.name.clone(), (t.terminal.terminal_kind.clone(), members))
+            })
+            .collect()
+    };
+    let (circuit, mechanics) = (ports("HydraulicCircuit"), ports("BoomMechanics"));
+    let (boom, controller) = (ports("HydraulicBoom"), ports("PressureFeedbackController"));
+    let pairs = [
+        (&circuit, &mechanics, "rod"),
+        (&circuit, &mechanics, "rod_tlm"),
+        (&circuit, &controller, "valve"),
+        (&circuit, &controller, "pressure"),
+        (&boom, &controller, "valve"),
+        (&boom, &controller, "pressure"),
+    ];
+    for (a, b, name) in pairs {
+        let ((kind_a, members_a), (kind_b, members_b)) = (&a[name], &b[name]);
+        assert!(kind_a.as_deref().is_some_and(|k| k.starts_with("_boomsim_")) && kind_a == kind_b, "{name}");
+        assert_eq!(members_a.keys().collect::<Vec<_>>(), members_b.keys().collect::<Vec<_>>(), "{name}");
+        for (member, ca) in members_a {
+            let cb = &members_b[member];
+            let complementary = matches!(
+                (ca, cb),
+                (Causality::Output, Causality::Input)
+                    | (Causality::Input, Causality::Output)
+                    | (Causality::Parameter, Causality::Parameter)
+            );
+            assert!(complementary, "{name}.{member}: {ca:?} against {cb:?}");
+        }
+    }
+    assert_eq!(circuit.len(), 4);
+    assert_eq!((mechanics.len(), boom.len(), controller.len()), (2, 2, 2));
+}

@@ -80,8 +80,9 @@ enum Cmd {
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
         set: Vec<String>,
     },
-    /// Write modelDescription/<ModelIdentifier>.xml (FMI 2.0) and
-    /// modelDescription/fmi3/<ModelIdentifier>.xml (FMI 3.0) from the variable tables.
+    /// Write modelDescription/<ModelIdentifier>.xml (FMI 2.0),
+    /// modelDescription/fmi3/<ModelIdentifier>.xml (FMI 3.0) from the variable tables, and the
+    /// FMI 3.0 terminals, modelDescription/fmi3/<ModelIdentifier>.terminalsAndIcons.xml.
     Xml {
         /// Compare instead of writing; fail if a committed file differs from the generator.
         #[arg(long)]
@@ -374,15 +375,21 @@ fn xml(check: bool) -> Result<(), String> {
     for (version, dir) in [(Version::Fmi2, dir.clone()), (Version::Fmi3, dir.join("fmi3"))] {
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
         for f in pack::all() {
-            let path = dir.join(format!("{}.xml", f.identifier));
-            let xml = (f.model_description)(version);
-            if check {
-                if std::fs::read_to_string(&path).ok().as_deref() != Some(xml.as_str()) {
-                    stale.push(path.display().to_string());
+            let terminals = (version == Version::Fmi3).then(|| (f.terminals)()).flatten();
+            let files = [
+                (format!("{}.xml", f.identifier), Some((f.model_description)(version))),
+                (format!("{}.terminalsAndIcons.xml", f.identifier), terminals),
+            ];
+            for (name, xml) in files.into_iter().filter_map(|(n, x)| Some((n, x?))) {
+                let path = dir.join(name);
+                if check {
+                    if std::fs::read_to_string(&path).ok().as_deref() != Some(xml.as_str()) {
+                        stale.push(path.display().to_string());
+                    }
+                } else {
+                    std::fs::write(&path, xml).map_err(|e| format!("{}: {e}", path.display()))?;
+                    println!("{}", path.display());
                 }
-            } else {
-                std::fs::write(&path, xml).map_err(|e| format!("{}: {e}", path.display()))?;
-                println!("{}", path.display());
             }
         }
     }

@@ -1,7 +1,8 @@
 //! The .fmu archive of either FMI version: modelDescription.xml at the root, the shared library
 //! of every platform under `binaries/<platform>/<modelIdentifier>.<so|dll>` (the version's
-//! platform names, [`crate::platform`]), and `documentation/index.html`. The same library goes
-//! into both versions' archives: it exports the fmi2* and the fmi3* symbols.
+//! platform names, [`crate::platform`]), `documentation/index.html` and, in FMI 3.0, the model's
+//! terminals in `terminalsAndIcons/terminalsAndIcons.xml`. The same library goes into both
+//! versions' archives: it exports the fmi2* and the fmi3* symbols.
 
 use crate::chart::escape;
 use crate::figures::Figures;
@@ -36,6 +37,8 @@ pub struct Fmu {
     pub model_description: fn(Version) -> String,
     /// documentation/index.html of a version for the platforms packed.
     pub documentation: fn(Version, &[Platform]) -> String,
+    /// terminalsAndIcons.xml (FMI 3.0), when the model has terminals.
+    pub terminals: fn() -> Option<String>,
 }
 
 impl Fmu {
@@ -46,6 +49,7 @@ impl Fmu {
             package,
             model_description: model_description::<M>,
             documentation: documentation::<M>,
+            terminals: crate::xml::terminals::terminals_and_icons::<M>,
         }
     }
 
@@ -63,6 +67,10 @@ impl Fmu {
         zip.start_file("documentation/index.html", deflate)?;
         let platforms: Vec<Platform> = libraries.iter().map(|(p, _)| *p).collect();
         zip.write_all((self.documentation)(version, &platforms).as_bytes())?;
+        if let (Version::Fmi3, Some(terminals)) = (version, (self.terminals)()) {
+            zip.start_file("terminalsAndIcons/terminalsAndIcons.xml", deflate)?;
+            zip.write_all(terminals.as_bytes())?;
+        }
         zip.finish()?;
         Ok(())
     }
@@ -174,7 +182,21 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
         ("After an error", after_error.to_owned()),
         ("Variables", M::VARIABLES.len().to_string()),
     ];
-    let rows: String = rows.iter().map(|(k, v)| format!("<tr><th>{k}</th><td>{}</td></tr>\n", escape(v))).collect();
+    let terminals: Vec<String> = i
+        .terminals
+        .iter()
+        .map(|t| {
+            let members: Vec<String> = t.members.iter().map(|(m, r)| format!("{m}: {}", name(r))).collect();
+            format!("{} ({}; {})", t.name, t.kind, members.join(", "))
+        })
+        .collect();
+    let terminals = (version == Version::Fmi3 && !terminals.is_empty())
+        .then(|| ("Terminals (terminalsAndIcons.xml, matching rule plug)", terminals.join("; ")));
+    let rows: String = rows
+        .iter()
+        .chain(terminals.iter())
+        .map(|(k, v)| format!("<tr><th>{k}</th><td>{}</td></tr>\n", escape(v)))
+        .collect();
     format!("<table class=\"facts\">\n{rows}</table>\n")
 }
 

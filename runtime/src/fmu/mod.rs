@@ -18,6 +18,6 @@ pub mod variables;
 pub mod version;
 
 pub use log::Status;
-pub use model::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart};
+pub use model::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Terminal};
 pub use variables::{Causality, Initial, Kind, Value, Values, Variability, Variable};
 pub use version::Version;

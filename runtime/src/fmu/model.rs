@@ -28,6 +28,24 @@ pub struct ModelInfo {
     pub interpolated_inputs: &'static [u32],
     /// HTML fragment for documentation/index.html: equations, sources, notes.
     pub documentation: &'static str,
+    /// The ports an importer connects as a whole (terminalsAndIcons.xml of the FMI 3.0 .fmu).
+    pub terminals: &'static [Terminal],
+}
+
+/// A terminal (FMI 3.0, section 2.4.9, "Terminals"): variables grouped into a port that an
+/// importer connects to a terminal of another FMU member by member. Every member is a signal
+/// (`variableKind="signal"`: connected values are equal; an output drives the input of the same
+/// `memberName`, a parameter is set equal on both sides).
+#[derive(Debug, Clone, Copy)]
+pub struct Terminal {
+    pub name: &'static str,
+    /// `terminalKind`: vendor-specific kinds start with "_boomsim_" (the standard's advice).
+    pub kind: &'static str,
+    /// `matchingRule`: "plug" (every member present and matched by `memberName`).
+    pub matching_rule: &'static str,
+    pub description: &'static str,
+    /// (`memberName`, value reference of the member variable).
+    pub members: &'static [(&'static str, u32)],
 }
 
 impl ModelInfo {

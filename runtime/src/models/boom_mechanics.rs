@@ -12,6 +12,7 @@
 use super::boom::Boom;
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
+use super::terminals;
 use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_VARIABLES, START_STROKE, TIP_DEFLECTION};
 use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
@@ -196,6 +197,7 @@ impl Model for BoomMechanics {
             "Rigid or lumped flexible boom with payload driven by the cylinder force or a TLM port (thesis section 2.1)",
         interpolated_inputs: &[vr::F, vr::C_H],
         documentation: DOCUMENTATION,
+        terminals: &[terminals::ROD, terminals::ROD_TLM],
         ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;

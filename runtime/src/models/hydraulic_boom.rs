@@ -12,6 +12,7 @@
 pub use super::boom::Boom;
 use super::circuit::{CIRCUIT_SCALE, ME_TOLERANCE};
 use super::port::Ramp;
+use super::terminals;
 use super::exposed::{BOOM_DERIVATIVES, CIRCUIT_DERIVATIVES, PLANT_STATES};
 use super::table::{
     out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_VARIABLES, START_P4,
@@ -220,6 +221,7 @@ impl Model for HydraulicBoom {
             "Pressure-compensated valve, counterbalance valve, cylinder and rigid or lumped flexible boom (thesis Fig. 2.8, section 2.1)",
         interpolated_inputs: &[vr::U_REF],
         documentation: DOCUMENTATION,
+        terminals: &[terminals::VALVE, terminals::PRESSURE],
         ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;

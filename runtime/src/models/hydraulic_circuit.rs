@@ -14,6 +14,7 @@
 
 use super::circuit::{CIRCUIT_SCALE, ME_TOLERANCE};
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
+use super::terminals;
 use super::exposed::{CIRCUIT_DERIVATIVES, CIRCUIT_STATES};
 use super::table::{
     out, TableBuilder, CIRCUIT_LOCALS, CIRCUIT_OUTPUTS, SOLVER_VARIABLES, START_P4, START_STROKE, U_REF_INPUT,
@@ -247,6 +248,7 @@ impl Model for HydraulicCircuit {
         // cylinder.x follows the integral of cylinder.v within a step: it has no slope of its own.
         interpolated_inputs: &[vr::U_REF, vr::X, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
+        terminals: &[terminals::ROD, terminals::ROD_TLM, terminals::VALVE, terminals::PRESSURE],
         ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;

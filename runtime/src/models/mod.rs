@@ -11,6 +11,7 @@ pub mod port;
 pub mod pressure_feedback_controller;
 pub mod exposed;
 pub mod table;
+pub mod terminals;
 pub mod vr;
 
 pub use boom_mechanics::BoomMechanics;

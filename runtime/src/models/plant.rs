@@ -31,4 +31,5 @@ pub(crate) const MODEL_INFO: crate::fmu::ModelInfo = crate::fmu::ModelInfo {
     log_categories: &[("logSolver", "Integrator statistics per communication step")],
     interpolated_inputs: &[],
     documentation: "",
+    terminals: &[],
 };

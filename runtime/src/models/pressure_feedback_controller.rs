@@ -222,6 +222,7 @@ impl Model for PressureFeedbackController {
         log_categories: &[("logSaturation", "Spool command clamped at u_min or u_max")],
         interpolated_inputs: &[vr::U_REF, vr::P],
         documentation: DOCUMENTATION,
+        terminals: &[super::terminals::CONTROLLER_VALVE, super::terminals::CONTROLLER_PRESSURE],
         ..super::plant::MODEL_INFO
     };
 

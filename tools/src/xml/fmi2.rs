@@ -52,7 +52,7 @@ fn write<M: Model>() -> io::Result<String> {
         ("guid", guid::<M>()),
         vec![("numberOfEventIndicators", M::EVENT_INDICATORS.len().to_string())],
     );
-    document(&root, |w| {
+    document("fmiModelDescription", &root, |w| {
         // The capabilities both interfaces share, around each one's own (schema order).
         let interface = |own: Attrs| -> Attrs {
             let head: Attrs = vec![("modelIdentifier", info.identifier.into()), ("needsExecutionTool", flag(false))];

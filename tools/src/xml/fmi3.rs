@@ -101,7 +101,7 @@ fn variable<M: Model>(v: &Variable) -> (&'static str, Attrs, Option<String>) {
 fn write<M: Model>() -> io::Result<String> {
     let info = &M::INFO;
     let root = root_attrs::<M>("3.0", ("instantiationToken", token::<M>()), vec![]);
-    document(&root, |w| {
+    document("fmiModelDescription", &root, |w| {
         // The capabilities both interfaces share, then each one's own.
         let interface = |own: Attrs| -> Attrs {
             let head: Attrs = vec![

@@ -6,6 +6,7 @@
 
 pub mod fmi2;
 pub mod fmi3;
+pub mod terminals;
 
 use boomsim::fmu::log::{num, GENERIC_CATEGORIES};
 use boomsim::fmu::model::{initial_unknown, Model};
@@ -33,11 +34,11 @@ pub fn flag(b: bool) -> String {
     b.to_string()
 }
 
-/// The document: declaration, `<fmiModelDescription>` with `root` attributes and `body` inside.
-pub fn document(root: &Attrs, body: impl FnOnce(&mut Xml) -> io::Result<()>) -> io::Result<String> {
+/// The document: declaration, the root element `name` with `root` attributes and `body` inside.
+pub fn document(name: &str, root: &Attrs, body: impl FnOnce(&mut Xml) -> io::Result<()>) -> io::Result<String> {
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
     w.write_event(quick_xml::events::Event::Decl(quick_xml::events::BytesDecl::new("1.0", Some("UTF-8"), None)))?;
-    w.create_element("fmiModelDescription")
+    w.create_element(name)
         .with_attributes(root.iter().map(|(k, v)| (*k, v.as_str())))
         .write_inner_content(body)?;
     let mut s = String::from_utf8(w.into_inner()).map_err(io::Error::other)?;
