@@ -77,5 +77,9 @@ def regress(only: list[str] | None = None, out=None) -> int:
     is within tolerance, 1 otherwise (the regressions are printed)."""
     from .regression import main
 
+    unknown = sorted(set(only or []) - set(scenario_ids()))
+    if unknown:
+        raise UsageError(f"only={only!r}: unknown scenario {', '.join(unknown)}; the scenarios are "
+                         f"{', '.join(scenario_ids())}")
     args = ["--step-sweep", ""] + (["--only", ",".join(only)] if only else []) + (["--out", str(out)] if out else [])
     return main(args)

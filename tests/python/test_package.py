@@ -77,6 +77,7 @@ def test_the_package_has_the_project_version():
     (lambda: boomsim.run("B", interface="me", step=1e-3), 'interface "me" has no communication step'),
     (lambda: boomsim.run("B", interface="native", fmi=3), "the native runner runs FMI 2.0"),
     (lambda: boomsim.run("B", interface="simulink"), 'interface="simulink": one of cs, me, native'),
+    (lambda: boomsim.regress(only=["Q"]), "only=['Q']: unknown scenario Q"),
 ])
 def test_the_api_refuses_wrong_input_in_one_line(call, says):
     with pytest.raises(boomsim.UsageError, match=re.escape(says)):
