@@ -32,7 +32,7 @@ INTERFACES = ("cs", "me", "native")
 
 def run(scenario: str | dict = "B", boom: str = "rigid", params: dict | None = None, step: float | None = None,
         stop_time: float | None = None, interface: str = "cs", fmi: int = 2, feedback_start: str | None = None,
-        tolerance: float = 1e-6) -> Result:
+        tolerance: float | None = None) -> Result:
     """Runs one variant of a scenario (an id of `scenario_ids()`, a .toml file or a loaded scenario)
     with the plant HydraulicBoom and the PressureFeedbackController coupled, and returns its
     Result (columns as NumPy arrays, `.metrics`, `.to_pandas()`).
@@ -40,24 +40,26 @@ def run(scenario: str | dict = "B", boom: str = "rigid", params: dict | None = N
     boom: "rigid" or "flexible"; params: FMU parameters by variable name (either FMU);
     step: the communication step [s] (default the scenario's, 1 ms); interface: "cs" (both
     FMUs' doStep through fmpy, Gauss-Seidel; FMI 3.0 holds the inputs over a step), "me" (one
-    ODE under fmpy's CVode at rtol `tolerance`) or "native" (`boomsim cosim`, the Rust loop of
+    ODE under fmpy's CVode, no communication step) or "native" (`boomsim cosim`, the Rust loop of
     a checkout, FMI 2.0 Co-Simulation, the same rows as "cs"); feedback_start: "t0" or "cbv_open"
-    (default: the scenario's first)."""
+    (default: the scenario's first); tolerance: the relative tolerance of the FMUs' solver ("cs",
+    default theirs, 1e-6) or of CVode ("me", default 1e-6)."""
     from . import cosim, model_exchange, native
 
     sc = scenario if isinstance(scenario, dict) else load_scenario(scenario)
     if interface == "cs":
-        return cosim.run(sc, boom, step, stop_time, interpolate=fmi == 2, feedback_start=feedback_start, fmi=fmi,
-                         params=params)
-    if step is not None:
-        raise UsageError(f"step={step!r}: interface \"{interface}\" has no communication step to set")
+        return cosim.run(sc, boom, step, stop_time, interpolate=fmi == 2, feedback_start=feedback_start,
+                         tolerance=tolerance, fmi=fmi, params=params)
     if interface == "me":
-        return model_exchange.run_me(sc, boom, stop_time, tolerance, feedback_start=feedback_start, fmi=fmi,
-                                     params=params)
+        if step is not None:
+            raise UsageError(f"step={step!r}: Model Exchange has no communication step")
+        return model_exchange.run_me(sc, boom, stop_time, 1e-6 if tolerance is None else tolerance,
+                                     feedback_start=feedback_start, fmi=fmi, params=params)
     if interface == "native":
-        if fmi != 2:
-            raise UsageError("the native runner runs FMI 2.0 Co-Simulation: give fmi=2")
-        return native.run_native(sc, boom, stop_time=stop_time, feedback_start=feedback_start, params=params)
+        if fmi != 2 or tolerance is not None:
+            raise UsageError("the native runner runs FMI 2.0 Co-Simulation at the FMUs' default tolerance: "
+                             "give fmi=2 and no tolerance")
+        return native.run_native(sc, boom, step, stop_time, feedback_start=feedback_start, params=params)
     raise UsageError(f"interface=\"{interface}\": one of {', '.join(INTERFACES)}")
 
 

@@ -74,14 +74,25 @@ def test_the_package_has_the_project_version():
     (lambda: boomsim.fmu("Crane"), 'unknown model "Crane"'),
     (lambda: boomsim.fmu("HydraulicBoom", fmi=1), "fmi=1: 2 (FMI 2.0) or 3 (FMI 3.0)"),
     (lambda: boomsim.run("Q"), 'unknown scenario "Q"'),
-    (lambda: boomsim.run("B", interface="me", step=1e-3), 'interface "me" has no communication step'),
+    (lambda: boomsim.run("B", interface="me", step=1e-3), "step=0.001: Model Exchange has no communication step"),
     (lambda: boomsim.run("B", interface="native", fmi=3), "the native runner runs FMI 2.0"),
+    (lambda: boomsim.run("B", interface="native", tolerance=1e-8), "at the FMUs' default tolerance"),
     (lambda: boomsim.run("B", interface="simulink"), 'interface="simulink": one of cs, me, native'),
     (lambda: boomsim.regress(only=["Q"]), "only=['Q']: unknown scenario Q"),
 ])
 def test_the_api_refuses_wrong_input_in_one_line(call, says):
     with pytest.raises(boomsim.UsageError, match=re.escape(says)):
         call()
+
+
+def test_run_routes_each_interface_to_its_runner():
+    """B's first 0.5 s at a 2 ms step: the native runner's rows are fmpy's bit for bit (the same
+    Gauss-Seidel coupling of the same FMU code, tests/python/test_sweep.py); Model Exchange has
+    no communication step, so its rows are CVode's every millisecond."""
+    cs, native = (boomsim.run("B", stop_time=0.5, step=2e-3, interface=i) for i in ("cs", "native"))
+    assert (cs["p4"] == native["p4"]).all() and (cs.time == native.time).all() and len(cs.time) == 251
+    me = boomsim.run("B", stop_time=0.5, interface="me")
+    assert me.interface.startswith("Model Exchange, CVode rtol 1e-06") and len(me.time) == 501
 
 
 def test_a_result_is_numpy_columns_and_a_dataframe():
