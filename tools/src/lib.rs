@@ -16,4 +16,5 @@ pub mod figures;
 pub mod in_process;
 pub mod pack;
 pub mod platform;
+pub mod reference;
 pub mod xml;

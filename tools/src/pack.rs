@@ -1,12 +1,13 @@
 //! The .fmu archive of either FMI version: modelDescription.xml at the root, the shared library
 //! of every platform under `binaries/<platform>/<modelIdentifier>.<so|dll>` (the version's
-//! platform names, [`crate::platform`]), `documentation/index.html` and, in FMI 3.0, the model's
-//! terminals in `terminalsAndIcons/terminalsAndIcons.xml`. The same library goes into both
+//! platform names, [`crate::platform`]), `documentation/index.html`, the reference results in
+//! `documentation/reference/` ([`crate::reference`]) and, in FMI 3.0, the model's terminals in `terminalsAndIcons/terminalsAndIcons.xml`. The same library goes into both
 //! versions' archives: it exports the fmi2* and the fmi3* symbols.
 
 use crate::chart::escape;
 use crate::figures::Figures;
 use crate::platform::Platform;
+use crate::reference::{self, Referenced};
 use boomsim::fmu::guid::{guid, token};
 use boomsim::fmu::log::{num, GENERIC_CATEGORIES};
 use boomsim::fmu::model::Model;
@@ -39,17 +40,20 @@ pub struct Fmu {
     pub documentation: fn(Version, &[Platform]) -> String,
     /// terminalsAndIcons.xml (FMI 3.0), when the model has terminals.
     pub terminals: fn() -> Option<String>,
+    /// The files of documentation/reference/: (name, content).
+    pub reference: fn() -> Result<Vec<(String, String)>, String>,
 }
 
 impl Fmu {
     /// The FMU of model `M`, built by the cdylib package `package`.
-    pub fn of<M: Figures>(package: &'static str) -> Self {
+    pub fn of<M: Figures + Referenced>(package: &'static str) -> Self {
         Fmu {
             identifier: M::INFO.identifier,
             package,
             model_description: model_description::<M>,
             documentation: documentation::<M>,
             terminals: crate::xml::terminals::terminals_and_icons::<M>,
+            reference: reference::files::<M>,
         }
     }
 
@@ -67,6 +71,12 @@ impl Fmu {
         zip.start_file("documentation/index.html", deflate)?;
         let platforms: Vec<Platform> = libraries.iter().map(|(p, _)| *p).collect();
         zip.write_all((self.documentation)(version, &platforms).as_bytes())?;
+        for (name, content) in
+            (self.reference)().map_err(|e| std::io::Error::other(format!("{}: {e}", self.identifier)))?
+        {
+            zip.start_file(format!("documentation/reference/{name}"), deflate)?;
+            zip.write_all(content.as_bytes())?;
+        }
         if let (Version::Fmi3, Some(terminals)) = (version, (self.terminals)()) {
             zip.start_file("terminalsAndIcons/terminalsAndIcons.xml", deflate)?;
             zip.write_all(terminals.as_bytes())?;
