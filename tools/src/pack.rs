@@ -1,8 +1,9 @@
 //! The .fmu archive of either FMI version: modelDescription.xml at the root, the shared library
 //! of every platform under `binaries/<platform>/<modelIdentifier>.<so|dll>` (the version's
 //! platform names, [`crate::platform`]), `documentation/index.html`, the reference results in
-//! `documentation/reference/` ([`crate::reference`]) and, in FMI 3.0, the model's terminals in `terminalsAndIcons/terminalsAndIcons.xml`. The same library goes into both
-//! versions' archives: it exports the fmi2* and the fmi3* symbols.
+//! `documentation/reference/` ([`crate::reference`]) and, in FMI 3.0, the model's terminals in
+//! `terminalsAndIcons/terminalsAndIcons.xml`. The same library goes into both versions' archives:
+//! it exports the fmi2* and the fmi3* symbols.
 
 use crate::chart::escape;
 use crate::figures::Figures;
