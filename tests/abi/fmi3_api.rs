@@ -42,20 +42,20 @@ unsafe extern "C" fn record(env: *mut c_void, status: fmi3Status, category: fmi3
 }
 
 /// One FMI 3.0 instance of `M` with its recorded messages.
-struct Inst<M: Model> {
-    c: fmi3Instance,
+pub(crate) struct Inst<M: Model> {
+    pub(crate) c: fmi3Instance,
     messages: Box<Messages>,
     _m: PhantomData<M>,
 }
 
 impl<M: Model> Inst<M> {
     /// Instantiates as Co-Simulation (`me` false) or Model Exchange with the right token.
-    fn new(me: bool) -> Self {
+    pub(crate) fn new(me: bool) -> Self {
         Self::try_new(me, &token::<M>(), false).expect("instantiation succeeds")
     }
 
     /// Instantiates with the given token (and, for CS, eventModeUsed); `Err`: the messages.
-    fn try_new(me: bool, token: &str, event_mode_used: bool) -> Result<Self, Vec<String>> {
+    pub(crate) fn try_new(me: bool, token: &str, event_mode_used: bool) -> Result<Self, Vec<String>> {
         let messages = Box::new(Messages::default());
         let env = &*messages as *const Messages as *mut c_void;
         let (n, t) = (CString::new("i3").unwrap(), CString::new(token).unwrap());
@@ -86,7 +86,7 @@ impl<M: Model> Inst<M> {
     }
 
     /// Initialised (stop time 1 s, the given Float64 values): CS in Step Mode, ME in Event Mode.
-    fn initialized(me: bool, reals: &[(u32, f64)]) -> Self {
+    pub(crate) fn initialized(me: bool, reals: &[(u32, f64)]) -> Self {
         let s = Self::new(me);
         unsafe {
             assert_eq!(api::enter_initialization_mode::<M>(s.c, false, 0.0, 0.0, true, 1.0), OK);
@@ -98,11 +98,11 @@ impl<M: Model> Inst<M> {
         s
     }
 
-    fn set(&self, r: u32, x: f64) -> fmi3Status {
+    pub(crate) fn set(&self, r: u32, x: f64) -> fmi3Status {
         unsafe { api::set_float64::<M>(self.c, &r, 1, &x, 1) }
     }
 
-    fn get(&self, r: u32) -> f64 {
+    pub(crate) fn get(&self, r: u32) -> f64 {
         let mut x = f64::NAN;
         assert_eq!(unsafe { api::get_float64::<M>(self.c, &r, 1, &mut x, 1) }, OK, "{:?}", self.last_error());
         x
@@ -118,7 +118,7 @@ impl<M: Model> Inst<M> {
         status
     }
 
-    fn last_error(&self) -> String {
+    pub(crate) fn last_error(&self) -> String {
         let m = self.messages.lock().unwrap();
         m.iter().rev().find(|m| m.0 == ERR).map(|m| m.2.clone()).unwrap_or_default()
     }

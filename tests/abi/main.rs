@@ -2,6 +2,7 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+mod clocks;
 mod dependencies;
 mod directional_derivatives;
 mod fmi2_api;

@@ -177,3 +177,56 @@ fn the_terminals_connect_the_fmus_member_by_member() {
     assert_eq!(circuit.len(), 4);
     assert_eq!((mechanics.len(), boom.len(), controller.len()), (2, 2, 2));
 }
+
+/// ClockedPressureFeedbackController through the `fmi` crate's FMI 3.0 Model Exchange and Clock
+/// calls (fmi3SetClock, fmi3GetClock, fmi3UpdateDiscreteStates), the crate reading the Clock from
+/// the modelDescription: p steps by dp at the first activation, which the sampled filter takes as
+/// a ramp of slope dp / T over the first interval, so u_comp(T) = K_f (dp / T) (1 - e^(-omega_f
+/// T)) / Q_rated (eq. 6.2's high pass of a ramp), decaying with e^(-omega_f (t - T)) while p
+/// stays. 1e-12: rounding, the filter state 5e6 Pa against p - x of 3e4 Pa.
+#[test]
+fn clocked_controller_runs_in_the_fmi_crate_with_its_clock() {
+    use boomsim::control::FEEDBACK_PARAMS;
+    use boomsim::models::ClockedPressureFeedbackController as Cpfc;
+    use fmi::schema::fmi3::{AbstractVariableTrait, Variable};
+    let import = fmu::<Fmi3Import>("ClockedPressureFeedbackController");
+    let md = import.model_description();
+    assert_eq!(md.instantiation_token, token::<Cpfc>());
+    let clock = md.model_variables.variables.iter().find_map(|v| match v {
+        Variable::Clock(c) if c.name() == "sample" => Some(c.value_reference()),
+        _ => None,
+    });
+    assert_eq!(clock, Some(vr::SAMPLE), "the crate reads the Clock");
+    let (k_f, omega, q_rated) =
+        (FEEDBACK_PARAMS[0].spec.default, FEEDBACK_PARAMS[1].spec.default, FEEDBACK_PARAMS[2].spec.default);
+    let t_s = boomsim::models::clocked_pressure_feedback_controller::INTERVAL;
+    let mut m = import.instantiate_me("cpfc", false, true).expect("instantiates");
+    m.enter_initialization_mode(None, 0.0, Some(1.0)).unwrap();
+    m.set_float64(&[vr::P, vr::U_REF], &[P0, U_REF]).unwrap();
+    m.exit_initialization_mode().unwrap();
+    m.update_discrete_states(&mut fmi::EventFlags::default()).unwrap();
+    m.enter_continuous_time_mode().unwrap();
+    let peak = k_f * (DP / t_s) * -(-omega * t_s).exp_m1() / q_rated;
+    let mut out = [0.0; 2];
+    for k in 1..=100 {
+        let t = k as f64 * t_s;
+        m.set_time(t).unwrap();
+        m.enter_event_mode().unwrap();
+        m.set_clock(&[vr::SAMPLE], &[true]).unwrap();
+        let mut on = [false];
+        m.get_clock(&[vr::SAMPLE], &mut on).unwrap();
+        assert!(on[0], "t = {t}: active after fmi3SetClock");
+        m.set_float64(&[vr::P], &[P0 + DP]).unwrap();
+        m.get_float64(&[vr::U, vr::U_COMP], &mut out).unwrap();
+        let expected = peak * (-omega * (t - t_s)).exp();
+        assert!(
+            (out[1] - expected).abs() <= 1e-12 * peak.abs(),
+            "t = {t}: u_comp {}, ramp response {expected}",
+            out[1]
+        );
+        assert_eq!(out[0], U_REF + out[1]);
+        m.update_discrete_states(&mut fmi::EventFlags::default()).unwrap();
+        m.enter_continuous_time_mode().unwrap();
+    }
+    assert!(m.get_float64(&[vr::U], &mut out[..1]).is_err(), "u is clocked: not readable between activations");
+}

@@ -2,10 +2,13 @@
 //! symbols call), as an importer drives it through the C ABI: for `boomsim bench` and the
 //! documentation's figures.
 
+use boomsim::fmu::guid::token;
 use boomsim::fmu::instance::{Instance, Step};
 use boomsim::fmu::log::Logger;
-use boomsim::fmu::machine::Interface;
+use boomsim::fmu::machine::{Interface, Mode};
+use boomsim::fmu::model::clock_row;
 use boomsim::fmu::variables::BaseType;
+use boomsim::fmu::Version;
 use boomsim::fmu::{guid::guid, Model, Value};
 
 /// One co-simulation slave, however it is reached.
@@ -42,6 +45,41 @@ impl<M: Model> InProcess<M> {
     /// Leaves Initialization Mode.
     pub fn exit_initialization_mode(&mut self) -> Result<(), String> {
         self.0.exit_initialization_mode()
+    }
+
+    /// A model with a Clock (FMI 3.0 Model Exchange), set up for `[0, stop]`, in Initialization
+    /// Mode.
+    pub fn clocked(stop: f64) -> Result<Self, String> {
+        let log = Logger::new(None, M::INFO.identifier, &[], false);
+        let mut i = Instance::<M>::new(log, token::<M>(), Version::Fmi3, Interface::ModelExchange);
+        i.setup_experiment(None, 0.0, Some(stop))?;
+        i.enter_initialization_mode();
+        Ok(InProcess(i))
+    }
+
+    /// A clocked instance's activation of its Clock at `t`, as an importer's time event: from
+    /// the Event Mode that initialisation ends in, that instant ended and Continuous-Time Mode;
+    /// then the time set, Event Mode, the Clock set, the clocked inputs set by `inputs`, the
+    /// outputs read by `outputs`, fmi3UpdateDiscreteStates, Continuous-Time Mode.
+    pub fn tick<T>(
+        &mut self,
+        t: f64,
+        inputs: impl FnOnce(&mut Self) -> Result<(), String>,
+        outputs: impl FnOnce(&mut Self) -> Result<T, String>,
+    ) -> Result<T, String> {
+        let clock = clock_row::<M>().map(|i| M::VARIABLES[i].vr).ok_or("the model has no Clock")?;
+        if self.0.core.mode == Mode::EventMode {
+            self.0.update_discrete_states()?;
+            self.0.core.mode = Mode::ContinuousTimeMode;
+        }
+        self.0.set_time(t)?;
+        self.0.core.mode = Mode::EventMode;
+        self.0.set_clocks(&[clock], &[true])?;
+        inputs(self)?;
+        let read = outputs(self)?;
+        self.0.update_discrete_states()?;
+        self.0.core.mode = Mode::ContinuousTimeMode;
+        Ok(read)
     }
 
     /// The slope of Real input `vr` over the next step (fmi2SetRealInputDerivatives, order 1).

@@ -148,7 +148,7 @@ fn pack(out: &Path, platforms: &str) -> Result<(), String> {
     let out = if out.is_absolute() { out.to_path_buf() } else { root().join(out) };
     for (version, dir) in [(Version::Fmi2, out.clone()), (Version::Fmi3, out.join("fmi3"))] {
         std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        for f in &pack::all() {
+        for f in pack::all().iter().filter(|f| f.has(version)) {
             let libs: Vec<_> = platforms.iter().map(|p| (*p, p.library(&target_dir(), f.identifier))).collect();
             let fmu = dir.join(format!("{}.fmu", f.identifier));
             f.write(version, &libs, &fmu).map_err(|e| format!("{}: {e}", fmu.display()))?;
@@ -374,7 +374,7 @@ fn xml(check: bool) -> Result<(), String> {
     let dir = root().join("modelDescription");
     for (version, dir) in [(Version::Fmi2, dir.clone()), (Version::Fmi3, dir.join("fmi3"))] {
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-        for f in pack::all() {
+        for f in pack::all().into_iter().filter(|f| f.has(version)) {
             let terminals = (version == Version::Fmi3).then(|| (f.terminals)()).flatten();
             let files = [
                 (format!("{}.xml", f.identifier), Some((f.model_description)(version))),

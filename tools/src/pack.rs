@@ -11,10 +11,13 @@ use crate::platform::Platform;
 use crate::reference::{self, Referenced};
 use boomsim::fmu::guid::{guid, token};
 use boomsim::fmu::log::{num, GENERIC_CATEGORIES};
+use boomsim::fmu::model::clock_row;
 use boomsim::fmu::model::Model;
 use boomsim::fmu::variables::{Kind, Variable};
 use boomsim::fmu::version::Version;
-use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController};
+use boomsim::models::{
+    BoomMechanics, ClockedPressureFeedbackController, HydraulicBoom, HydraulicCircuit, PressureFeedbackController,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
@@ -23,6 +26,7 @@ use zip::write::SimpleFileOptions;
 pub fn all() -> Vec<Fmu> {
     vec![
         Fmu::of::<PressureFeedbackController>("fmu-pressure-feedback-controller"),
+        Fmu::of::<ClockedPressureFeedbackController>("fmu-clocked-pressure-feedback-controller"),
         Fmu::of::<HydraulicBoom>("fmu-hydraulic-boom"),
         Fmu::of::<HydraulicCircuit>("fmu-hydraulic-circuit"),
         Fmu::of::<BoomMechanics>("fmu-boom-mechanics"),
@@ -43,6 +47,8 @@ pub struct Fmu {
     pub terminals: fn() -> Option<String>,
     /// The files of documentation/reference/: (name, content).
     pub reference: fn() -> Result<Vec<(String, String)>, String>,
+    /// Whether it has an FMI 2.0 archive: not for a model with a Clock (FMI 3.0 only).
+    pub fmi2: bool,
 }
 
 impl Fmu {
@@ -55,7 +61,13 @@ impl Fmu {
             documentation: documentation::<M>,
             terminals: crate::xml::terminals::terminals_and_icons::<M>,
             reference: reference::files::<M>,
+            fmi2: clock_row::<M>().is_none(),
         }
+    }
+
+    /// Whether the FMU has an archive of FMI `version`.
+    pub fn has(&self, version: Version) -> bool {
+        version == Version::Fmi3 || self.fmi2
     }
 
     /// Writes the .fmu of `version` from the built shared library of each platform. Entries carry
@@ -101,6 +113,9 @@ fn row(v: &Variable) -> String {
         Kind::Integer { start, min, max } => ("Integer", start.to_string(), String::new(), format!("[{min}, {max}]")),
         Kind::Boolean { start } => ("Boolean", start.to_string(), String::new(), String::new()),
         Kind::String { start } => ("String", start.to_owned(), String::new(), String::new()),
+        Kind::Clock { interval, shift } => {
+            ("Clock", String::new(), "s".into(), format!("every {} s from {} s", num(interval), num(shift)))
+        }
     };
     let start = if v.has_start() { start } else { String::new() };
     format!(
@@ -161,7 +176,13 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
     let states_label =
         format!("Continuous states (Model Exchange, in {} order)", version.function("fmi2GetContinuousStates"));
     let rows = [
-        ("Interfaces", format!("{fmi} Model Exchange and Co-Simulation")),
+        (
+            "Interfaces",
+            match clock_row::<M>() {
+                Some(_) => format!("{fmi} Model Exchange (with a Clock)"),
+                None => format!("{fmi} Model Exchange and Co-Simulation"),
+            },
+        ),
         (states_label.as_str(), format!("{}: {}", states.len(), states.join(", "))),
         ("Model identifier", i.identifier.to_owned()),
         ("Version", i.version.to_owned()),
@@ -177,7 +198,13 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
                 num(i.default_tolerance)
             ),
         ),
-        (interpolation, if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") }),
+        match clock_row::<M>().map(|r| &M::VARIABLES[r]) {
+            Some(Variable { name, kind: Kind::Clock { interval, shift }, .. }) => (
+                "Clock (input, constant interval)",
+                format!("{name}: every {} s from {} s after the start time", num(*interval), num(*shift)),
+            ),
+            _ => (interpolation, if interpolated.is_empty() { "none".into() } else { interpolated.join(", ") }),
+        },
         ("Log categories", categories.join(", ")),
         (
             "Model Exchange tolerance",
@@ -230,9 +257,9 @@ pub fn documentation<M: Figures>(version: Version, platforms: &[Platform]) -> St
         facts = facts::<M>(version, platforms),
         doc = i.documentation,
         figures = M::figures(),
-        note = match version {
-            Version::Fmi2 => "",
-            Version::Fmi3 => "<p><i>The model text names FMI 2.0's functions: in FMI 3.0, fmi3DoStep and fmi3EnterInitializationMode (with the tolerance and stop time) take the roles of fmi2DoStep and fmi2SetupExperiment, and FMI 3.0 has no input derivatives: the inputs hold their value over a step.</i></p>\n",
+        note = match (version, clock_row::<M>()) {
+            (Version::Fmi2, _) | (_, Some(_)) => "",
+            (Version::Fmi3, None) => "<p><i>The model text names FMI 2.0's functions: in FMI 3.0, fmi3DoStep and fmi3EnterInitializationMode (with the tolerance and stop time) take the roles of fmi2DoStep and fmi2SetupExperiment, and FMI 3.0 has no input derivatives: the inputs hold their value over a step.</i></p>\n",
         },
     )
 }

@@ -11,9 +11,13 @@
 
 use crate::in_process::{InProcess, Slave};
 use boomsim::fmu::log::num;
+use boomsim::fmu::model::clock_row;
 use boomsim::fmu::Model;
+use boomsim::models::clocked_pressure_feedback_controller::INTERVAL;
 use boomsim::models::port::vr as port;
-use boomsim::models::{BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController};
+use boomsim::models::{
+    BoomMechanics, ClockedPressureFeedbackController, HydraulicBoom, HydraulicCircuit, PressureFeedbackController,
+};
 use std::fmt::Write;
 
 /// One reference experiment of a model.
@@ -98,6 +102,13 @@ impl Referenced for PressureFeedbackController {
     }
 }
 
+impl Referenced for ClockedPressureFeedbackController {
+    /// PressureFeedbackController's experiment, sampled by the Clock.
+    fn experiment() -> Result<Experiment, String> {
+        Ok(Experiment { step: INTERVAL, ..PressureFeedbackController::experiment()? })
+    }
+}
+
 /// 2 s at 10 ms with the models' default tolerance.
 fn standard() -> Experiment {
     Experiment { description: String::new(), stop: 2.0, step: 0.01, tolerance: 1e-6, inputs: vec![], outputs: &[] }
@@ -139,10 +150,7 @@ pub fn files<M: Referenced>() -> Result<Vec<(String, String)>, String> {
     let inputs: Vec<(u32, &[(f64, f64)])> =
         e.inputs.iter().map(|(n, rows)| Ok((vr::<M>(n)?, rows.as_slice()))).collect::<Result<_, String>>()?;
     let outputs: Vec<u32> = e.outputs.iter().map(|n| vr::<M>(n)).collect::<Result<_, String>>()?;
-    let mut s = InProcess::<M>::initializing(Some(e.tolerance), 0.0, Some(e.stop), &[])?;
     let set = |s: &mut InProcess<M>, t: f64| inputs.iter().try_for_each(|(r, rows)| s.set(*r, at(rows, t)));
-    set(&mut s, 0.0)?;
-    s.exit_initialization_mode()?;
     let n = (e.stop / e.step).round() as usize;
     let mut out = format!("time,{}\n", e.outputs.join(","));
     let row = |s: &mut InProcess<M>, t: f64, out: &mut String| -> Result<(), String> {
@@ -150,12 +158,29 @@ pub fn files<M: Referenced>() -> Result<Vec<(String, String)>, String> {
         let _ = writeln!(out, "{t},{}", values.join(","));
         Ok(())
     };
-    row(&mut s, 0.0, &mut out)?;
-    for k in 0..n {
-        let (t, next) = (k as f64 * e.step, (k + 1) as f64 * e.step);
-        set(&mut s, t)?;
-        s.step(t, next - t)?;
-        row(&mut s, next, &mut out)?;
+    let clocked = clock_row::<M>().is_some();
+    if clocked {
+        // Model Exchange: the outputs of Initialization Mode, then at every activation of the
+        // Clock (every step from one step after the start) the inputs of that time set.
+        let mut s = InProcess::<M>::clocked(e.stop)?;
+        set(&mut s, 0.0)?;
+        row(&mut s, 0.0, &mut out)?;
+        s.exit_initialization_mode()?;
+        for k in 1..=n {
+            let t = k as f64 * e.step;
+            s.tick(t, |s| set(s, t), |s| row(s, t, &mut out))?;
+        }
+    } else {
+        let mut s = InProcess::<M>::initializing(Some(e.tolerance), 0.0, Some(e.stop), &[])?;
+        set(&mut s, 0.0)?;
+        s.exit_initialization_mode()?;
+        row(&mut s, 0.0, &mut out)?;
+        for k in 0..n {
+            let (t, next) = (k as f64 * e.step, (k + 1) as f64 * e.step);
+            set(&mut s, t)?;
+            s.step(t, next - t)?;
+            row(&mut s, next, &mut out)?;
+        }
     }
     let mut input = format!("time,{}\n", e.inputs.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(","));
     let mut times: Vec<f64> = e.inputs.iter().flat_map(|(_, rows)| rows.iter().map(|r| r.0)).collect();
@@ -167,13 +192,21 @@ pub fn files<M: Referenced>() -> Result<Vec<(String, String)>, String> {
         let _ = writeln!(input, "{t},{}", values.join(","));
     }
     let opt = format!("StartTime, 0\nStopTime, {}\nStepSize, {}\nRelTol, {}\n", e.stop, e.step, e.tolerance);
+    let how = if clocked {
+        "{id}_ref.opt: start and stop time [s], the Clock's interval = output interval [s], relative tolerance.\n\
+         {id}_ref.csv: the outputs of Initialization Mode, then at every activation of the Clock, SI units.\n\
+         Model Exchange: at every multiple of the interval after the start, enter Event Mode, activate the Clock \
+         (fmi3SetClock), set the inputs of that time, read the outputs, fmi3UpdateDiscreteStates.\n"
+    } else {
+        "{id}_ref.opt: start and stop time [s], communication step = output interval [s], relative tolerance.\n\
+         {id}_ref.csv: the outputs at every communication point, SI units.\n\
+         Co-Simulation: set the inputs at each step's start time (held over the step), step, read the outputs.\n"
+    };
     let readme = format!(
         "Reference results of {id}, computed by this FMU's model when it was packed.\n\n{}\n\n\
-         {id}_in.csv: the inputs, linear between rows, held after the last.\n\
-         {id}_ref.opt: start and stop time [s], communication step = output interval [s], relative tolerance.\n\
-         {id}_ref.csv: the outputs at every communication point, SI units.\n\
-         Co-Simulation: set the inputs at each step's start time (held over the step), step, read the outputs.\n",
-        e.description
+         {id}_in.csv: the inputs, linear between rows, held after the last.\n{}",
+        e.description,
+        how.replace("{id}", id)
     );
     Ok(vec![
         (format!("{id}_in.csv"), input),

@@ -9,7 +9,7 @@ use super::types::*;
 use crate::fmu::calls::{self, call, slice, Call};
 use crate::fmu::guid::guid;
 use crate::fmu::log::Logger;
-use crate::fmu::model::Model;
+use crate::fmu::model::{clock_row, Model};
 use crate::fmu::variables::{BaseType, Value};
 use crate::fmu::version::Version;
 use std::ffi::CStr;
@@ -72,6 +72,9 @@ pub unsafe fn instantiate<M: Model>(
         let expected = guid::<M>();
         if let Err(e) = calls::instance_name(name) {
             return fail(e);
+        }
+        if clock_row::<M>().is_some() {
+            return fail(format!("{} is an FMI 3.0 FMU (it has a Clock, which FMI 2.0 lacks)", M::INFO.identifier));
         }
         let interface = match fmu_type {
             FMI2_MODEL_EXCHANGE => Interface::ModelExchange,

@@ -10,7 +10,7 @@ use crate::fmu::calls::{self, call, slice, slice_mut, Call};
 use crate::fmu::guid::token;
 use crate::fmu::instance::Instance;
 use crate::fmu::log::{num, Logger};
-use crate::fmu::model::Model;
+use crate::fmu::model::{clock_row, Model};
 use crate::fmu::variables::{BaseType, Value};
 use crate::fmu::version::Version;
 use std::ffi::CStr;
@@ -111,6 +111,12 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     _intermediate_update: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
     let more = || {
+        if clock_row::<M>().is_some() {
+            return Err(format!(
+                "{} provides Model Exchange only (its Clock needs Event Mode, which its Co-Simulation would lack)",
+                M::INFO.identifier
+            ));
+        }
         if event_mode_used {
             return Err(
                 "eventModeUsed = true, but the FMU has no event mode in Co-Simulation (hasEventMode=\"false\")".into(),
@@ -314,6 +320,84 @@ pub unsafe fn other_type<M: Model>(
     })
 }
 
+/// fmi3GetClock: whether the Clock is active (FMI 3.0, 2.3.5).
+pub unsafe fn get_clock<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut bool) -> fmi3Status {
+    let f = at("fmi3GetClock", allowed::GET_CLOCK);
+    calls::get::<M, bool>(c, f, vr, n, v, BaseType::Clock, |v| matches!(v, Value::Clock(true)))
+}
+
+/// fmi3SetClock: activates input Clocks (FMI 3.0, 2.3.5). The C `bool`s are read as bytes, as in
+/// fmi3SetBoolean.
+pub unsafe fn set_clock<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const u8) -> fmi3Status {
+    call::<M>(c, at("fmi3SetClock", allowed::SET_CLOCK), |inst| {
+        let limit = calls::references::<M>(Version::Fmi3);
+        let vrs = slice(vr, n, limit, "valueReferences")?;
+        let active = slice(v, n, limit, "values")?
+            .iter()
+            .map(|&b| match b {
+                0 | 1 => Ok(b == 1),
+                _ => Err(format!(
+                    "{b} is not an fmi3Clock; valid values are fmi3ClockInactive (0) and fmi3ClockActive (1)"
+                )),
+            })
+            .collect::<Result<Vec<bool>, String>>()?;
+        inst.set_clocks(vrs, &active)?;
+        Ok(fmi3Status::OK)
+    })
+}
+
+/// fmi3IntervalUnchanged: the only qualifier of a constant Clock (FMI 3.0, 2.2.8.4, the table of
+/// allowed qualifiers, (2)).
+const INTERVAL_UNCHANGED: fmi3IntervalQualifier = 1;
+
+/// fmi3GetIntervalDecimal: a constant Clock's interval, always `fmi3IntervalUnchanged`.
+pub unsafe fn get_interval_decimal<M: Model>(
+    c: fmi3Instance,
+    vr: *const u32,
+    n: usize,
+    intervals: *mut f64,
+    qualifiers: *mut fmi3IntervalQualifier,
+) -> fmi3Status {
+    call::<M>(c, at("fmi3GetIntervalDecimal", allowed::GET_INTERVAL), |inst| {
+        let limit = calls::references::<M>(Version::Fmi3);
+        let vrs = slice(vr, n, limit, "valueReferences")?;
+        let out = slice_mut(intervals, n, limit, "intervals")?;
+        let qualifier = slice_mut(qualifiers, n, limit, "qualifiers")?;
+        for (k, &r) in vrs.iter().enumerate() {
+            (out[k], qualifier[k]) = (inst.clock_timing(r)?.0, INTERVAL_UNCHANGED);
+        }
+        Ok(fmi3Status::OK)
+    })
+}
+
+/// fmi3GetShiftDecimal: a constant Clock's shift (its first activation after the start time).
+pub unsafe fn get_shift_decimal<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, shifts: *mut f64) -> fmi3Status {
+    call::<M>(c, at("fmi3GetShiftDecimal", allowed::GET_SHIFT), |inst| {
+        let limit = calls::references::<M>(Version::Fmi3);
+        let vrs = slice(vr, n, limit, "valueReferences")?;
+        let out = slice_mut(shifts, n, limit, "shifts")?;
+        for (k, &r) in vrs.iter().enumerate() {
+            out[k] = inst.clock_timing(r)?.1;
+        }
+        Ok(fmi3Status::OK)
+    })
+}
+
+/// The clock functions boomsim does not provide: for a model without a Clock, none; for a model
+/// with its constant Clock, the fraction variants (`supportsFraction="false"`), the setters (the
+/// interval and shift of a constant Clock are the modelDescription's) and Scheduled Execution's.
+pub fn clock_unsupported<M: Model>(c: fmi3Instance, function: &'static str) -> fmi3Status {
+    let why = match (clock_row::<M>(), function) {
+        (None, _) => "the FMU has no clocks",
+        (Some(_), f) if f.ends_with("Fraction") && f.starts_with("fmi3Get") => "supportsFraction=\"false\"",
+        (Some(_), "fmi3ActivateModelPartition") => "the FMU provides no Scheduled Execution",
+        (Some(_), _) => {
+            "the Clock is constant (intervalVariability=\"constant\"): its interval and shift are the modelDescription's"
+        }
+    };
+    calls::unsupported::<M>(c, at(function, allowed::UNSUPPORTED), why)
+}
+
 /// Functions boomsim does not provide, in any state.
 pub fn unsupported<M: Model>(c: fmi3Instance, function: &'static str, why: &str) -> fmi3Status {
     calls::unsupported::<M>(c, at(function, allowed::UNSUPPORTED), why)
@@ -419,8 +503,11 @@ pub unsafe fn get_adjoint_derivative<M: Model>(c: fmi3Instance, d: Derivative) -
     })
 }
 
-/// fmi3UpdateDiscreteStates: no discrete states and no time events (see FMI 2.0's
-/// fmi2NewDiscreteStates), so the event iteration ends at once and nothing changed.
+/// fmi3UpdateDiscreteStates: the end of the instant: an active Clock's model partition is
+/// computed and its clocked states become the previous values, and the Clock is deactivated
+/// ([`Instance::update_discrete_states`]). No other discrete states, no time events (the Clock's
+/// activations are the importer's: it knows their times from the Clock's constant interval), so
+/// the event iteration ends at once and no continuous state changed.
 pub unsafe fn update_discrete_states<M: Model>(
     c: fmi3Instance,
     (need_update, terminate, nominals_changed, values_changed, time_defined): (
@@ -432,7 +519,7 @@ pub unsafe fn update_discrete_states<M: Model>(
     ),
     next_event_time: *mut f64,
 ) -> fmi3Status {
-    call::<M>(c, at("fmi3UpdateDiscreteStates", allowed::UPDATE_DISCRETE_STATES), |_| {
+    call::<M>(c, at("fmi3UpdateDiscreteStates", allowed::UPDATE_DISCRETE_STATES), |inst| {
         let flags = [
             (need_update, "discreteStatesNeedUpdate"),
             (terminate, "terminateSimulation"),
@@ -444,15 +531,25 @@ pub unsafe fn update_discrete_states<M: Model>(
             return Err(format!("{name} is NULL"));
         }
         let time = next_event_time.as_mut().ok_or("nextEventTime is NULL")?;
+        inst.update_discrete_states()?;
         flags.iter().for_each(|(p, _)| **p = false);
         *time = 0.0;
         Ok(fmi3Status::OK)
     })
 }
 
+/// fmi3EnterContinuousTimeMode. With the Clock still active the instant has not ended: refused
+/// (FMI 3.0, 2.3.5: "Each super-dense time instant concludes with a call to
+/// fmi3UpdateDiscreteStates", which deactivates the Clock; the standard leaves this call open).
 pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
     let f = at("fmi3EnterContinuousTimeMode", allowed::ENTER_CONTINUOUS_TIME_MODE);
-    calls::enter::<M>(c, f, Mode::ContinuousTimeMode)
+    call::<M>(c, f, |inst| {
+        if inst.clock_active() {
+            return Err("the Clock is active: end the instant with fmi3UpdateDiscreteStates first (FMI 3.0, 2.3.5)".into());
+        }
+        inst.core.mode = Mode::ContinuousTimeMode;
+        Ok(fmi3Status::OK)
+    })
 }
 
 pub unsafe fn completed_integrator_step<M: Model>(

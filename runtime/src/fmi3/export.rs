@@ -93,9 +93,9 @@ macro_rules! export_fmi3 {
                 c: fmi3Instance,
                 vr: *const u32,
                 n: usize,
-                _v: *mut fmi3Clock,
+                v: *mut fmi3Clock,
             ) -> fmi3Status {
-                api::other_type::<M>(c, "fmi3GetClock", false, vr, n, "Clock")
+                api::get_clock::<M>(c, vr, n, v)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3SetBinary(
@@ -113,9 +113,9 @@ macro_rules! export_fmi3 {
                 c: fmi3Instance,
                 vr: *const u32,
                 n: usize,
-                _v: *const fmi3Clock,
+                v: *const u8,
             ) -> fmi3Status {
-                api::other_type::<M>(c, "fmi3SetClock", true, vr, n, "Clock")
+                api::set_clock::<M>(c, vr, n, v)
             }
             #[no_mangle]
             pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
@@ -153,10 +153,27 @@ macro_rules! export_fmi3 {
             pub unsafe extern "C" fn fmi3ExitConfigurationMode(c: fmi3Instance) -> fmi3Status {
                 api::unsupported::<M>(c, "fmi3ExitConfigurationMode", "the FMU has no structural parameters")
             }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetIntervalDecimal(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                intervals: *mut f64,
+                qualifiers: *mut fmi3IntervalQualifier,
+            ) -> fmi3Status {
+                api::get_interval_decimal::<M>(c, vr, n, intervals, qualifiers)
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetShiftDecimal(
+                c: fmi3Instance,
+                vr: *const u32,
+                n: usize,
+                shifts: *mut f64,
+            ) -> fmi3Status {
+                api::get_shift_decimal::<M>(c, vr, n, shifts)
+            }
             $crate::__fmi3_clock_functions! {
-                fmi3GetIntervalDecimal(*const u32, usize, *mut f64, *mut fmi3IntervalQualifier);
                 fmi3GetIntervalFraction(*const u32, usize, *mut u64, *mut u64, *mut fmi3IntervalQualifier);
-                fmi3GetShiftDecimal(*const u32, usize, *mut f64);
                 fmi3GetShiftFraction(*const u32, usize, *mut u64, *mut u64);
                 fmi3SetIntervalDecimal(*const u32, usize, *const f64);
                 fmi3SetIntervalFraction(*const u32, usize, *const u64, *const u64);
@@ -258,14 +275,14 @@ macro_rules! __fmi3_other_types {
     )*};
 }
 
-/// The clock functions (inside [`export_fmi3!`]): the FMU has no clocks.
+/// The clock functions boomsim does not provide (inside [`export_fmi3!`]).
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __fmi3_clock_functions {
     ($($name:ident($($arg:ty),*);)*) => {$(
         #[no_mangle]
         pub unsafe extern "C" fn $name(c: fmi3Instance, $(_: $arg),*) -> fmi3Status {
-            api::unsupported::<M>(c, stringify!($name), "the FMU has no clocks")
+            api::clock_unsupported::<M>(c, stringify!($name))
         }
     )*};
 }

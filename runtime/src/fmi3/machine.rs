@@ -2,8 +2,9 @@
 //! (section 3.2.4) as one table: per function, the interface it belongs to and the set of states
 //! in which it may be called. The states are those of [`crate::fmu::machine`]: `StepComplete` is
 //! FMI 3.0's Step Mode, `StepFailed` its Step Discarded; `StepCanceled` is never entered. There
-//! are no structural parameters, clocks, or event mode in Co-Simulation (`hasEventMode="false"`),
-//! so Configuration, Reconfiguration, Clock Activation and Intermediate Update Mode are never
+//! are no structural parameters and no event mode in Co-Simulation (`hasEventMode="false"`; the
+//! one model with a Clock is Model Exchange only, where its Clock is set in Event Mode), so
+//! Configuration, Reconfiguration, Clock Activation and Intermediate Update Mode are never
 //! entered either.
 
 pub use crate::fmu::machine::*;
@@ -33,6 +34,14 @@ pub mod allowed {
     /// every call, in any state, is an error naming why.
     pub const UNSUPPORTED: Rule = both(ANY);
     pub const UPDATE_DISCRETE_STATES: Rule = me(EVENT);
+    /// fmi3SetClock and fmi3GetClock: Event Mode (2.3.5; a Clock is set there, output Clocks
+    /// are read there).
+    pub const SET_CLOCK: Rule = both(EVENT);
+    pub const GET_CLOCK: Rule = both(EVENT);
+    /// fmi3GetIntervalDecimal: Initialization and Event Mode (2.2.8.1, input Clock); the shift
+    /// of a constant Clock in Initialization Mode (2.2.8.2, the table of Clock types).
+    pub const GET_INTERVAL: Rule = both(INIT | EVENT);
+    pub const GET_SHIFT: Rule = both(INIT);
     pub const ENTER_CONTINUOUS_TIME_MODE: Rule = me(EVENT);
     pub const COMPLETED_INTEGRATOR_STEP: Rule = me(CONT);
     /// Continuous-Time Mode only (3.2.1; Event Mode, 2.3.5, does not list it).

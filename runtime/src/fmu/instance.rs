@@ -4,7 +4,7 @@
 use super::driver::Driven;
 use super::log::{num, Logger, Status};
 use super::machine::{Interface, Mode};
-use super::model::{initial_unknown, Log, Model, Seeds};
+use super::model::{clock_row, initial_unknown, Log, Model, Seeds};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
 use std::borrow::Cow;
@@ -94,6 +94,11 @@ impl<M: Model> Default for Core<M> {
     fn default() -> Self {
         Self::new()
     }
+}
+
+/// Whether the model's Clock is active.
+fn clock_active<M: Model>(values: &Values) -> bool {
+    clock_row::<M>().is_some_and(|i| *values.at(i) == Value::Clock(true))
 }
 
 /// Most event indicators a model may declare (the circuit has 3): their values are refreshed
@@ -512,7 +517,10 @@ impl<M: Model> Instance<M> {
         if c.mode == Mode::InitializationMode {
             // Initial outputs follow from the values set so far.
             write_outputs(&Driven::new(M::initialize(&c.values)?), &mut c.values);
-        } else if let Some(model) = &c.model {
+        } else if let Some(model) = c.model.as_mut() {
+            if clock_active::<M>(&c.values) {
+                model.evaluate_partition(&c.values);
+            }
             write_outputs(model, &mut c.values);
         }
         c.outputs_current = true;
@@ -586,6 +594,7 @@ impl<M: Model> Instance<M> {
                 continue;
             }
             let (i, v) = self.lookup(vr, wanted)?;
+            self.clocked_access(v)?;
             if self.derivative_rows[i] && !self.core.derivatives_current {
                 self.refresh_derivatives()?;
             }
@@ -613,6 +622,7 @@ impl<M: Model> Instance<M> {
         let mut states: Option<Vec<f64>> = None;
         for (&vr, value) in vrs.iter().zip(new) {
             let (i, v) = self.lookup(vr, value.base_type())?;
+            self.clocked_access(v)?;
             let state = M::STATES.iter().position(|s| s.state == vr);
             settable(v, state.is_some(), self.core.mode)?;
             in_range(v, &value)?;
@@ -645,6 +655,86 @@ impl<M: Model> Instance<M> {
         }
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
+        Ok(())
+    }
+
+    /// FMI 3.0, 2.2.8.3: a clocked variable is set and read only while its Clock is active, or in
+    /// Initialization Mode (and before it, where its start value may be set).
+    fn clocked_access(&self, v: &Variable) -> Result<(), String> {
+        let before = matches!(self.core.mode, Mode::Instantiated | Mode::InitializationMode);
+        if !v.clocked || before || clock_active::<M>(&self.core.values) {
+            return Ok(());
+        }
+        let clock = clock_row::<M>().map_or("", |i| M::VARIABLES[i].name);
+        Err(format!(
+            "\"{}\" is clocked by \"{clock}\", which is not active: a clocked variable is set and read only while its \
+             Clock is active (fmi3SetClock in Event Mode) or in Initialization Mode (FMI 3.0, 2.2.8.3)",
+            v.name
+        ))
+    }
+
+    /// Whether the model's Clock is active.
+    pub fn clock_active(&self) -> bool {
+        clock_active::<M>(&self.core.values)
+    }
+
+    /// fmi3SetClock: activates the model's input Clock for this instant of Event Mode, at one of
+    /// its times (FMI 3.0, 2.2.8.2: t_i = t_start + shift + i interval; the time within 1e-6 of an
+    /// interval, far above the rounding of a time summed from intervals and far below an
+    /// interval). It cannot be deactivated (`canBeDeactivated="false"`): fmi3UpdateDiscreteStates
+    /// does that (FMI 3.0, 2.3.5).
+    pub fn set_clocks(&mut self, vrs: &[u32], active: &[bool]) -> Result<(), String> {
+        let mut rows = Vec::with_capacity(vrs.len());
+        for (&vr, &on) in vrs.iter().zip(active) {
+            let (i, v) = self.lookup(vr, BaseType::Clock)?;
+            if !on {
+                return Err(format!(
+                    "cannot deactivate Clock \"{}\": it has canBeDeactivated=\"false\"; fmi3UpdateDiscreteStates \
+                     deactivates it (FMI 3.0, 2.3.5)",
+                    v.name
+                ));
+            }
+            let (interval, shift) = self.clock_timing(vr)?;
+            let (t, first) = (self.core.time, self.core.start_time + shift);
+            let k = (t - first) / interval;
+            if !(k > -1e-6 && (k - k.round()).abs() <= 1e-6) {
+                return Err(format!(
+                    "Clock \"{}\" activated at t = {}, which is none of its times {} + i {} s, i = 0, 1, ... (a \
+                     constant Clock, FMI 3.0, 2.2.8.2)",
+                    v.name,
+                    num(t),
+                    num(first),
+                    num(interval)
+                ));
+            }
+            rows.push(i);
+        }
+        for i in rows {
+            self.core.values.put(i, Value::Clock(true));
+        }
+        self.core.outputs_current = false;
+        Ok(())
+    }
+
+    /// The interval and shift of the Clock `vr` (its constant timing).
+    pub fn clock_timing(&self, vr: u32) -> Result<(f64, f64), String> {
+        match self.lookup(vr, BaseType::Clock)?.1.kind {
+            Kind::Clock { interval, shift } => Ok((interval, shift)),
+            _ => Err(self.type_mismatch(vr, "Clock")),
+        }
+    }
+
+    /// fmi3UpdateDiscreteStates: ends the instant. With the Clock active, its model partition is
+    /// computed (if no read did it) and its clocked states become the previous values, and the
+    /// Clock is deactivated (FMI 3.0, 2.3.5).
+    pub fn update_discrete_states(&mut self) -> Result<(), String> {
+        let Some(row) = clock_row::<M>().filter(|_| clock_active::<M>(&self.core.values)) else {
+            return Ok(());
+        };
+        self.refresh_outputs()?;
+        self.model()?.update_previous();
+        self.core.values.put(row, Value::Clock(false));
+        self.core.outputs_current = false;
         Ok(())
     }
 

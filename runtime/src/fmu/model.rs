@@ -4,7 +4,7 @@
 //! [`super::driver`], integrates).
 
 use super::driver::Step;
-use super::variables::{Causality, Initial, Value, Values, Variable};
+use super::variables::{Causality, Initial, Kind, Value, Values, Variable};
 use crate::solver::OdeSystem;
 
 /// Static facts about a model, written to modelDescription.xml.
@@ -174,6 +174,17 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Writes the [`Model::EVENT_INDICATORS`] event indicators at the current states and inputs.
     fn event_indicators(&self, _values: &Values, _z: &mut [f64]) {}
 
+    /// FMI 3.0 clocks (2.2.8.3): at an activation of the model's Clock, computes its model
+    /// partition, the clocked states and outputs, from the previous values of the clocked states
+    /// and the clocked inputs in `values` (f_disc and f_event). It may be called again in the same
+    /// instant when the importer sets the inputs anew, so it always starts from the previous
+    /// values. Default: the model has no Clock.
+    fn evaluate_partition(&mut self, _values: &Values) {}
+
+    /// The end of the instant of a Clock activation (fmi3UpdateDiscreteStates): the clocked
+    /// states computed by [`Model::evaluate_partition`] become the previous values.
+    fn update_previous(&mut self) {}
+
     /// The master set the variables `vrs` between two steps (inputs and tunable parameters,
     /// after [`Model::retune`]): a model that extrapolates an input takes a new value as a sample
     /// at the current time. Default: nothing to do.
@@ -198,15 +209,20 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// its state for the driver to integrate, or steps itself in closed form ([`Step::Done`]).
     fn begin_step(&mut self, step: &StepStart<'_>, log: &mut dyn Log) -> Result<Step<'_, Self::Ode>, StepError>;
 
-    /// Typical magnitude of each state of `ode` (absolute tolerance = rtol x scale).
-    fn scale(ode: &Self::Ode) -> Vec<f64>;
+    /// Typical magnitude of each state of `ode` (absolute tolerance = rtol x scale). Default:
+    /// none (a model without ODE state).
+    fn scale(_ode: &Self::Ode) -> Vec<f64> {
+        Vec::new()
+    }
 
     /// After the driver reached the communication point `t`: what the model does there (the TLM
     /// port emits its wave). Default: nothing.
     fn communication_point(&mut self, _t: f64) {}
 
-    /// The ODE state the driver integrates (empty for a model that steps in closed form).
-    fn state(&self) -> &[f64];
+    /// The ODE state the driver integrates. Default: none (a model that steps in closed form).
+    fn state(&self) -> &[f64] {
+        &[]
+    }
 
     /// The length of [`Model::head`].
     const HEAD: usize = 0;
@@ -222,14 +238,20 @@ pub trait Model: Clone + Send + Sized + 'static {
     fn restore(values: &Values, head: &[f64], state: &[f64]) -> Result<Self, String>;
 }
 
+/// The table row of the model's Clock (FMI 3.0 only; at most one), if it has one.
+pub fn clock_row<M: Model>() -> Option<usize> {
+    M::VARIABLES.iter().position(|v| matches!(v.kind, Kind::Clock { .. }))
+}
+
 /// FMI 2.0, 2.2.8 (FMI 3.0, 2.4.8 alike): whether `v` is an InitialUnknown of model `M`: an
 /// output with initial approx or calculated, a calculated parameter, a continuous state with
-/// initial approx or calculated, or a `der()` variable.
+/// initial approx or calculated, or a `der()` variable. Clocked variables are not listed (FMI 3.0,
+/// 2.2.8.3: optional for them; fmpy's validation expects them absent).
 pub fn initial_unknown<M: Model>(v: &Variable) -> bool {
     let state = M::STATES.iter().any(|s| s.state == v.vr && v.initial != Initial::Exact);
     let derivative = M::STATES.iter().any(|s| s.derivative == v.vr);
     derivative
         || state
-        || (v.causality == Causality::Output && v.initial != Initial::Exact)
+        || (v.causality == Causality::Output && v.initial != Initial::Exact && !v.clocked)
         || v.causality == Causality::CalculatedParameter
 }

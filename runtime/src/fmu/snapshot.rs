@@ -53,6 +53,10 @@ pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
                 put_u64(&mut p, s.len() as u64);
                 p.extend_from_slice(s.as_bytes())
             }
+            Value::Clock(active) => {
+                p.push(4);
+                p.push(*active as u8)
+            }
         }
     }
     core.input_derivatives.iter().for_each(|&d| put_f64(&mut p, d));
@@ -143,6 +147,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
             (0, Value::Real(_)) => Value::Real(r.f64()?),
             (1, Value::Integer(_)) => Value::Integer(i32::from_le_bytes(r.take(4)?.try_into().unwrap_or_default())),
             (2, Value::Boolean(_)) => Value::Boolean(r.take(1)?[0] != 0),
+            (4, Value::Clock(_)) => Value::Clock(r.take(1)?[0] != 0),
             (3, Value::String(_)) => {
                 let n = r.u64()? as usize;
                 Value::String(String::from_utf8(r.take(n)?.to_vec()).map_err(|e| e.to_string())?)

@@ -38,15 +38,20 @@ pub enum Kind {
     Integer { start: i32, min: i32, max: i32 },
     Boolean { start: bool },
     String { start: &'static str },
+    /// An FMI 3.0 input Clock with a constant interval (`intervalVariability="constant"`,
+    /// FMI 3.0, 2.2.8.2): the importer activates it every `interval` seconds from the start time
+    /// plus `shift`. Its value is whether it is active.
+    Clock { interval: f64, shift: f64 },
 }
 
-/// The four FMI base types, for messages and type checks.
+/// The FMI base types, for messages and type checks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BaseType {
     Real,
     Integer,
     Boolean,
     String,
+    Clock,
 }
 
 /// The FMI spelling of an enum value: `CalculatedParameter` -> `calculatedParameter`.
@@ -72,6 +77,13 @@ pub struct Variable {
     /// For outputs whose initial equation differs: the inputs it depends on in Initialization
     /// Mode (`None`: those of `depends_on`).
     pub initial_depends_on: Option<&'static [u32]>,
+    /// Whether the variable belongs to the model partition of the model's Clock (FMI 3.0,
+    /// 2.2.8.3, attribute `clocks`): set and read only while the Clock is active, or in
+    /// Initialization Mode.
+    pub clocked: bool,
+    /// For a clocked state (FMI 3.0 `<ClockedState>`): the value reference of the variable with
+    /// its previous value (attribute `previous`).
+    pub previous: Option<u32>,
 }
 
 const NO_MIN: f64 = f64::NEG_INFINITY;
@@ -87,7 +99,19 @@ impl Variable {
         kind: Kind,
         description: &'static str,
     ) -> Self {
-        Variable { name, vr, description, causality, variability, initial, kind, depends_on: &[], initial_depends_on: None }
+        Variable {
+            name,
+            vr,
+            description,
+            causality,
+            variability,
+            initial,
+            kind,
+            depends_on: &[],
+            initial_depends_on: None,
+            clocked: false,
+            previous: None,
+        }
     }
 
     /// A tunable Real parameter from its physical description.
@@ -162,6 +186,27 @@ impl Variable {
         Self::new(name, vr, Causality::Parameter, Variability::Fixed, Initial::Exact, kind, description)
     }
 
+    /// An input Clock with a constant interval and shift [s] (FMI 3.0 `<Clock causality="input"
+    /// variability="discrete" intervalVariability="constant">`); inactive at the start.
+    pub const fn clock(name: &'static str, vr: u32, (interval, shift): (f64, f64), description: &'static str) -> Self {
+        let kind = Kind::Clock { interval, shift };
+        Self::new(name, vr, Causality::Input, Variability::Discrete, Initial::Exact, kind, description)
+    }
+
+    /// The same variable in the model partition of the model's Clock: discrete-time, changed only
+    /// at the Clock's activations.
+    pub const fn clocked(mut self) -> Self {
+        self.variability = Variability::Discrete;
+        self.clocked = true;
+        self
+    }
+
+    /// The same clocked variable as a clocked state whose previous value is variable `vr`.
+    pub const fn previous(mut self, vr: u32) -> Self {
+        self.previous = Some(vr);
+        self
+    }
+
     /// The same variable, but fixed (settable only before initialisation ends).
     pub const fn fixed(mut self) -> Self {
         self.variability = Variability::Fixed;
@@ -187,6 +232,7 @@ impl Variable {
             Kind::Integer { .. } => BaseType::Integer,
             Kind::Boolean { .. } => BaseType::Boolean,
             Kind::String { .. } => BaseType::String,
+            Kind::Clock { .. } => BaseType::Clock,
         }
     }
 
@@ -202,6 +248,7 @@ impl Variable {
             Kind::Integer { start, .. } => Value::Integer(start),
             Kind::Boolean { start } => Value::Boolean(start),
             Kind::String { start } => Value::String(start.to_owned()),
+            Kind::Clock { .. } => Value::Clock(false),
         }
     }
 }
@@ -213,6 +260,8 @@ pub enum Value {
     Integer(i32),
     Boolean(bool),
     String(String),
+    /// A Clock: whether it is active.
+    Clock(bool),
 }
 
 impl Value {
@@ -223,6 +272,7 @@ impl Value {
             Value::Integer(_) => BaseType::Integer,
             Value::Boolean(_) => BaseType::Boolean,
             Value::String(_) => BaseType::String,
+            Value::Clock(_) => BaseType::Clock,
         }
     }
 }

@@ -48,6 +48,7 @@ impl Version {
             (Version::Fmi3, BaseType::Integer) => "Int32",
             (_, BaseType::Boolean) => "Boolean",
             (_, BaseType::String) => "String",
+            (_, BaseType::Clock) => "Clock",
         }
     }
 }

@@ -2,6 +2,7 @@
 //! contract both FMI versions export.
 
 pub mod boom;
+pub mod clocked_pressure_feedback_controller;
 pub mod boom_mechanics;
 pub mod circuit;
 pub mod hydraulic_boom;
@@ -15,6 +16,7 @@ pub mod terminals;
 pub mod vr;
 
 pub use boom_mechanics::BoomMechanics;
+pub use clocked_pressure_feedback_controller::ClockedPressureFeedbackController;
 pub use hydraulic_boom::HydraulicBoom;
 pub use hydraulic_circuit::HydraulicCircuit;
 pub use pressure_feedback_controller::PressureFeedbackController;

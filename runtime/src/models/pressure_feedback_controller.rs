@@ -32,14 +32,27 @@ pub mod vr {
     pub const P_LP: u32 = 10;
     pub const EXTRAPOLATION: u32 = 11;
     pub const DER_P_LP: u32 = 12;
+    /// The clocked controller's ([`super::super::clocked_pressure_feedback_controller`]): its
+    /// Clock, pressure sample and the previous values of its clocked states.
+    pub const SAMPLE: u32 = 13;
+    pub const P_SAMPLE: u32 = 14;
+    pub const P_LP_PREVIOUS: u32 = 15;
+    pub const P_SAMPLE_PREVIOUS: u32 = 16;
 }
 
 /// Admissible fed-back pressure: absolute zero (gauge) up to 1000 bar, far above the PVG32's
 /// 350 bar rating, so any physical pressure passes and only nonsense is refused.
 const P_RANGE: (f64, f64) = (-1.01325e5, 1e8);
 
-const VARIABLES: &[Variable] = &[
-    Variable::real_input(
+/// The rows the clocked controller ([`super::clocked_pressure_feedback_controller`]) shares, with
+/// the same value references.
+pub(super) mod row {
+    use super::{vr, P_RANGE};
+    use crate::control::FEEDBACK_PARAMS;
+    use crate::fmu::Variable;
+    use crate::params::ParamSpec;
+
+    pub const U_REF: Variable = Variable::real_input(
         "u_ref",
         vr::U_REF,
         0.0,
@@ -47,23 +60,28 @@ const VARIABLES: &[Variable] = &[
         "%",
         (-1.0, 1.0),
         "Operator's spool reference; < 0 lowers the load",
-    ),
-    Variable::real_input("p", vr::P, 0.0, "Pa", "bar", P_RANGE, "Fed-back pressure (p4, rod side / CBV pilot), gauge"),
-    // The filter starts at rest at the initial p (u_comp = 0): in Initialization Mode u depends
-    // on u_ref only.
-    Variable::real_output("u", vr::U, "1", "%", "Spool command u = clamp(u_ref + u_comp, u_min, u_max)")
-        .depends(&[vr::U_REF, vr::P])
-        .initial_depends(&[vr::U_REF]),
-    Variable::real_output("u_comp", vr::U_COMP, "1", "%", "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)")
-        .depends(&[vr::P])
-        .initial_depends(&[]),
-    Variable::param(vr::K_F, FEEDBACK_PARAMS[0].spec),
-    Variable::param(vr::OMEGA_F, FEEDBACK_PARAMS[1].spec),
-    Variable::param(vr::Q_RATED, FEEDBACK_PARAMS[2].spec).fixed(),
-    Variable::bool_param("enable", vr::ENABLE, true, "Feedback on; off gives u = u_ref (experiment U)"),
-    Variable::param(
+    );
+    pub const P: Variable = Variable::real_input(
+        "p",
+        vr::P,
+        0.0,
+        "Pa",
+        "bar",
+        P_RANGE,
+        "Fed-back pressure (p4, rod side / CBV pilot), gauge",
+    );
+    pub const U: Variable =
+        Variable::real_output("u", vr::U, "1", "%", "Spool command u = clamp(u_ref + u_comp, u_min, u_max)");
+    pub const U_COMP: Variable =
+        Variable::real_output("u_comp", vr::U_COMP, "1", "%", "Compensation u_comp = G_f(s) p / Q_rated (eq. 6.2)");
+    pub const K_F: Variable = Variable::param(vr::K_F, FEEDBACK_PARAMS[0].spec);
+    pub const OMEGA_F: Variable = Variable::param(vr::OMEGA_F, FEEDBACK_PARAMS[1].spec);
+    pub const Q_RATED: Variable = Variable::param(vr::Q_RATED, FEEDBACK_PARAMS[2].spec).fixed();
+    pub const ENABLE: Variable =
+        Variable::bool_param("enable", vr::ENABLE, true, "Feedback on; off gives u = u_ref (experiment U)");
+    pub const U_MIN: Variable = Variable::param(
         vr::U_MIN,
-        crate::params::ParamSpec {
+        ParamSpec {
             name: "u_min",
             default: -1.0,
             unit: "1",
@@ -74,10 +92,10 @@ const VARIABLES: &[Variable] = &[
             source: "Full spool opening in the lowering direction (eq. 2.44)",
             integer: false,
         },
-    ),
-    Variable::param(
+    );
+    pub const U_MAX: Variable = Variable::param(
         vr::U_MAX,
-        crate::params::ParamSpec {
+        ParamSpec {
             name: "u_max",
             default: 1.0,
             unit: "1",
@@ -88,14 +106,30 @@ const VARIABLES: &[Variable] = &[
             source: "Full spool opening in the lifting direction (eq. 2.44)",
             integer: false,
         },
-    ),
-    Variable::real_local(
+    );
+    pub const P_LP: Variable = Variable::real_local(
         "filter.p_lp",
         vr::P_LP,
         "Pa",
         "bar",
         "Filter state: low-passed pressure x, x' = omega_f (p - x)",
-    ),
+    );
+}
+
+const VARIABLES: &[Variable] = &[
+    row::U_REF,
+    row::P,
+    // The filter starts at rest at the initial p (u_comp = 0): in Initialization Mode u depends
+    // on u_ref only.
+    row::U.depends(&[vr::U_REF, vr::P]).initial_depends(&[vr::U_REF]),
+    row::U_COMP.depends(&[vr::P]).initial_depends(&[]),
+    row::K_F,
+    row::OMEGA_F,
+    row::Q_RATED,
+    row::ENABLE,
+    row::U_MIN,
+    row::U_MAX,
+    row::P_LP,
     Variable::bool_param(
         "p.extrapolation",
         vr::EXTRAPOLATION,
@@ -131,13 +165,46 @@ plant first and passes the slope (default false: <i>p</i> held). The filter star
 (x = p at the end of initialisation): no kick at t = 0. Defaults: experiment B (K<sub>f</sub> = 1.24e-11 m<sup>4</sup>s<sup>2</sup>/kg,
 &omega;<sub>f</sub> = 35.8 rad/s, Table 7.2).</p>"#;
 
+/// The controller's tunable parameters: the filter of eq. 6.2, the switch and the command's
+/// limits (shared with the clocked controller).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Settings {
+    pub feedback: HighPassFeedback,
+    pub enable: bool,
+    pub u_min: f64,
+    pub u_max: f64,
+}
+
+impl Settings {
+    /// The parameters' values; refuses limits that leave no command.
+    pub fn read(values: &Values) -> Result<Self, String> {
+        let (u_min, u_max) = (values.real(vr::U_MIN), values.real(vr::U_MAX));
+        if u_min >= u_max {
+            return Err(format!("u_min = {u_min} must be less than u_max = {u_max}"));
+        }
+        let feedback = build(HighPassFeedback::default(), &FEEDBACK_PARAMS, |k| values.real(vr::K_F + k as u32));
+        Ok(Settings { feedback, enable: values.boolean(vr::ENABLE), u_min, u_max })
+    }
+
+    /// (u_comp, unclamped u) for the reference `u_ref`, pressure `p` and filter state `x`.
+    pub fn command(&self, u_ref: f64, p: f64, x: f64) -> (f64, f64) {
+        let u_comp = if self.enable { self.feedback.u_comp(p, x) } else { 0.0 };
+        (u_comp, u_ref + u_comp)
+    }
+
+    /// Logs a command beyond the limits (`logSaturation`) at time `t`.
+    pub fn log_saturation(&self, u: f64, t: f64, log: &mut dyn Log) {
+        if u < self.u_min || u > self.u_max {
+            let (lo, hi) = (self.u_min, self.u_max);
+            log.info("logSaturation", &format!("t = {t}: u_ref + u_comp = {u} clamped to [{lo}, {hi}]"));
+        }
+    }
+}
+
 /// The controller's parameters, filter state and fed-back pressure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PressureFeedbackController {
-    feedback: HighPassFeedback,
-    enable: bool,
-    u_min: f64,
-    u_max: f64,
+    settings: Settings,
     /// `p.extrapolation`.
     extrapolate: bool,
     /// Low-passed pressure x [Pa].
@@ -155,11 +222,8 @@ pub struct PressureFeedbackController {
 impl PressureFeedbackController {
     /// The controller with filter state `x`, at rest at the current input p.
     fn from_values(values: &Values, x: f64) -> Result<Self, String> {
-        let mut c = PressureFeedbackController {
-            feedback: HighPassFeedback::default(),
-            enable: true,
-            u_min: -1.0,
-            u_max: 1.0,
+        let c = PressureFeedbackController {
+            settings: Settings::read(values)?,
             extrapolate: values.boolean(vr::EXTRAPOLATION),
             x,
             t: 0.0,
@@ -167,7 +231,6 @@ impl PressureFeedbackController {
             sampled: false,
             fresh: true,
         };
-        c.retune(values)?;
         Ok(c)
     }
 
@@ -183,8 +246,7 @@ impl PressureFeedbackController {
 
     /// (u_comp, unclamped u) for pressure `p`.
     fn command(&self, values: &Values, p: f64) -> (f64, f64) {
-        let u_comp = if self.enable { self.feedback.u_comp(p, self.x) } else { 0.0 };
-        (u_comp, values.real(vr::U_REF) + u_comp)
+        self.settings.command(values.real(vr::U_REF), p, self.x)
     }
 
     /// The pressure over the step from `t` of length `h`: the input with the master's slope;
@@ -235,19 +297,14 @@ impl Model for PressureFeedbackController {
 
     /// Re-reads the tunable parameters; keeps the filter state and the pressure samples.
     fn retune(&mut self, values: &Values) -> Result<(), String> {
-        let (u_min, u_max) = (values.real(vr::U_MIN), values.real(vr::U_MAX));
-        if u_min >= u_max {
-            return Err(format!("u_min = {u_min} must be less than u_max = {u_max}"));
-        }
-        self.feedback = build(self.feedback, &FEEDBACK_PARAMS, |k| values.real(vr::K_F + k as u32));
-        (self.enable, self.u_min, self.u_max) = (values.boolean(vr::ENABLE), u_min, u_max);
+        self.settings = Settings::read(values)?;
         Ok(())
     }
 
     fn outputs(&self, values: &mut Values) {
         let (u_comp, u) = self.command(values, self.pressure(values));
         values.set_real(vr::U_COMP, u_comp);
-        values.set_real(vr::U, u.clamp(self.u_min, self.u_max));
+        values.set_real(vr::U, u.clamp(self.settings.u_min, self.settings.u_max));
         values.set_real(vr::P_LP, self.x);
     }
 
@@ -262,7 +319,7 @@ impl Model for PressureFeedbackController {
 
     /// The filter of eq. 6.2 (Model Exchange: p is the input as set; the exact discretisation of [`HighPassFeedback::advance`] is the Co-Simulation step's).
     fn derivatives(&self, values: &Values, dx: &mut [f64]) {
-        dx[0] = self.feedback.state_derivative(values.real(vr::P), self.x);
+        dx[0] = self.settings.feedback.state_derivative(values.real(vr::P), self.x);
     }
 
     fn inputs_set(&mut self, vrs: &[u32]) {
@@ -278,24 +335,11 @@ impl Model for PressureFeedbackController {
     fn begin_step(&mut self, step: &StepStart<'_>, log: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
         let (values, t, h) = (step.values, step.t, step.h);
         let p = self.pressure_ramp(step);
-        self.x = self.feedback.advance(self.x, p.at(t), p.slope, h);
+        self.x = self.settings.feedback.advance(self.x, p.at(t), p.slope, h);
         (self.p, self.sampled, self.fresh, self.t) = (p, true, false, t + h);
         let (_, u) = self.command(values, p.at(self.t));
-        if u < self.u_min || u > self.u_max {
-            log.info(
-                "logSaturation",
-                &format!("t = {}: u_ref + u_comp = {u} clamped to [{}, {}]", t + h, self.u_min, self.u_max),
-            );
-        }
+        self.settings.log_saturation(u, self.t, log);
         Ok(Step::Done)
-    }
-
-    fn scale(_: &()) -> Vec<f64> {
-        Vec::new()
-    }
-
-    fn state(&self) -> &[f64] {
-        &[]
     }
 
     /// The filter state, the time, the pressure ramp (t0, p, slope) and two flags (0/1).

@@ -71,7 +71,7 @@ pub fn parameter_change(arg: &str) -> Result<(&'static Variable, Value), String>
         BaseType::Real => Value::Real(text.parse().map_err(|_| bad())?),
         BaseType::Integer => Value::Integer(text.parse().map_err(|_| bad())?),
         BaseType::Boolean => Value::Boolean(text.parse().map_err(|_| bad())?),
-        BaseType::String => return Err(bad()),
+        BaseType::String | BaseType::Clock => return Err(bad()),
     };
     in_range(v, &value).map_err(|e| format!("--set {arg}: {e}"))?;
     Ok((v, value))

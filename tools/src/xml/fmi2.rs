@@ -28,6 +28,7 @@ fn type_attrs(v: &Variable) -> (&'static str, Attrs) {
         }
         Kind::Boolean { start: s } => ("Boolean", if start { vec![("start", s.to_string())] } else { vec![] }),
         Kind::String { start: s } => ("String", if start { vec![("start", s.into())] } else { vec![] }),
+        Kind::Clock { .. } => unreachable!("FMI 2.0 has no Clocks: a model with one is packed as FMI 3.0 only"),
     }
 }
 

@@ -17,7 +17,8 @@ use crate::xml::{
 };
 use boomsim::fmu::guid::token;
 use boomsim::fmu::instance::INDEPENDENT_VR;
-use boomsim::fmu::model::Model;
+use boomsim::fmu::log::num;
+use boomsim::fmu::model::{clock_row, Model};
 use boomsim::fmu::structure::probe;
 use boomsim::fmu::variables::{Causality, Kind, Variable};
 use std::io;
@@ -94,7 +95,21 @@ fn variable<M: Model>(v: &Variable) -> (&'static str, Attrs, Option<String>) {
         }
         // FMI 3.0 writes a String's start value as a <Start> child.
         Kind::String { start: s } => ("String", start.then(|| s.to_owned())),
+        // A constant periodic input Clock (2.4.7.5): no start value.
+        Kind::Clock { interval, shift } => {
+            a.push(("intervalVariability", "constant".into()));
+            a.push(("intervalDecimal", num(interval)));
+            a.push(("shiftDecimal", num(shift)));
+            ("Clock", None)
+        }
     };
+    // A clocked variable names its Clock (`clocks`), a clocked state its previous value.
+    if let (true, Some(row)) = (v.clocked, clock_row::<M>()) {
+        a.push(("clocks", M::VARIABLES[row].vr.to_string()));
+    }
+    if let Some(previous) = v.previous {
+        a.push(("previous", previous.to_string()));
+    }
     (name, a, string_start)
 }
 
@@ -121,16 +136,21 @@ fn write<M: Model>() -> io::Result<String> {
             ("providesEvaluateDiscreteStates", flag(false)),
         ]);
         element(w, "ModelExchange", &me)?;
-        let cs = interface(vec![
-            ("canHandleVariableCommunicationStepSize", flag(true)),
-            ("maxOutputDerivativeOrder", "0".into()),
-            ("providesIntermediateUpdate", flag(false)),
-            ("mightReturnEarlyFromDoStep", flag(false)),
-            ("canReturnEarlyAfterIntermediateUpdate", flag(false)),
-            ("hasEventMode", flag(false)),
-            ("providesEvaluateDiscreteStates", flag(false)),
-        ]);
-        element(w, "CoSimulation", &cs)?;
+        // A model with a Clock is Model Exchange only: its Co-Simulation would need Event Mode.
+        let cs = clock_row::<M>().is_none().then(|| {
+            interface(vec![
+                ("canHandleVariableCommunicationStepSize", flag(true)),
+                ("maxOutputDerivativeOrder", "0".into()),
+                ("providesIntermediateUpdate", flag(false)),
+                ("mightReturnEarlyFromDoStep", flag(false)),
+                ("canReturnEarlyAfterIntermediateUpdate", flag(false)),
+                ("hasEventMode", flag(false)),
+                ("providesEvaluateDiscreteStates", flag(false)),
+            ])
+        });
+        if let Some(cs) = cs {
+            element(w, "CoSimulation", &cs)?;
+        }
         unit_definitions::<M>(w, &["s"])?;
         type_definitions::<M>(w)?;
         log_categories::<M>(w, |d| d.replace("fmi2", "fmi3"))?;
@@ -162,8 +182,8 @@ fn write<M: Model>() -> io::Result<String> {
 }
 
 /// FMI 3.0, 2.4.8: Output, ContinuousStateDerivative (in the order of the state vector),
-/// InitialUnknown and EventIndicator (in the order of fmi3GetEventIndicators), each with its
-/// dependencies by value reference.
+/// ClockedState (without `dependencies`: on every known), InitialUnknown and EventIndicator (in
+/// the order of fmi3GetEventIndicators), each with its dependencies by value reference.
 fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
     let structure = probe::<M>();
     let deps = dependencies::<M>(&structure);
@@ -176,6 +196,9 @@ fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
         }
         for s in M::STATES {
             unknown(w, "ContinuousStateDerivative", s.derivative, &deps[&s.derivative])?;
+        }
+        for v in M::VARIABLES.iter().filter(|v| v.previous.is_some()) {
+            element(w, "ClockedState", &vec![("valueReference", v.vr.to_string())])?;
         }
         for (vr, deps) in &initial_unknowns::<M>(&structure) {
             unknown(w, "InitialUnknown", *vr, deps)?;
