@@ -15,7 +15,7 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version
 
 from .errors import Skip, UsageError
-from .paths import MODELS, fmu
+from .paths import FMI3_MODELS, MODELS, fmu
 from .result import Result
 from .scenarios import load_scenario, scenario_ids
 
@@ -24,7 +24,7 @@ try:
 except PackageNotFoundError:  # running from a checkout without an install
     __version__ = "unknown"
 
-__all__ = ["MODELS", "Result", "Skip", "UsageError", "fmu", "load_scenario", "regress", "run", "scenario_ids",
+__all__ = ["FMI3_MODELS", "MODELS", "Result", "Skip", "UsageError", "fmu", "load_scenario", "regress", "run", "scenario_ids",
            "sweep", "__version__"]
 
 INTERFACES = ("cs", "me", "native")

@@ -11,6 +11,45 @@ from .result import COLUMNS, PLANT_OUT, Result
 from .scenarios import controller_start, reference
 
 
+class Integrator:
+    """fmpy's CVode (BDF, dense Newton with difference-quotient Jacobian, rtol `tolerance`, atol =
+    rtol x the nominals) over an ODE given by its callbacks from t = 0, stepped to output points
+    with a restart at every state event."""
+
+    def __init__(self, nx: int, nz: int, tolerance: float, get_x, set_x, get_dx, get_z, get_nominals, set_time):
+        from fmpy.sundials import CVodeSolver
+
+        class NoInput:
+            def apply(self, t):
+                pass
+
+        self.now = 0.0
+
+        def at(t):
+            self.now = t
+            set_time(t)
+
+        self.set_time = at
+        self.solver = CVodeSolver(nx=nx, nz=nz, get_x=get_x, set_x=set_x, get_dx=get_dx, get_z=get_z,
+                                  get_nominals=get_nominals, set_time=at, input=NoInput(), startTime=0.0,
+                                  relativeTolerance=tolerance, maxNumSteps=100000)
+
+    def advance(self, t: float, on_event) -> None:
+        """Integrates to `t`; at each state event on the way `on_event()` (in the event's time)
+        and a restart."""
+        while True:
+            event, _, t_reached = self.solver.step(self.now, t)
+            self.set_time(t_reached)
+            if not event:
+                return
+            on_event()
+            self.solver.reset(t_reached)
+
+    def reset(self, t: float) -> None:
+        """A restart at `t` (a discontinuity of the right-hand side)."""
+        self.solver.reset(t)
+
+
 def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
            feedback_start: str | None = None, events: bool = True, fmi: int = 2,
            params: dict | None = None) -> Result:
@@ -26,7 +65,6 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     state events (`events`). `fmi` 3: the FMI 3.0 FMUs (the same event indicators); `params`: as
     for `run`."""
     from ctypes import POINTER, c_double
-    from fmpy.sundials import CVodeSolver
 
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
@@ -74,32 +112,31 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
 
         def get_dx(ptr, _n):
             counts["rhs"] += 1
-            couple(now[0])
+            couple(cvode.now)
             for m, p, n in parts(ptr):
                 m.getDerivatives(p, n)
 
         def get_z(ptr, n):
-            couple(now[0])
+            couple(cvode.now)
             plant.getEventIndicators(ptr, n)
 
         def get_nominals(ptr, _n):
             for m, p, n in parts(ptr):
                 m.getNominalsOfContinuousStates(p, n)
 
-        now = [0.0]
-
         def set_time(t):
-            now[0] = t
             for m in (plant, ctrl):
                 m.setTime(t)
 
-        class NoInput:
-            def apply(self, t):
-                pass
+        def state_event():
+            # Nothing is reinitialised (no discrete states), CVode restarts.
+            counts["events"] += 1
+            for m in (plant, ctrl):
+                m.enterEventMode()
+                m.newDiscreteStates()
+                m.enterContinuousTimeMode()
 
-        solver = CVodeSolver(nx=np_ + nc, nz=nz, get_x=get_x, set_x=set_x, get_dx=get_dx,
-                             get_z=get_z, get_nominals=get_nominals, set_time=set_time,
-                             input=NoInput(), startTime=0.0, relativeTolerance=tolerance, maxNumSteps=100000)
+        cvode = Integrator(np_ + nc, nz, tolerance, get_x, set_x, get_dx, get_z, get_nominals, set_time)
         breaks = set(np.round(table[:, 0], 9))
         out_p = [vp[k] for k in PLANT_OUT]
         i_cbv = PLANT_OUT.index("cbv.u_cbv")
@@ -108,18 +145,8 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
         n = int(round(t_end / 1e-3))
         for k in range(n + 1):
             t = k * 1e-3
-            while k > 0:
-                event, _, t_reached = solver.step(now[0], t)
-                set_time(t_reached)
-                if not event:
-                    break
-                # A state event: nothing is reinitialised (no discrete states), CVode restarts.
-                counts["events"] += 1
-                for m in (plant, ctrl):
-                    m.enterEventMode()
-                    m.newDiscreteStates()
-                    m.enterContinuousTimeMode()
-                solver.reset(t_reached)
+            if k > 0:
+                cvode.advance(t, state_event)
             couple(t)
             y = plant.getReal(out_p)
             u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])
@@ -135,7 +162,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
                 p4 = np.array([plant.getReal([vp["p4"]])[0]])
                 ctrl.setContinuousStates(p4.ctypes.data_as(POINTER(c_double)), 1)
             if restart:
-                solver.reset(t)
+                cvode.reset(t)
         data = np.array(rows)
     finally:
         release(plant, ctrl)

@@ -24,6 +24,8 @@ BOOMSIM = CHECKOUT / "target" / "release" / "boomsim" if CHECKOUT else None
 OUT = CHECKOUT / "out" if CHECKOUT else pathlib.Path("out")
 
 MODELS = ("HydraulicBoom", "PressureFeedbackController", "HydraulicCircuit", "BoomMechanics")
+#: The FMI 3.0 FMUs: every model's, and the controller sampled by a Clock (FMI 3.0 Model Exchange only).
+FMI3_MODELS = (*MODELS, "ClockedPressureFeedbackController")
 
 
 def fmu_dir() -> pathlib.Path:
@@ -35,12 +37,13 @@ def fmu_dir() -> pathlib.Path:
 
 
 def fmu(model: str, fmi: int = 2) -> pathlib.Path:
-    """The path of `model`'s .fmu (one of MODELS) for FMI `fmi` 2 or 3; a UsageError names a
-    missing file and how to make it."""
-    if model not in MODELS:
-        raise UsageError(f"unknown model \"{model}\": one of {', '.join(MODELS)}")
+    """The path of `model`'s .fmu (one of MODELS, or of FMI3_MODELS for FMI 3.0) for FMI `fmi` 2
+    or 3; a UsageError names a missing file and how to make it."""
     if fmi not in (2, 3):
         raise UsageError(f"fmi={fmi!r}: 2 (FMI 2.0) or 3 (FMI 3.0)")
+    if model not in (MODELS if fmi == 2 else FMI3_MODELS):
+        known = ", ".join(MODELS) + (f" (FMI 3.0 also {FMI3_MODELS[-1]})" if fmi == 2 else f", {FMI3_MODELS[-1]}")
+        raise UsageError(f"unknown model \"{model}\" in FMI {fmi}.0: one of {known}")
     path = fmu_dir() / ("fmi3" if fmi == 3 else "") / f"{model}.fmu"
     if not path.exists():
         fix = ("run `cargo build --release && target/release/boomsim pack`" if CHECKOUT
