@@ -29,6 +29,7 @@ from .fmus import FmuFile, boom_switch, initialize_plant, release, with_params
 from .model_exchange import Integrator
 from .paths import OUT
 from .result import COLUMNS, PLANT_OUT, Result, write_csv
+from . import rig_loop
 from .rig_loop import MODELS
 from .scenarios import controller_start, load_scenario, reference
 
@@ -48,21 +49,26 @@ def clock(ctrl_f: FmuFile, ctrl):
 
 
 def run_clocked(scenario: dict, boom: str = "rigid", stop_time: float | None = None, tolerance: float = 1e-6,
-                params: dict | None = None) -> Result:
+                params: dict | None = None, interface: str = "me") -> Result:
     """The scenario variant with the sampled controller (feedback from t0, as the rig runs it),
-    rows every millisecond. `params`: FMU parameters by name (HydraulicBoom's or the
-    controller's). `counts`: CVode's right-hand sides (`rhs`), state events (`events`) and the
-    Clock's activations (`ticks`)."""
+    rows every millisecond. `interface` "me": both FMUs in Model Exchange, the plant under CVode,
+    the Clock's activations time events; "cs": both in Co-Simulation, the plant stepped by 1 ms
+    with the command held, the controller with Event Mode (eventModeUsed) stepped to each
+    activation, which it handles in Event Mode. `params`: FMU parameters by name (HydraulicBoom's
+    or the controller's). `counts`: the plant's right-hand sides (`rhs`: CVode's, or the FMU's
+    integrator's), CVode's state events (`events`) and the Clock's activations (`ticks`)."""
+    if interface not in ("me", "cs"):
+        raise UsageError(f"interface={interface!r}: \"me\" (Model Exchange) or \"cs\" (Co-Simulation with Event Mode)")
+    me = interface == "me"
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", 3), FmuFile.get(CONTROLLER, 3)
     switch = boom_switch(plant_f, boom)
     scenario, ctrl_params = with_params(scenario, plant_f, params)
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     table = scenario["reference"]
-    plant = plant_f.model(f"{scenario['id']}.plant")
-    ctrl = ctrl_f.model(f"{scenario['id']}.controller")
+    name = scenario["id"]
+    plant = plant_f.model(f"{name}.plant") if me else plant_f.slave(f"{name}.plant")
+    ctrl = ctrl_f.model(f"{name}.controller") if me else ctrl_f.slave(f"{name}.controller", event_mode=True)
     vp, vc = plant_f.vr, ctrl_f.vr
-    nx = len(plant_f.md.derivatives)
-    nz = plant_f.md.numberOfEventIndicators
     counts = {"rhs": 0, "events": 0, "ticks": 0}
     try:
         initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
@@ -70,76 +76,105 @@ def run_clocked(scenario: dict, boom: str = "rigid", stop_time: float | None = N
         per_tick = round(interval / 1e-3)
         if abs(per_tick * 1e-3 - interval) > 1e-12 or abs(shift - interval) > 1e-12:
             raise UsageError(f"the Clock's interval {interval} s and shift {shift} s must be one multiple of 1 ms")
-        for name, value in controller_start(scenario, ctrl_params).items():
-            ctrl_f.set(ctrl, name, value)
+        for key, value in controller_start(scenario, ctrl_params).items():
+            ctrl_f.set(ctrl, key, value)
         ctrl_f.set(ctrl, "enable", bool(scenario["controller"]["enable"]))
         ctrl.setReal([vc["p"], vc["u_ref"]], [plant.getReal([vp["p4"]])[0], reference(table, 0.0)])
         u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])  # clocked: readable in Initialization Mode
-        ctrl.exitInitializationMode()
+        ctrl.exitInitializationMode()  # Event Mode: Model Exchange, and Co-Simulation with eventModeUsed
         plant.setReal([vp["valve.u_ref"]], [u])
-        for m in (plant, ctrl):
-            m.newDiscreteStates()
-            m.enterContinuousTimeMode()
-
-        def get_x(ptr, n):
-            plant.getContinuousStates(ptr, n)
-
-        def set_x(ptr, n):
-            plant.setContinuousStates(ptr, n)
-
-        def get_dx(ptr, n):
-            counts["rhs"] += 1
-            plant.getDerivatives(ptr, n)
-
-        def get_z(ptr, n):
-            plant.getEventIndicators(ptr, n)
-
-        def get_nominals(ptr, n):
-            plant.getNominalsOfContinuousStates(ptr, n)
-
-        def state_event():  # of the plant: no discrete state changes
-            counts["events"] += 1
-            plant.enterEventMode()
+        ctrl.newDiscreteStates()
+        if me:
             plant.newDiscreteStates()
-            plant.enterContinuousTimeMode()
+            for m in (plant, ctrl):
+                m.enterContinuousTimeMode()
+            cvode = plant_integrator(plant_f, plant, tolerance, counts)
+        else:
+            ctrl.enterStepMode()
 
-        cvode = Integrator(nx, nz, tolerance, get_x, set_x, get_dx, get_z, get_nominals, plant.setTime)
+        def activate(t: float):
+            """The Clock's activation at t, the controller already in Event Mode: its command."""
+            counts["ticks"] += 1
+            ctrl.setClock([sample], [True])
+            ctrl.setReal([vc["p"], vc["u_ref"]], [plant.getReal([vp["p4"]])[0], reference(table, t)])
+            command = ctrl.getReal([vc["u"], vc["u_comp"]])
+            ctrl.newDiscreteStates()
+            return command
+
         out_p = [vp[k] for k in PLANT_OUT]
         rows = []
         for k in range(int(round(t_end / 1e-3)) + 1):
             t = k * 1e-3
-            if k > 0:
-                cvode.advance(t, state_event)
-            if k > 0 and k % per_tick == 0:
-                # The Clock's activation: a time event of both FMUs.
-                counts["ticks"] += 1
+            tick = k > 0 and k % per_tick == 0
+            if k > 0 and me:
+                cvode.advance(t)
+            elif k > 0:
+                plant.doStep(t - 1e-3, 1e-3)
+                ctrl.doStep(t - 1e-3, 1e-3)
+            if tick and me:
+                # A time event of both FMUs.
                 ctrl.setTime(t)
                 for m in (plant, ctrl):
                     m.enterEventMode()
-                ctrl.setClock([sample], [True])
-                ctrl.setReal([vc["p"], vc["u_ref"]], [plant.getReal([vp["p4"]])[0], reference(table, t)])
-                u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])
+                u, u_comp = activate(t)
                 plant.setReal([vp["valve.u_ref"]], [u])
+                plant.newDiscreteStates()
                 for m in (ctrl, plant):
-                    m.newDiscreteStates()
                     m.enterContinuousTimeMode()
                 cvode.reset(t)
+            elif tick:
+                ctrl.enterEventMode()
+                u, u_comp = activate(t)
+                ctrl.enterStepMode()
+                plant.setReal([vp["valve.u_ref"]], [u])
             rows.append([t, reference(table, t), u_comp, u, *plant.getReal(out_p)])
         data = np.array(rows)
+        if not me:
+            counts["rhs"] = int(plant.getReal([vp["solver.rhs_evals"]])[0])
     finally:
         release(plant, ctrl)
+    how = f"Model Exchange, CVode rtol {tolerance:g}" if me else "Co-Simulation with Event Mode, 1 ms"
     return Result(scenario, boom, interval, False, {c: data[:, i] for i, c in enumerate(COLUMNS)}, 0.0, "t0",
-                  counts=counts, interface=f"Model Exchange + {interval * 1e3:g} ms Clock, CVode rtol {tolerance:g}")
+                  counts=counts, interface=f"{how} + {interval * 1e3:g} ms Clock")
+
+
+def plant_integrator(plant_f: FmuFile, plant, tolerance: float, counts: dict) -> Integrator:
+    """CVode over the plant's Model Exchange instance alone; a state event (the plant's: no
+    discrete state changes) counted in `counts["events"]`, each right-hand side in `rhs`."""
+
+    def get_dx(ptr, n):
+        counts["rhs"] += 1
+        plant.getDerivatives(ptr, n)
+
+    def state_event():
+        counts["events"] += 1
+        plant.enterEventMode()
+        plant.newDiscreteStates()
+        plant.enterContinuousTimeMode()
+
+    return Integrator(len(plant_f.md.derivatives), plant_f.md.numberOfEventIndicators, tolerance,
+                      plant.getContinuousStates, plant.setContinuousStates, get_dx, plant.getEventIndicators,
+                      plant.getNominalsOfContinuousStates, plant.setTime, state_event)
+
+
+#: The runs of the table: label -> run_clocked's interface (None: rig_loop's 5 ms Co-Simulation).
+RUNS = {"Clock in Model Exchange": "me", "Clock in Co-Simulation with Event Mode": "cs", "5 ms Co-Simulation": None}
+
+
+def runs_of(scenario: dict, model: str) -> dict:
+    """Experiment `scenario` with valve model `model` (rig_loop.MODELS) in each of RUNS."""
+    return {label: run_clocked(scenario, params=MODELS[model], interface=i) if i else rig_loop.run(scenario, model)
+            for label, i in RUNS.items()}
 
 
 def table(runs: dict) -> str:
-    """The Markdown table of docs/interfaces.md: per valve model (rig_loop.MODELS) its runs
-    {model: (clocked Result, Co-Simulation Result)}: speed against the rated one, p3 peak-to-peak
-    of the last third, dominant frequency, 2 % settling time, and the Clock's activations."""
+    """The Markdown table of docs/interfaces.md: per valve model its runs_of: speed against the
+    rated one, p3 peak-to-peak of the last third, dominant frequency, 2 % settling time, and the
+    Clock's activations."""
     lines = ["| B, rigid boom | speed / rated | p3 pp late (bar) | f (Hz) | settled (s) | activations |",
              "| --- | --- | --- | --- | --- | --- |"]
-    for model, pair in runs.items():
-        for res, how in zip(pair, ("Clock in Model Exchange", "5 ms Co-Simulation")):
+    for model, by_run in runs.items():
+        for how, res in by_run.items():
             m = metrics.compute(res)
             settled = "-" if m["t_settle"] is None else f"{m['t_settle']:.2f}"
             ticks = res.counts.get("ticks", "")
@@ -153,11 +188,13 @@ def main(argv=None) -> int:
     ap.add_argument("scenario", help="scenario file or id (e.g. B)")
     ap.add_argument("--model", choices=list(MODELS), default="PVES loop", help="valve electronics (rig_loop.MODELS)")
     ap.add_argument("--boom", choices=["rigid", "flexible"], default="rigid")
+    ap.add_argument("--interface", choices=["me", "cs"], default="me",
+                    help="Model Exchange (CVode, activations as time events) or Co-Simulation with Event Mode")
     ap.add_argument("--stop-time", type=float)
     ap.add_argument("--out", type=pathlib.Path, default=OUT / "clocked")
     args = ap.parse_args(argv)
     sc = load_scenario(args.scenario)
-    res = run_clocked(sc, args.boom, args.stop_time, params=MODELS[args.model])
+    res = run_clocked(sc, args.boom, args.stop_time, params=MODELS[args.model], interface=args.interface)
     m = metrics.compute(res)
     args.out.mkdir(parents=True, exist_ok=True)
     path = args.out / f"{sc['id']}-{args.boom}.csv"

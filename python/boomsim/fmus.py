@@ -87,9 +87,10 @@ class FmuFile:
             cls._cache[identifier, fmi] = FmuFile(identifier, fmi=fmi)
         return cls._cache[identifier, fmi]
 
-    def _instance(self, interface: str, name: str):
+    def _instance(self, interface: str, name: str, **instantiate):
         """An instantiated fmpy instance of `interface` ("CoSimulation" or "ModelExchange"),
-        FMI 3.0 ones behind the FMI 2.0 method names (class Fmi3)."""
+        FMI 3.0 ones behind the FMI 2.0 method names (class Fmi3); `instantiate`: the arguments
+        of fmpy's instantiate."""
         from fmpy import fmi2, fmi3
 
         kind = "Slave" if interface == "CoSimulation" else "Model"
@@ -97,12 +98,12 @@ class FmuFile:
         description = self.md.coSimulation if interface == "CoSimulation" else self.md.modelExchange
         i = cls(guid=self.md.guid, unzipDirectory=self.dir,
                 modelIdentifier=description.modelIdentifier, instanceName=name)
-        i.instantiate()
+        i.instantiate(**instantiate)
         return Fmi3(i) if self.fmi == 3 else i
 
-    def slave(self, name: str):
-        """A Co-Simulation instance."""
-        return self._instance("CoSimulation", name)
+    def slave(self, name: str, event_mode: bool = False):
+        """A Co-Simulation instance; `event_mode`: FMI 3.0 with Event Mode (eventModeUsed)."""
+        return self._instance("CoSimulation", name, **({"eventModeUsed": True} if event_mode else {}))
 
     def model(self, name: str):
         """A Model Exchange instance."""

@@ -13,10 +13,11 @@ from .scenarios import controller_start, reference
 
 class Integrator:
     """fmpy's CVode (BDF, dense Newton with difference-quotient Jacobian, rtol `tolerance`, atol =
-    rtol x the nominals) over an ODE given by its callbacks from t = 0, stepped to output points
-    with a restart at every state event."""
+    rtol x the nominals) over an ODE given by its callbacks from t = 0, stepped to output points;
+    at every state event `on_event()` (in the event's time) and a restart."""
 
-    def __init__(self, nx: int, nz: int, tolerance: float, get_x, set_x, get_dx, get_z, get_nominals, set_time):
+    def __init__(self, nx: int, nz: int, tolerance: float, get_x, set_x, get_dx, get_z, get_nominals, set_time,
+                 on_event):
         from fmpy.sundials import CVodeSolver
 
         class NoInput:
@@ -29,20 +30,19 @@ class Integrator:
             self.now = t
             set_time(t)
 
-        self.set_time = at
+        self.set_time, self.on_event = at, on_event
         self.solver = CVodeSolver(nx=nx, nz=nz, get_x=get_x, set_x=set_x, get_dx=get_dx, get_z=get_z,
                                   get_nominals=get_nominals, set_time=at, input=NoInput(), startTime=0.0,
                                   relativeTolerance=tolerance, maxNumSteps=100000)
 
-    def advance(self, t: float, on_event) -> None:
-        """Integrates to `t`; at each state event on the way `on_event()` (in the event's time)
-        and a restart."""
+    def advance(self, t: float) -> None:
+        """Integrates to `t` through the state events on the way."""
         while True:
             event, _, t_reached = self.solver.step(self.now, t)
             self.set_time(t_reached)
             if not event:
                 return
-            on_event()
+            self.on_event()
             self.solver.reset(t_reached)
 
     def reset(self, t: float) -> None:
@@ -136,7 +136,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
                 m.newDiscreteStates()
                 m.enterContinuousTimeMode()
 
-        cvode = Integrator(np_ + nc, nz, tolerance, get_x, set_x, get_dx, get_z, get_nominals, set_time)
+        cvode = Integrator(np_ + nc, nz, tolerance, get_x, set_x, get_dx, get_z, get_nominals, set_time, state_event)
         breaks = set(np.round(table[:, 0], 9))
         out_p = [vp[k] for k in PLANT_OUT]
         i_cbv = PLANT_OUT.index("cbv.u_cbv")
@@ -146,7 +146,7 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
         for k in range(n + 1):
             t = k * 1e-3
             if k > 0:
-                cvode.advance(t, state_event)
+                cvode.advance(t)
             couple(t)
             y = plant.getReal(out_p)
             u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])

@@ -233,14 +233,14 @@ fn an_instant_recomputed_with_new_inputs_starts_from_the_previous_values() {
     }
 }
 
-/// The FMU is FMI 3.0 Model Exchange only: Co-Simulation would need Event Mode for the Clock
-/// (FMI 3.0, 2.3.1: "For FMUs that have clocks, eventModeUsed = fmi3True is required"; 4.4:
-/// hasEventMode), which it does not provide, and FMI 2.0 has no Clocks. Both are refused with a
-/// message; an FMU state taken between activations resumes bit for bit.
+/// FMI 2.0 has no Clocks, and FMI 3.0 Co-Simulation needs Event Mode for one (2.3.1: "For FMUs
+/// that have clocks, eventModeUsed = fmi3True is required"): fmi2Instantiate and
+/// fmi3InstantiateCoSimulation without eventModeUsed are refused with a message. An FMU state
+/// taken between activations resumes bit for bit.
 #[test]
-fn only_model_exchange_of_fmi3_instantiates_and_states_resume() {
-    let e = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), true).err().expect("Co-Simulation refused");
-    assert!(e.iter().any(|m| m.contains("provides Model Exchange only")), "{e:?}");
+fn fmi2_and_co_simulation_without_event_mode_are_refused_and_states_resume() {
+    let e = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), false).err().expect("Co-Simulation refused");
+    assert!(e.iter().any(|m| m.contains("eventModeUsed = false, but the FMU has a Clock")), "{e:?}");
     let messages = Box::new(crate::common::Messages::default());
     let callbacks = crate::common::callbacks(&messages);
     let (name, guid) = (CString::new("i2").unwrap(), CString::new(token::<Cpfc>()).unwrap());
@@ -264,4 +264,48 @@ fn only_model_exchange_of_fmi3_instantiates_and_states_resume() {
     }
     let again: Vec<_> = (11..=20).map(|k| tick(&i, k as f64 * T, ramp(k))).collect();
     assert_eq!(first, again);
+}
+
+/// Co-Simulation with Event Mode (FMI 3.0, 4.2: initialisation ends in Event Mode;
+/// fmi3EnterStepMode, fmi3DoStep to the activation, fmi3EnterEventMode, the Clock and its
+/// variables, fmi3UpdateDiscreteStates): the commands of Model Exchange bit for bit (one model).
+/// A step past an activation is refused naming it (the importer activates a time-based Clock at
+/// its times, 2.2.8.2), and so is fmi3EnterStepMode before the instant ended (2.3.5).
+#[test]
+fn co_simulation_with_event_mode_gives_the_commands_of_model_exchange() {
+    let me = running(50e5, -0.05);
+    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), true).expect("Co-Simulation with Event Mode");
+    unsafe {
+        assert_eq!(api::enter_initialization_mode::<Cpfc>(cs.c, false, 0.0, 0.0, false, 0.0), OK);
+        assert_eq!((cs.set(vr::P, 50e5), cs.set(vr::U_REF, -0.05)), (OK, OK));
+        assert_eq!(api::exit_initialization_mode::<Cpfc>(cs.c), OK);
+        assert!(!clock(&cs), "in Event Mode after initialisation");
+        assert_eq!(update(&cs), OK);
+        assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), OK);
+    }
+    for k in 1..=40 {
+        let (t, p) = (k as f64 * T, 50e5 + 1e4 * (k * k) as f64);
+        assert_eq!(cs.step(t - T, T), OK, "{}", cs.last_error());
+        unsafe { assert_eq!(api::enter_event_mode::<Cpfc>(cs.c), OK, "{}", cs.last_error()) };
+        assert_eq!(set_clock(&cs, true), OK, "{}", cs.last_error());
+        assert_eq!(cs.set(vr::P, p), OK);
+        let read = (cs.get(vr::U), cs.get(vr::U_COMP));
+        assert_eq!(update(&cs), OK);
+        unsafe { assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), OK) };
+        assert_eq!(read, tick(&me, t, p), "t = {t}");
+    }
+    assert_eq!(cs.step(40.0 * T, 1.5 * T), ERR, "past the activation at 41 T");
+    assert!(cs.last_error().contains("would pass the Clock's activation at t = 0.205"), "{}", cs.last_error());
+    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), true).unwrap();
+    unsafe {
+        assert_eq!(api::enter_initialization_mode::<Cpfc>(cs.c, false, 0.0, 0.0, false, 0.0), OK);
+        assert_eq!(api::exit_initialization_mode::<Cpfc>(cs.c), OK);
+        assert_eq!(update(&cs), OK);
+        assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), OK);
+        assert_eq!(cs.step(0.0, T), OK);
+        assert_eq!(api::enter_event_mode::<Cpfc>(cs.c), OK);
+        assert_eq!(set_clock(&cs, true), OK);
+        assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), ERR, "the instant has not ended");
+    }
+    assert!(cs.last_error().contains("end the instant with fmi3UpdateDiscreteStates"), "{}", cs.last_error());
 }

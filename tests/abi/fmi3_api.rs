@@ -108,7 +108,7 @@ impl<M: Model> Inst<M> {
         x
     }
 
-    fn step(&self, t: f64, h: f64) -> fmi3Status {
+    pub(crate) fn step(&self, t: f64, h: f64) -> fmi3Status {
         let (mut e, mut term, mut early, mut last) = (true, true, true, f64::NAN);
         let status = unsafe { api::do_step::<M>(self.c, t, h, true, (&mut e, &mut term, &mut early), &mut last) };
         if status == OK {

@@ -179,7 +179,7 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
         (
             "Interfaces",
             match clock_row::<M>() {
-                Some(_) => format!("{fmi} Model Exchange (with a Clock)"),
+                Some(_) => format!("{fmi} Model Exchange and Co-Simulation with Event Mode (a Clock)"),
                 None => format!("{fmi} Model Exchange and Co-Simulation"),
             },
         ),

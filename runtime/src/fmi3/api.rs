@@ -47,7 +47,7 @@ pub fn get_version() -> *const c_char {
 /// failure.
 unsafe fn instantiate<M: Model>(
     function: &str,
-    interface: Interface,
+    (interface, event_mode_used): (Interface, bool),
     (name, instantiation_token): (fmi3String, fmi3String),
     logging_on: bool,
     (environment, log_message): (fmi3InstanceEnvironment, fmi3LogMessageCallback),
@@ -63,7 +63,7 @@ unsafe fn instantiate<M: Model>(
             })
             .and_then(|_| more());
         match checked {
-            Ok(()) => calls::new_instance::<M>(logger, expected, Version::Fmi3, interface),
+            Ok(()) => calls::new_instance::<M>(logger, expected, Version::Fmi3, interface, event_mode_used),
             Err(message) => {
                 logger.status(fmi3Status::Error, &format!("{function}: {message}"));
                 std::ptr::null_mut()
@@ -85,7 +85,7 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
     let f = "fmi3InstantiateModelExchange";
     instantiate::<M>(
         f,
-        Interface::ModelExchange,
+        (Interface::ModelExchange, false),
         (name, instantiation_token),
         logging_on,
         (environment, log_message),
@@ -111,13 +111,14 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     _intermediate_update: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
     let more = || {
-        if clock_row::<M>().is_some() {
-            return Err(format!(
-                "{} provides Model Exchange only (its Clock needs Event Mode, which its Co-Simulation would lack)",
-                M::INFO.identifier
-            ));
+        if clock_row::<M>().is_some() && !event_mode_used {
+            return Err(
+                "eventModeUsed = false, but the FMU has a Clock, which needs Event Mode (FMI 3.0, 2.3.1: \"For FMUs \
+                 that have clocks, eventModeUsed = fmi3True is required\")"
+                    .into(),
+            );
         }
-        if event_mode_used {
+        if clock_row::<M>().is_none() && event_mode_used {
             return Err(
                 "eventModeUsed = true, but the FMU has no event mode in Co-Simulation (hasEventMode=\"false\")".into(),
             );
@@ -132,7 +133,7 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     let f = "fmi3InstantiateCoSimulation";
     instantiate::<M>(
         f,
-        Interface::CoSimulation,
+        (Interface::CoSimulation, event_mode_used),
         (name, instantiation_token),
         logging_on,
         (environment, log_message),
@@ -196,8 +197,16 @@ pub unsafe fn exit_initialization_mode<M: Model>(c: fmi3Instance) -> fmi3Status 
     calls::exit_initialization_mode::<M>(c, at("fmi3ExitInitializationMode", allowed::EXIT_INITIALIZATION_MODE))
 }
 
+/// fmi3EnterEventMode: Model Exchange from Continuous-Time Mode, Co-Simulation from Step Mode
+/// when instantiated with `eventModeUsed` (4.2.2).
 pub unsafe fn enter_event_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
-    calls::enter::<M>(c, at("fmi3EnterEventMode", allowed::ENTER_EVENT_MODE), Mode::EventMode)
+    call::<M>(c, at("fmi3EnterEventMode", allowed::ENTER_EVENT_MODE), |inst| {
+        if inst.interface == Interface::CoSimulation && !inst.event_mode_used {
+            return Err("not supported: the instance was instantiated with eventModeUsed = false".into());
+        }
+        inst.core.mode = Mode::EventMode;
+        Ok(fmi3Status::OK)
+    })
 }
 
 pub unsafe fn terminate<M: Model>(c: fmi3Instance) -> fmi3Status {
@@ -538,16 +547,21 @@ pub unsafe fn update_discrete_states<M: Model>(
     })
 }
 
-/// fmi3EnterContinuousTimeMode. With the Clock still active the instant has not ended: refused
-/// (FMI 3.0, 2.3.5: "Each super-dense time instant concludes with a call to
-/// fmi3UpdateDiscreteStates", which deactivates the Clock; the standard leaves this call open).
+/// fmi3EnterContinuousTimeMode.
 pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
     let f = at("fmi3EnterContinuousTimeMode", allowed::ENTER_CONTINUOUS_TIME_MODE);
+    leave_event_mode::<M>(c, f, Mode::ContinuousTimeMode)
+}
+
+/// Leaves Event Mode for `mode`. With the Clock still active the instant has not ended: refused
+/// (FMI 3.0, 2.3.5: "Each super-dense time instant concludes with a call to
+/// fmi3UpdateDiscreteStates", which deactivates the Clock; the standard leaves this call open).
+unsafe fn leave_event_mode<M: Model>(c: fmi3Instance, f: Call, mode: Mode) -> fmi3Status {
     call::<M>(c, f, |inst| {
         if inst.clock_active() {
             return Err("the Clock is active: end the instant with fmi3UpdateDiscreteStates first (FMI 3.0, 2.3.5)".into());
         }
-        inst.core.mode = Mode::ContinuousTimeMode;
+        inst.core.mode = mode;
         Ok(fmi3Status::OK)
     })
 }
@@ -601,9 +615,10 @@ pub unsafe fn get_number_of_continuous_states<M: Model>(c: fmi3Instance, n: *mut
     })
 }
 
-/// fmi3EnterStepMode: only from Event Mode, which these Co-Simulation instances never enter.
+/// fmi3EnterStepMode: from Event Mode, which only a Co-Simulation instance with `eventModeUsed`
+/// enters.
 pub unsafe fn enter_step_mode<M: Model>(c: fmi3Instance) -> fmi3Status {
-    calls::enter::<M>(c, at("fmi3EnterStepMode", allowed::ENTER_STEP_MODE), Mode::StepComplete)
+    leave_event_mode::<M>(c, at("fmi3EnterStepMode", allowed::ENTER_STEP_MODE), Mode::StepComplete)
 }
 
 pub unsafe fn get_output_derivatives<M: Model>(c: fmi3Instance) -> fmi3Status {

@@ -2,10 +2,10 @@
 //! (section 3.2.4) as one table: per function, the interface it belongs to and the set of states
 //! in which it may be called. The states are those of [`crate::fmu::machine`]: `StepComplete` is
 //! FMI 3.0's Step Mode, `StepFailed` its Step Discarded; `StepCanceled` is never entered. There
-//! are no structural parameters and no event mode in Co-Simulation (`hasEventMode="false"`; the
-//! one model with a Clock is Model Exchange only, where its Clock is set in Event Mode), so
+//! are no structural parameters, and Event Mode in Co-Simulation only for the one model with a
+//! Clock (`hasEventMode="true"`, instantiated with `eventModeUsed`, checked per instance), so
 //! Configuration, Reconfiguration, Clock Activation and Intermediate Update Mode are never
-//! entered either.
+//! entered.
 
 pub use crate::fmu::machine::*;
 
@@ -17,8 +17,9 @@ pub mod allowed {
     pub const FREE_INSTANCE: Rule = both(ANY);
     pub const ENTER_INITIALIZATION_MODE: Rule = both(INST);
     pub const EXIT_INITIALIZATION_MODE: Rule = both(INIT);
-    /// Model Exchange from Continuous-Time Mode (Co-Simulation has no Event Mode here).
-    pub const ENTER_EVENT_MODE: Rule = me(CONT);
+    /// Model Exchange from Continuous-Time Mode, Co-Simulation from Step Mode (with
+    /// `eventModeUsed`, checked per instance).
+    pub const ENTER_EVENT_MODE: Rule = both(DONE | CONT);
     pub const TERMINATE: Rule = both(DONE | FAIL | EVENT | CONT);
     pub const RESET: Rule = both(ANY);
     pub const GET: Rule = both(INIT | DONE | FAIL | EVENT | CONT | TERM | ERR);
@@ -33,7 +34,7 @@ pub mod allowed {
     /// clocks and Scheduled Execution; fmi3EvaluateDiscreteStates; per-element dependencies):
     /// every call, in any state, is an error naming why.
     pub const UNSUPPORTED: Rule = both(ANY);
-    pub const UPDATE_DISCRETE_STATES: Rule = me(EVENT);
+    pub const UPDATE_DISCRETE_STATES: Rule = both(EVENT);
     /// fmi3SetClock and fmi3GetClock: Event Mode (2.3.5; a Clock is set there, output Clocks
     /// are read there).
     pub const SET_CLOCK: Rule = both(EVENT);

@@ -176,9 +176,18 @@ pub unsafe fn check_identity(identity: *const c_char, what: &str, kind: &str, ex
     }
 }
 
-/// A new instance on the heap, as the pointer instantiation returns.
-pub fn new_instance<M: Model>(log: Logger, guid: String, version: Version, interface: Interface) -> Handle {
-    Box::into_raw(Box::new(Instance::<M>::new(log, guid, version, interface))) as Handle
+/// A new instance on the heap, as the pointer instantiation returns; `event_mode_used`: FMI 3.0
+/// Co-Simulation with Event Mode.
+pub fn new_instance<M: Model>(
+    log: Logger,
+    guid: String,
+    version: Version,
+    interface: Interface,
+    event_mode_used: bool,
+) -> Handle {
+    let mut instance = Instance::<M>::new(log, guid, version, interface);
+    instance.event_mode_used = event_mode_used;
+    Box::into_raw(Box::new(instance)) as Handle
 }
 
 /// Frees an instance with every FMU state the importer did not free.

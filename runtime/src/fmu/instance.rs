@@ -37,6 +37,9 @@ pub struct Instance<M: Model> {
     pub version: Version,
     /// Model Exchange or Co-Simulation, as instantiated.
     pub interface: Interface,
+    /// FMI 3.0 Co-Simulation with Event Mode (`eventModeUsed`): initialisation ends in Event
+    /// Mode, and fmi3EnterEventMode / fmi3EnterStepMode move between it and Step Mode.
+    pub event_mode_used: bool,
     pub core: Core<M>,
     /// Storage behind the pointers the last fmi2GetString / fmi3GetString returned.
     pub(crate) strings: Vec<std::ffi::CString>,
@@ -94,6 +97,15 @@ impl<M: Model> Default for Core<M> {
     fn default() -> Self {
         Self::new()
     }
+}
+
+/// The first activation of the model's Clock after `t` (None without a Clock): t_start + shift +
+/// i interval, the time within 1e-6 of an interval counting as on it.
+fn next_activation<M: Model>(start: f64, t: f64) -> Option<f64> {
+    let Kind::Clock { interval, shift } = M::VARIABLES[clock_row::<M>()?].kind else { return None };
+    let first = start + shift;
+    let i = ((t - first) / interval + 1e-6).floor().max(-1.0) + 1.0;
+    Some(first + i * interval)
 }
 
 /// Whether the model's Clock is active.
@@ -185,6 +197,7 @@ impl<M: Model> Instance<M> {
             log,
             version,
             interface,
+            event_mode_used: false,
             core: Core::new(),
             strings: Vec::new(),
             guid,
@@ -276,8 +289,8 @@ impl<M: Model> Instance<M> {
         c.derivatives_current = false;
         c.last_successful_time = c.time;
         c.mode = match self.interface {
-            Interface::CoSimulation => Mode::StepComplete,
-            Interface::ModelExchange => Mode::EventMode,
+            Interface::CoSimulation if !self.event_mode_used => Mode::StepComplete,
+            _ => Mode::EventMode,
         };
         Ok(())
     }
@@ -798,6 +811,16 @@ impl<M: Model> Instance<M> {
                     num(t + h),
                     num(stop),
                     self.version.function("fmi2SetupExperiment")
+                ));
+            }
+        }
+        if let Some(next) = next_activation::<M>(c.start_time, c.time) {
+            if t + h > next + TIME_MATCH_RTOL * next.abs().max(1.0) {
+                return Err(format!(
+                    "a step to t = {} would pass the Clock's activation at t = {}: step to it and activate the \
+                     Clock in Event Mode (FMI 3.0, 2.2.8.2: the importer activates a time-based Clock at its times)",
+                    num(t + h),
+                    num(next)
                 ));
             }
         }

@@ -4,7 +4,9 @@
 //! activation 5 ms after the start; at each activation the controller samples `p` and `u_ref`,
 //! advances its filter over the interval and sets the command `u`, which holds until the next
 //! one. The FMU has no continuous state: coupled with the plant in Model Exchange, the importer
-//! integrates the plant and activates the Clock as a time event (FMI 3.0, 2.2.8).
+//! integrates the plant and activates the Clock as a time event (FMI 3.0, 2.2.8); in
+//! Co-Simulation (with Event Mode, which a Clock requires) it steps to each activation and
+//! activates the Clock in Event Mode.
 //!
 //! Discretisation of eq. 6.2 (a choice: the thesis gives the filter in continuous time): the
 //! filter x' = omega_f (p - x) is advanced exactly over the interval T with p linear between the
@@ -81,8 +83,10 @@ K<sub>f</sub>&omega;<sub>f</sub>(p &minus; x)/Q<sub>rated</sub>, u<sub>min</sub>
 next activation: the command the continuous PressureFeedbackController gives when stepped by 5 ms with the slope of
 <i>p</i>. Couple it with HydraulicBoom in Model Exchange: integrate the plant, and at each multiple of 5 ms enter
 Event Mode, activate <code>sample</code>, set <i>p</i> = p4 and <i>u</i><sub>ref</sub>, read <i>u</i>, call
-fmi3UpdateDiscreteStates and pass <i>u</i> to the plant. Clocked variables can be set and read only while the Clock is
-active (and in Initialization Mode). FMI 3.0 Model Exchange only.</p>"#;
+fmi3UpdateDiscreteStates and pass <i>u</i> to the plant. In Co-Simulation (instantiated with eventModeUsed, which a
+Clock requires) step to each activation and activate the Clock in Event Mode (fmi3EnterEventMode, fmi3SetClock, the
+inputs, the outputs, fmi3UpdateDiscreteStates, fmi3EnterStepMode); a step past an activation is refused. Clocked
+variables can be set and read only while the Clock is active (and in Initialization Mode). FMI 3.0 only.</p>"#;
 
 /// The sampled controller: its parameters and its clocked states (this activation's and the
 /// previous ones).
@@ -163,12 +167,12 @@ impl Model for ClockedPressureFeedbackController {
         (self.x_previous, self.p_sample_previous) = (self.x, self.p_sample);
     }
 
-    /// Model Exchange only: no Co-Simulation step (the FMI layer refuses the interface).
+    /// Co-Simulation (with Event Mode): between activations nothing changes, the command holds.
     type Ode = ();
     const CLOSED_FORM: bool = true;
 
-    fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
-        Err(StepError { time: step.t, message: "the FMU provides Model Exchange only".into() })
+    fn begin_step(&mut self, _step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
+        Ok(Step::Done)
     }
 
     /// The clocked states, their previous values and the last command.

@@ -136,21 +136,17 @@ fn write<M: Model>() -> io::Result<String> {
             ("providesEvaluateDiscreteStates", flag(false)),
         ]);
         element(w, "ModelExchange", &me)?;
-        // A model with a Clock is Model Exchange only: its Co-Simulation would need Event Mode.
-        let cs = clock_row::<M>().is_none().then(|| {
-            interface(vec![
-                ("canHandleVariableCommunicationStepSize", flag(true)),
-                ("maxOutputDerivativeOrder", "0".into()),
-                ("providesIntermediateUpdate", flag(false)),
-                ("mightReturnEarlyFromDoStep", flag(false)),
-                ("canReturnEarlyAfterIntermediateUpdate", flag(false)),
-                ("hasEventMode", flag(false)),
-                ("providesEvaluateDiscreteStates", flag(false)),
-            ])
-        });
-        if let Some(cs) = cs {
-            element(w, "CoSimulation", &cs)?;
-        }
+        // A model with a Clock has Event Mode in Co-Simulation (FMI 3.0, 4.4: required then).
+        let cs = interface(vec![
+            ("canHandleVariableCommunicationStepSize", flag(true)),
+            ("maxOutputDerivativeOrder", "0".into()),
+            ("providesIntermediateUpdate", flag(false)),
+            ("mightReturnEarlyFromDoStep", flag(false)),
+            ("canReturnEarlyAfterIntermediateUpdate", flag(false)),
+            ("hasEventMode", flag(clock_row::<M>().is_some())),
+            ("providesEvaluateDiscreteStates", flag(false)),
+        ]);
+        element(w, "CoSimulation", &cs)?;
         unit_definitions::<M>(w, &["s"])?;
         type_definitions::<M>(w)?;
         log_categories::<M>(w, |d| d.replace("fmi2", "fmi3"))?;
