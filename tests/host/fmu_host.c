@@ -16,6 +16,13 @@
  *     print:I:VR      printed after every 100th step and the last
  *     tol:X           relative tolerance (fmi2SetupExperiment / fmi3EnterInitializationMode;
  *                     default: none defined)
+ *     clock:I:VR      (--fmi3) FMU I has the input Clock VR with a constant interval, which must be H:
+ *                     it is instantiated with eventModeUsed (FMI 3.0, 2.3.1), leaves initialisation
+ *                     in Event Mode (fmi3UpdateDiscreteStates, fmi3EnterStepMode), and after each of
+ *                     its steps activates the Clock (fmi3EnterEventMode, fmi3SetClock, its link and
+ *                     ramp inputs at the step's end, its printed outputs read, fmi3UpdateDiscreteStates,
+ *                     fmi3EnterStepMode): FMI 3.0, 2.2.8 and 2.3.5; its clocked outputs are printed
+ *                     as read at the last activation
  *
  * Exit status: 0 when every call returned OK (fmi2OK = fmi3OK = 0), 1 otherwise (the failing call
  * is printed), 2 for bad arguments. */
@@ -69,6 +76,13 @@ typedef struct {
     Status (*get_float64)(Component, const VR *, size_t, double *, size_t);
     Status (*set_boolean3)(Component, const VR *, size_t, const bool *, size_t);
     Status (*do_step3)(Component, double, double, bool, bool *, bool *, bool *, double *);
+    Status (*enter_event_mode3)(Component);
+    Status (*enter_step_mode3)(Component);
+    Status (*set_clock3)(Component, const VR *, size_t, const bool *);
+    Status (*update_discrete_states3)(Component, bool *, bool *, bool *, bool *, bool *, double *);
+    Status (*get_interval3)(Component, const VR *, size_t, double *, int *);
+    int clocked; /* clock:I:VR given for this FMU */
+    VR clock;
     /* both (the same signatures) */
     Status (*exit_init)(Component);
     Status (*terminate)(Component);
@@ -78,10 +92,11 @@ typedef struct {
 
 enum { MAX_OPS = 64 };
 typedef struct {
-    char kind; /* 'r' real, 'b' bool, 'l' link, 'm' ramp, 'p' print, 't' tolerance */
+    char kind; /* 'r' real, 'b' bool, 'l' link, 'm' ramp, 'p' print, 't' tolerance, 'c' clock */
     int fmu, src_fmu;
     VR vr, src_vr;
     double value, slope;
+    double read; /* a print op of a clocked FMU: the value read at the last activation */
 } Op;
 
 static void logger(void *env, const char *name, int status, const char *category, const char *format, ...) {
@@ -117,6 +132,10 @@ static void *need(void *lib, const char *name) {
 }
 
 static void load(Fmu *f, int fmi3, const char *path, const char *guid, const Callbacks *cb) {
+    if (f->clocked && !fmi3) {
+        fprintf(stderr, "fmu_host: clock: needs --fmi3 (FMI 2.0 has no Clocks)\n");
+        exit(2);
+    }
     void *lib = LOAD(path);
     if (!lib) {
         fprintf(stderr, "fmu_host: cannot load %s\n", path);
@@ -137,8 +156,14 @@ static void load(Fmu *f, int fmi3, const char *path, const char *guid, const Cal
         NEED(get_float64, "GetFloat64");
         NEED(set_boolean3, "SetBoolean");
         NEED(do_step3, "DoStep");
-        /* no event mode, no early return, no intermediate variables; the environment is the path */
-        f->c = f->instantiate3("host", guid, NULL, false, false, false, false, NULL, 0, (void *)path, logger3, NULL);
+        NEED(enter_event_mode3, "EnterEventMode");
+        NEED(enter_step_mode3, "EnterStepMode");
+        NEED(set_clock3, "SetClock");
+        NEED(update_discrete_states3, "UpdateDiscreteStates");
+        NEED(get_interval3, "GetIntervalDecimal");
+        /* event mode only for an FMU with a Clock; no early return, no intermediate variables; the
+         * environment is the path */
+        f->c = f->instantiate3("host", guid, NULL, false, false, f->clocked, false, NULL, 0, (void *)path, logger3, NULL);
     } else {
         NEED(instantiate, "Instantiate");
         NEED(setup, "SetupExperiment");
@@ -201,6 +226,46 @@ static void fmu_do_step(Fmu *f, double t, double h) {
     check(f->do_step(f->c, t, h, 1), "fmi2DoStep");
 }
 
+static void fmu_update_discrete_states(Fmu *f) {
+    bool need_update, terminate, nominals_changed, values_changed, next_defined;
+    double next;
+    check(f->update_discrete_states3(f->c, &need_update, &terminate, &nominals_changed, &values_changed,
+                                     &next_defined, &next),
+          "fmi3UpdateDiscreteStates");
+}
+
+/* In Initialization Mode: the Clock's interval must be the host's step. */
+static void check_interval(Fmu *f, double h) {
+    double interval;
+    int qualifier;
+    check(f->get_interval3(f->c, &f->clock, 1, &interval, &qualifier), "fmi3GetIntervalDecimal");
+    if (interval != h) {
+        fprintf(stderr, "fmu_host: the Clock's interval %.17g differs from the step %.17g\n", interval, h);
+        exit(2);
+    }
+}
+
+/* The input of a link or ramp op at time t. */
+static double input(Fmu *fmus, const Op *op, double t) {
+    return op->kind == 'l' ? fmu_get_real(&fmus[op->src_fmu], op->src_vr) : op->value + op->slope * t;
+}
+
+/* An activation of FMU i's Clock at t, from Step Mode: FMI 3.0, 2.3.5. */
+static void activate(Fmu *fmus, int i, Op *ops, int n_ops, double t) {
+    Fmu *f = &fmus[i];
+    bool active = true;
+    check(f->enter_event_mode3(f->c), "fmi3EnterEventMode");
+    check(f->set_clock3(f->c, &f->clock, 1, &active), "fmi3SetClock");
+    for (int j = 0; j < n_ops; j++) {
+        if (ops[j].fmu == i && (ops[j].kind == 'l' || ops[j].kind == 'm')) fmu_set_real(f, ops[j].vr, input(fmus, &ops[j], t));
+    }
+    for (int j = 0; j < n_ops; j++) {
+        if (ops[j].fmu == i && ops[j].kind == 'p') ops[j].read = fmu_get_real(f, ops[j].vr);
+    }
+    fmu_update_discrete_states(f);
+    check(f->enter_step_mode3(f->c), "fmi3EnterStepMode");
+}
+
 static void fmu_free(Fmu *f) {
     check(f->terminate(f->c), f->fmi3 ? "fmi3Terminate" : "fmi2Terminate");
     f->free_instance(f->c);
@@ -215,6 +280,7 @@ static Op parse(const char *s) {
     else if (sscanf(s, "ramp:%d:%u=%lf,%lf", &op.fmu, &vr, &op.value, &op.slope) == 4) op.kind = 'm';
     else if (sscanf(s, "print:%d:%u", &op.fmu, &vr) == 2) op.kind = 'p';
     else if (sscanf(s, "tol:%lf", &op.value) == 1) op.kind = 't';
+    else if (sscanf(s, "clock:%d:%u", &op.fmu, &vr) == 2) op.kind = 'c';
     else {
         fprintf(stderr, "fmu_host: cannot read \"%s\"\n", s);
         exit(2);
@@ -228,14 +294,14 @@ static void print_outputs(Fmu *fmus, const Op *ops, int n_ops, double t) {
     printf("%.17g", t);
     for (int k = 0; k < n_ops; k++) {
         if (ops[k].kind != 'p') continue;
-        printf(" %.17g", fmu_get_real(&fmus[ops[k].fmu], ops[k].vr));
+        printf(" %.17g", fmus[ops[k].fmu].clocked ? ops[k].read : fmu_get_real(&fmus[ops[k].fmu], ops[k].vr));
     }
     printf("\n");
 }
 
 int main(int argc, char **argv) {
     Callbacks cb = {logger, calloc, free, NULL, NULL};
-    Fmu fmus[2];
+    Fmu fmus[2] = {{0}, {0}};
     Op ops[MAX_OPS];
     int fmi3 = argc > 1 && strcmp(argv[1], "--fmi3") == 0;
     int n_fmus = 0, n_ops = 0, k = 3 + fmi3;
@@ -245,8 +311,13 @@ int main(int argc, char **argv) {
     }
     long steps = atol(argv[1 + fmi3]);
     double h = atof(argv[2 + fmi3]);
-    for (; k + 1 < argc && strcmp(argv[k], "--") != 0 && n_fmus < 2; k += 2) load(&fmus[n_fmus++], fmi3, argv[k], argv[k + 1], &cb);
+    int first_lib = k;
+    for (; k + 1 < argc && strcmp(argv[k], "--") != 0 && n_fmus < 2; k += 2) n_fmus++;
     for (k++; k < argc && n_ops < MAX_OPS; k++) ops[n_ops++] = parse(argv[k]);
+    for (int j = 0; j < n_ops; j++) {
+        if (ops[j].kind == 'c' && ops[j].fmu < n_fmus) fmus[ops[j].fmu].clocked = 1, fmus[ops[j].fmu].clock = ops[j].vr;
+    }
+    for (int i = 0; i < n_fmus; i++) load(&fmus[i], fmi3, argv[first_lib + 2 * i], argv[first_lib + 2 * i + 1], &cb);
 
     double tolerance = 0.0;
     for (int j = 0; j < n_ops; j++) {
@@ -260,18 +331,21 @@ int main(int argc, char **argv) {
         for (int j = 0; j < n_ops; j++) {
             if (ops[j].kind == 'r' && ops[j].fmu == i) fmu_set_real(&fmus[i], ops[j].vr, ops[j].value);
         }
+        if (fmus[i].clocked) check_interval(&fmus[i], h);
         fmu_exit_init(&fmus[i]);
+        if (fmus[i].clocked) {
+            fmu_update_discrete_states(&fmus[i]);
+            check(fmus[i].enter_step_mode3(fmus[i].c), "fmi3EnterStepMode");
+        }
     }
     for (long n = 0; n < steps; n++) {
         double t = n * h;
         for (int i = 0; i < n_fmus; i++) {
-            for (int j = 0; j < n_ops; j++) {
-                if (ops[j].fmu != i || (ops[j].kind != 'l' && ops[j].kind != 'm')) continue;
-                double x = ops[j].kind == 'l' ? fmu_get_real(&fmus[ops[j].src_fmu], ops[j].src_vr)
-                                              : ops[j].value + ops[j].slope * t;
-                fmu_set_real(&fmus[i], ops[j].vr, x);
+            for (int j = 0; j < n_ops && !fmus[i].clocked; j++) {
+                if (ops[j].fmu == i && (ops[j].kind == 'l' || ops[j].kind == 'm')) fmu_set_real(&fmus[i], ops[j].vr, input(fmus, &ops[j], t));
             }
             fmu_do_step(&fmus[i], t, h);
+            if (fmus[i].clocked) activate(fmus, i, ops, n_ops, (n + 1) * h);
         }
         if ((n + 1) % 100 == 0 || n + 1 == steps) print_outputs(fmus, ops, n_ops, (n + 1) * h);
     }

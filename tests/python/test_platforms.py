@@ -21,6 +21,7 @@ What agrees how well, and why:
   the spool opens). A real defect (a wrong ABI, a mis-linked math function, a truncated constant)
   is far larger. The largest differences are printed (pytest -s) and quoted in the README."""
 
+import math
 import os
 import pathlib
 import shutil
@@ -86,10 +87,10 @@ def hosts(tmp_path_factory):
     return out
 
 
-def run(hosts, unpacked, platform, steps, fmus, ops, fmi=2):
+def run(hosts, unpacked, platform, steps, fmus, ops, fmi=2, h="0.001"):
     """fmu_host's printed rows (lists of floats, exact: printed with 17 digits) for the FMI `fmi`
-    FMUs `fmus` on `platform`."""
-    args = (["--fmi3"] if fmi == 3 else []) + [str(steps), "0.001"]
+    FMUs `fmus` on `platform`, stepped by `h` seconds."""
+    args = (["--fmi3"] if fmi == 3 else []) + [str(steps), h]
     for ident in fmus:
         _, token, libs = unpacked[fmi, ident]
         args += [str(libs[platform]), token]
@@ -209,6 +210,32 @@ def test_fmi3_equals_fmi2_on_the_same_platform(runs, name, platform):
     assert len(rows3) == len(rows2) > 0
     differ = [(r2[0], j) for r2, r3 in zip(rows2, rows3) for j, (a, b) in enumerate(zip(r2, r3)) if a != b]
     assert not differ, f"{name} on {platform}: FMI 3.0 differs from FMI 2.0 at (time, column) {differ[:5]}"
+
+
+def test_the_clocked_controller_on_every_platform(hosts, tmp_path):
+    """ClockedPressureFeedbackController (FMI 3.0 only) through the C host's Co-Simulation with
+    Event Mode (`clock:0:13`: eventModeUsed, its Clock activated after every 5 ms step) on each
+    platform, p ramping by 2e7 Pa/s from 40 bar: at the activations the sampled filter is the high
+    pass of the ramp, u_comp = K_f a / Q_rated (1 - e^(-omega_f t)) (eq. 6.2, the defaults of
+    Table 7.2): 1e-9 of the plateau (rounding of the filter state over 300 activations), and the
+    platforms agree with linux64 to 1e-12 (libm's exp may differ by an ulp)."""
+    path = fmu3_path("ClockedPressureFeedbackController")
+    with zipfile.ZipFile(path) as z:
+        z.extractall(tmp_path)
+    token = ET.parse(tmp_path / "modelDescription.xml").getroot().get("instantiationToken")
+    libs = {p: tmp_path / "binaries" / TUPLE[p] / ("ClockedPressureFeedbackController" + SUFFIX[p]) for p in PLATFORMS}
+    unpacked = {(3, "ClockedPressureFeedbackController"): (tmp_path, token, libs)}
+    ops = ["clock:0:13", "real:0:1=4e6", "ramp:0:1=4e6,2e7", "real:0:0=-0.05", "print:0:2", "print:0:3"]
+    rows = {p: run(hosts, unpacked, p, 300, ["ClockedPressureFeedbackController"], ops, fmi=3, h="0.005")
+            for p in PLATFORMS}
+    plateau = 1.24e-11 * 2e7 / (25 / 60000)
+    assert [r[0] for r in rows["linux64"]] == pytest.approx([0.5, 1.0, 1.5], abs=1e-12)
+    for t, u, u_comp in rows["linux64"]:
+        assert u_comp == pytest.approx(plateau * -math.expm1(-35.8 * t), abs=1e-9 * plateau), t
+        assert u == -0.05 + u_comp
+    flat = {p: [x for row in r for x in row] for p, r in rows.items()}
+    for p in PLATFORMS[1:]:
+        assert flat[p] == pytest.approx(flat["linux64"], rel=1e-12), p
 
 
 def test_tools_are_installed():
