@@ -81,6 +81,23 @@ def test_fmpy_validation_reports_nothing():
     assert validate_fmu(str(boomsim.fmu(CONTROLLER, fmi=3))) == []
 
 
+@pytest.mark.parametrize("how", [dict(fmi_type="ModelExchange"), dict(fmi_type="CoSimulation", use_event_mode=True)])
+def test_fmpy_simulate_which_never_activates_the_clock_gets_a_clear_error(how):
+    """fmpy's simulate_fmu has no Clock master: it reads the outputs between activations, which
+    FMI 3.0 forbids for clocked variables (2.2.8.3). The FMU answers fmi3Error with a message
+    naming the variable and its Clock, never a value."""
+    from fmpy import simulate_fmu
+
+    messages = []
+
+    def logger(_env, _status, _category, message):
+        messages.append(message.decode())
+
+    with pytest.raises(Exception, match="fmi3GetFloat64 failed"):
+        simulate_fmu(str(boomsim.fmu(CONTROLLER, fmi=3)), stop_time=0.1, output_interval=5e-3, logger=logger, **how)
+    assert any('"u" is clocked by "sample", which is not active' in m for m in messages), messages
+
+
 def test_the_reference_results_reproduce_through_fmpy():
     """Issue 29 item 4 for the clocked FMU: its documentation/reference/ (computed when packed)
     reproduced bit for bit by fmpy's FMI 3.0 Model Exchange calls: the inputs of _in.csv
