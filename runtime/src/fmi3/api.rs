@@ -293,11 +293,17 @@ pub unsafe fn set_int32<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: 
 /// fmi3SetBoolean: the C `bool`s are read as bytes, so a value other than 0 or 1 is refused
 /// instead of being undefined behaviour.
 pub unsafe fn set_boolean<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const u8, nv: usize) -> fmi3Status {
-    set::<M, u8>(c, at("fmi3SetBoolean", allowed::SET_DISCRETE), (vr, n, v, nv), |x| match x {
-        0 => Ok(Value::Boolean(false)),
-        1 => Ok(Value::Boolean(true)),
-        _ => Err(format!("{x} is not an fmi3Boolean; valid values are false (0) and true (1)")),
+    set::<M, u8>(c, at("fmi3SetBoolean", allowed::SET_DISCRETE), (vr, n, v, nv), |x| {
+        c_bool(x, "an fmi3Boolean", ("false", "true")).map(Value::Boolean)
     })
+}
+
+/// A C `bool` read as a byte: 0 or 1, anything else refused naming the type and its two values.
+fn c_bool(x: u8, what: &str, (no, yes): (&str, &str)) -> Result<bool, String> {
+    match x {
+        0 | 1 => Ok(x == 1),
+        _ => Err(format!("{x} is not {what}; valid values are {no} (0) and {yes} (1)")),
+    }
 }
 
 pub unsafe fn set_string<M: Model>(
@@ -343,12 +349,7 @@ pub unsafe fn set_clock<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: 
         let vrs = slice(vr, n, limit, "valueReferences")?;
         let active = slice(v, n, limit, "values")?
             .iter()
-            .map(|&b| match b {
-                0 | 1 => Ok(b == 1),
-                _ => Err(format!(
-                    "{b} is not an fmi3Clock; valid values are fmi3ClockInactive (0) and fmi3ClockActive (1)"
-                )),
-            })
+            .map(|&b| c_bool(b, "an fmi3Clock", ("fmi3ClockInactive", "fmi3ClockActive")))
             .collect::<Result<Vec<bool>, String>>()?;
         inst.set_clocks(vrs, &active)?;
         Ok(fmi3Status::OK)
@@ -367,29 +368,39 @@ pub unsafe fn get_interval_decimal<M: Model>(
     intervals: *mut f64,
     qualifiers: *mut fmi3IntervalQualifier,
 ) -> fmi3Status {
-    call::<M>(c, at("fmi3GetIntervalDecimal", allowed::GET_INTERVAL), |inst| {
+    let f = at("fmi3GetIntervalDecimal", allowed::GET_INTERVAL);
+    clock_timings::<M>(c, f, (vr, n), (intervals, "intervals"), |(interval, _)| interval, |limit| {
+        slice_mut(qualifiers, n, limit, "qualifiers")?.fill(INTERVAL_UNCHANGED);
+        Ok(())
+    })
+}
+
+/// A getter of the Clocks' constant timing: `pick` of (interval, shift) for each value reference
+/// into `out`, after `more` (the other out-arguments).
+unsafe fn clock_timings<M: Model>(
+    c: fmi3Instance,
+    f: Call,
+    (vr, n): (*const u32, usize),
+    (out, name): (*mut f64, &str),
+    pick: impl Fn((f64, f64)) -> f64,
+    more: impl FnOnce(calls::Limit) -> Result<(), String>,
+) -> fmi3Status {
+    call::<M>(c, f, |inst| {
         let limit = calls::references::<M>(Version::Fmi3);
         let vrs = slice(vr, n, limit, "valueReferences")?;
-        let out = slice_mut(intervals, n, limit, "intervals")?;
-        let qualifier = slice_mut(qualifiers, n, limit, "qualifiers")?;
-        for (k, &r) in vrs.iter().enumerate() {
-            (out[k], qualifier[k]) = (inst.clock_timing(r)?.0, INTERVAL_UNCHANGED);
+        let out = slice_mut(out, n, limit, name)?;
+        for (o, &r) in out.iter_mut().zip(vrs) {
+            *o = pick(inst.clock_timing(r)?);
         }
+        more(limit)?;
         Ok(fmi3Status::OK)
     })
 }
 
 /// fmi3GetShiftDecimal: a constant Clock's shift (its first activation after the start time).
 pub unsafe fn get_shift_decimal<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, shifts: *mut f64) -> fmi3Status {
-    call::<M>(c, at("fmi3GetShiftDecimal", allowed::GET_SHIFT), |inst| {
-        let limit = calls::references::<M>(Version::Fmi3);
-        let vrs = slice(vr, n, limit, "valueReferences")?;
-        let out = slice_mut(shifts, n, limit, "shifts")?;
-        for (k, &r) in vrs.iter().enumerate() {
-            out[k] = inst.clock_timing(r)?.1;
-        }
-        Ok(fmi3Status::OK)
-    })
+    let f = at("fmi3GetShiftDecimal", allowed::GET_SHIFT);
+    clock_timings::<M>(c, f, (vr, n), (shifts, "shifts"), |(_, shift)| shift, |_| Ok(()))
 }
 
 /// The clock functions boomsim does not provide: for a model without a Clock, none; for a model

@@ -4,7 +4,7 @@
 use super::driver::Driven;
 use super::log::{num, Logger, Status};
 use super::machine::{Interface, Mode};
-use super::model::{clock_row, initial_unknown, Log, Model, Seeds};
+use super::model::{activations, clock_row, initial_unknown, Log, Model, Seeds, ACTIVATION_TOLERANCE};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
 use std::borrow::Cow;
@@ -99,12 +99,11 @@ impl<M: Model> Default for Core<M> {
     }
 }
 
-/// The first activation of the model's Clock after `t` (None without a Clock): t_start + shift +
-/// i interval, the time within 1e-6 of an interval counting as on it.
+/// The first activation of the model's Clock after `t` (None without a Clock), a time within
+/// [`ACTIVATION_TOLERANCE`] of an activation counting as on it.
 fn next_activation<M: Model>(start: f64, t: f64) -> Option<f64> {
-    let Kind::Clock { interval, shift } = M::VARIABLES[clock_row::<M>()?].kind else { return None };
-    let first = start + shift;
-    let i = ((t - first) / interval + 1e-6).floor().max(-1.0) + 1.0;
+    let (first, interval) = activations::<M>(start)?;
+    let i = ((t - first) / interval + ACTIVATION_TOLERANCE).floor().max(-1.0) + 1.0;
     Some(first + i * interval)
 }
 
@@ -692,10 +691,8 @@ impl<M: Model> Instance<M> {
     }
 
     /// fmi3SetClock: activates the model's input Clock for this instant of Event Mode, at one of
-    /// its times (FMI 3.0, 2.2.8.2: t_i = t_start + shift + i interval; the time within 1e-6 of an
-    /// interval, far above the rounding of a time summed from intervals and far below an
-    /// interval). It cannot be deactivated (`canBeDeactivated="false"`): fmi3UpdateDiscreteStates
-    /// does that (FMI 3.0, 2.3.5).
+    /// its times (FMI 3.0, 2.2.8.2; within [`ACTIVATION_TOLERANCE`]). It cannot be deactivated
+    /// (`canBeDeactivated="false"`): fmi3UpdateDiscreteStates does that (FMI 3.0, 2.3.5).
     pub fn set_clocks(&mut self, vrs: &[u32], active: &[bool]) -> Result<(), String> {
         let mut rows = Vec::with_capacity(vrs.len());
         for (&vr, &on) in vrs.iter().zip(active) {
@@ -707,10 +704,9 @@ impl<M: Model> Instance<M> {
                     v.name
                 ));
             }
-            let (interval, shift) = self.clock_timing(vr)?;
-            let (t, first) = (self.core.time, self.core.start_time + shift);
+            let (t, (first, interval)) = (self.core.time, activations::<M>(self.core.start_time).ok_or("no Clock")?);
             let k = (t - first) / interval;
-            if !(k > -1e-6 && (k - k.round()).abs() <= 1e-6) {
+            if !(k > -ACTIVATION_TOLERANCE && (k - k.round()).abs() <= ACTIVATION_TOLERANCE) {
                 return Err(format!(
                     "Clock \"{}\" activated at t = {}, which is none of its times {} + i {} s, i = 0, 1, ... (a \
                      constant Clock, FMI 3.0, 2.2.8.2)",

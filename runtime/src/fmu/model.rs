@@ -238,10 +238,35 @@ pub trait Model: Clone + Send + Sized + 'static {
     fn restore(values: &Values, head: &[f64], state: &[f64]) -> Result<Self, String>;
 }
 
-/// The table row of the model's Clock (FMI 3.0 only; at most one), if it has one.
+/// The table row of the model's Clock (FMI 3.0 only; at most one), if it has one: found at compile
+/// time (it is asked on every step and output refresh).
 pub fn clock_row<M: Model>() -> Option<usize> {
-    M::VARIABLES.iter().position(|v| matches!(v.kind, Kind::Clock { .. }))
+    const { clock_row_in(M::VARIABLES) }
 }
+
+const fn clock_row_in(table: &[Variable]) -> Option<usize> {
+    let mut i = 0;
+    while i < table.len() {
+        if matches!(table[i].kind, Kind::Clock { .. }) {
+            return Some(i);
+        }
+        i += 1;
+    }
+    None
+}
+
+/// The activations of the model's Clock in an experiment from `start`: (the first, the interval)
+/// (FMI 3.0, 2.2.8.2: t_i = t_start + shift + i interval).
+pub fn activations<M: Model>(start: f64) -> Option<(f64, f64)> {
+    match M::VARIABLES[clock_row::<M>()?].kind {
+        Kind::Clock { interval, shift } => Some((start + shift, interval)),
+        _ => None,
+    }
+}
+
+/// How far a time may lie from an activation and still be on it, in intervals: far above the
+/// rounding of a time summed from intervals, far below an interval.
+pub const ACTIVATION_TOLERANCE: f64 = 1e-6;
 
 /// FMI 2.0, 2.2.8 (FMI 3.0, 2.4.8 alike): whether `v` is an InitialUnknown of model `M`: an
 /// output with initial approx or calculated, a calculated parameter, a continuous state with
