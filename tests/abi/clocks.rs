@@ -239,7 +239,7 @@ fn an_instant_recomputed_with_new_inputs_starts_from_the_previous_values() {
 /// taken between activations resumes bit for bit.
 #[test]
 fn fmi2_and_co_simulation_without_event_mode_are_refused_and_states_resume() {
-    let e = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), false).err().expect("Co-Simulation refused");
+    let e = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), (false, false)).err().expect("Co-Simulation refused");
     assert!(e.iter().any(|m| m.contains("eventModeUsed = false, but the FMU has a Clock")), "{e:?}");
     let messages = Box::new(crate::common::Messages::default());
     let callbacks = crate::common::callbacks(&messages);
@@ -274,7 +274,7 @@ fn fmi2_and_co_simulation_without_event_mode_are_refused_and_states_resume() {
 #[test]
 fn co_simulation_with_event_mode_gives_the_commands_of_model_exchange() {
     let me = running(50e5, -0.05);
-    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), true).expect("Co-Simulation with Event Mode");
+    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), (true, false)).expect("Co-Simulation with Event Mode");
     unsafe {
         assert_eq!(api::enter_initialization_mode::<Cpfc>(cs.c, false, 0.0, 0.0, false, 0.0), OK);
         assert_eq!((cs.set(vr::P, 50e5), cs.set(vr::U_REF, -0.05)), (OK, OK));
@@ -296,7 +296,7 @@ fn co_simulation_with_event_mode_gives_the_commands_of_model_exchange() {
     }
     assert_eq!(cs.step(40.0 * T, 1.5 * T), ERR, "past the activation at 41 T");
     assert!(cs.last_error().contains("would pass the Clock's activation at t = 0.205"), "{}", cs.last_error());
-    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), true).unwrap();
+    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), (true, false)).unwrap();
     unsafe {
         assert_eq!(api::enter_initialization_mode::<Cpfc>(cs.c, false, 0.0, 0.0, false, 0.0), OK);
         assert_eq!(api::exit_initialization_mode::<Cpfc>(cs.c), OK);

@@ -51,11 +51,16 @@ pub(crate) struct Inst<M: Model> {
 impl<M: Model> Inst<M> {
     /// Instantiates as Co-Simulation (`me` false) or Model Exchange with the right token.
     pub(crate) fn new(me: bool) -> Self {
-        Self::try_new(me, &token::<M>(), false).expect("instantiation succeeds")
+        Self::try_new(me, &token::<M>(), (false, false)).expect("instantiation succeeds")
     }
 
-    /// Instantiates with the given token (and, for CS, eventModeUsed); `Err`: the messages.
-    pub(crate) fn try_new(me: bool, token: &str, event_mode_used: bool) -> Result<Self, Vec<String>> {
+    /// Instantiates with the given token (and, for CS, eventModeUsed and earlyReturnAllowed);
+    /// `Err`: the messages.
+    pub(crate) fn try_new(
+        me: bool,
+        token: &str,
+        (event_mode_used, early_return_allowed): (bool, bool),
+    ) -> Result<Self, Vec<String>> {
         let messages = Box::new(Messages::default());
         let env = &*messages as *const Messages as *mut c_void;
         let (n, t) = (CString::new("i3").unwrap(), CString::new(token).unwrap());
@@ -70,7 +75,7 @@ impl<M: Model> Inst<M> {
                     false,
                     false,
                     event_mode_used,
-                    false,
+                    early_return_allowed,
                     null(),
                     0,
                     env,
@@ -357,10 +362,10 @@ fn every_function_in_every_state_follows_the_fmi3_state_machine() {
 #[test]
 fn instantiation_refuses_a_wrong_token_name_or_mode() {
     for wrong in ["{00000000-0000-0000-0000-000000000000}".to_string(), guid::<Pfc>()] {
-        let e = Inst::<Pfc>::try_new(false, &wrong, false).err().expect("refused");
+        let e = Inst::<Pfc>::try_new(false, &wrong, (false, false)).err().expect("refused");
         assert!(e.iter().any(|m| m.contains("instantiationToken") && m.contains("does not match")), "{e:?}");
     }
-    let e = Inst::<Pfc>::try_new(false, &token::<Pfc>(), true).err().expect("refused");
+    let e = Inst::<Pfc>::try_new(false, &token::<Pfc>(), (true, false)).err().expect("refused");
     assert!(e.iter().any(|m| m.contains("eventModeUsed") && m.contains("hasEventMode")), "{e:?}");
     let t = CString::new(token::<Pfc>()).unwrap();
     let c = unsafe {

@@ -4,6 +4,7 @@
 mod common;
 mod clocks;
 mod dependencies;
+mod early_return;
 mod directional_derivatives;
 mod fmi2_api;
 mod fmi3_api;

@@ -23,6 +23,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 # (python/boomsim/figures.py): text inside the canvas, every axis labelled with its unit.
 os.environ["BOOMSIM_STRICT_FIGURES"] = "1"
 FMU_DIR = ROOT / "target" / "fmu"
+#: fmi-sim (rust-fmi's fmusim, an independent importer) as scripts/setup builds it.
+FMI_SIM = ROOT / ".tools" / "bin" / "fmi-sim"
 
 
 #: The 34 functions of FMI 2.0 Co-Simulation (25 common + 9 co-simulation), without "fmi2".

@@ -43,7 +43,7 @@ impl Referenced for HydraulicBoom {
     fn experiment() -> Result<Experiment, String> {
         Ok(Experiment {
             description: "Experiment U without the controller (thesis 7.1): valve.u_ref = -0.10 from rest at \
-                          start.x = 480 mm, rigid boom; the lowering starts to oscillate."
+                          start.x = 480 mm, the default flexible boom; the lowering starts to oscillate."
                 .into(),
             inputs: vec![("valve.u_ref", vec![(0.0, -0.10)])],
             outputs: &["p3", "p4", "cylinder.x", "cylinder.v"],
@@ -204,7 +204,10 @@ pub fn files<M: Referenced>() -> Result<Vec<(String, String)>, String> {
     };
     let readme = format!(
         "Reference results of {id}, computed by this FMU's model when it was packed.\n\n{}\n\n\
-         {id}_in.csv: the inputs, linear between rows, held after the last.\n{}",
+         {id}_in.csv: the inputs, linear between rows, held after the last.\n{}\
+         Compare each column within 10 x RelTol of its largest magnitude: an importer whose times or input values \
+         differ from these by rounding makes the integrator take other steps, and two runs at RelTol differ by \
+         that much.\n",
         e.description,
         how.replace("{id}", id)
     );

@@ -10,7 +10,7 @@ use crate::fmu::calls::{self, call, slice, slice_mut, Call};
 use crate::fmu::guid::token;
 use crate::fmu::instance::Instance;
 use crate::fmu::log::{num, Logger};
-use crate::fmu::model::{clock_row, Model};
+use crate::fmu::model::{clock_row, has_event_mode, Model};
 use crate::fmu::variables::{BaseType, Value};
 use crate::fmu::version::Version;
 use std::ffi::CStr;
@@ -47,7 +47,7 @@ pub fn get_version() -> *const c_char {
 /// failure.
 unsafe fn instantiate<M: Model>(
     function: &str,
-    (interface, event_mode_used): (Interface, bool),
+    (interface, event_mode_used, early_return_allowed): (Interface, bool, bool),
     (name, instantiation_token): (fmi3String, fmi3String),
     logging_on: bool,
     (environment, log_message): (fmi3InstanceEnvironment, fmi3LogMessageCallback),
@@ -63,7 +63,10 @@ unsafe fn instantiate<M: Model>(
             })
             .and_then(|_| more());
         match checked {
-            Ok(()) => calls::new_instance::<M>(logger, expected, Version::Fmi3, interface, event_mode_used),
+            Ok(()) => {
+                let modes = (event_mode_used, early_return_allowed);
+                calls::new_instance::<M>(logger, expected, Version::Fmi3, interface, modes)
+            }
             Err(message) => {
                 logger.status(fmi3Status::Error, &format!("{function}: {message}"));
                 std::ptr::null_mut()
@@ -85,7 +88,7 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
     let f = "fmi3InstantiateModelExchange";
     instantiate::<M>(
         f,
-        (Interface::ModelExchange, false),
+        (Interface::ModelExchange, false, false),
         (name, instantiation_token),
         logging_on,
         (environment, log_message),
@@ -93,9 +96,10 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
     )
 }
 
-/// fmi3InstantiateCoSimulation: `eventModeUsed` is refused (`hasEventMode="false"`), and so are
-/// required intermediate variables (`providesIntermediateUpdate="false"`); `earlyReturnAllowed`
-/// is accepted (doStep never returns early).
+/// fmi3InstantiateCoSimulation: `eventModeUsed` for a model with a Clock (required) or event
+/// indicators (`hasEventMode="true"`), else refused; `earlyReturnAllowed` makes a model with event
+/// indicators end a step at their first root (`mightReturnEarlyFromDoStep="true"`); required
+/// intermediate variables are refused (`providesIntermediateUpdate="false"`).
 pub unsafe fn instantiate_co_simulation<M: Model>(
     name: fmi3String,
     instantiation_token: fmi3String,
@@ -103,7 +107,7 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     _visible: fmi3Boolean,
     logging_on: fmi3Boolean,
     event_mode_used: fmi3Boolean,
-    _early_return_allowed: fmi3Boolean,
+    early_return_allowed: fmi3Boolean,
     _required_intermediate_variables: *const fmi3ValueReference,
     n_required_intermediate_variables: usize,
     environment: fmi3InstanceEnvironment,
@@ -118,7 +122,7 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
                     .into(),
             );
         }
-        if clock_row::<M>().is_none() && event_mode_used {
+        if !has_event_mode::<M>() && event_mode_used {
             return Err(
                 "eventModeUsed = true, but the FMU has no event mode in Co-Simulation (hasEventMode=\"false\")".into(),
             );
@@ -133,7 +137,7 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     let f = "fmi3InstantiateCoSimulation";
     instantiate::<M>(
         f,
-        (Interface::CoSimulation, event_mode_used),
+        (Interface::CoSimulation, event_mode_used, early_return_allowed),
         (name, instantiation_token),
         logging_on,
         (environment, log_message),
@@ -637,9 +641,10 @@ pub unsafe fn get_output_derivatives<M: Model>(c: fmi3Instance) -> fmi3Status {
     calls::unsupported::<M>(c, f, "maxOutputDerivativeOrder=\"0\"")
 }
 
-/// fmi3DoStep. The out-arguments are checked before the step: no event handling (no event
-/// mode), never an early return, `terminateSimulation` once a step was discarded (the instance
-/// is then in Step Discarded), and the time the instance reached.
+/// fmi3DoStep. The out-arguments are checked before the step: `earlyReturn` where the step ended
+/// before `t + h` at an event (with `earlyReturnAllowed`), `eventHandlingNeeded` where it ended at
+/// an event and the importer uses Event Mode (4.2.3), `terminateSimulation` once a step was
+/// discarded (the instance is then in Step Discarded), and the time the instance reached.
 pub unsafe fn do_step<M: Model>(
     c: fmi3Instance,
     t: f64,
@@ -655,7 +660,8 @@ pub unsafe fn do_step<M: Model>(
         let early = early_return.as_mut().ok_or("earlyReturn is NULL")?;
         let last = last_successful_time.as_mut().ok_or("lastSuccessfulTime is NULL")?;
         let status = calls::do_step(inst, f.function, t, h);
-        (*event, *early) = (false, false);
+        *event = inst.event.is_some() && inst.event_mode_used;
+        *early = inst.event.is_some_and(|t_event| t_event < t + h);
         *term = inst.core.mode == Mode::StepFailed;
         *last = inst.core.last_successful_time;
         status

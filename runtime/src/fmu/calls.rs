@@ -176,17 +176,18 @@ pub unsafe fn check_identity(identity: *const c_char, what: &str, kind: &str, ex
     }
 }
 
-/// A new instance on the heap, as the pointer instantiation returns; `event_mode_used`: FMI 3.0
-/// Co-Simulation with Event Mode.
+/// A new instance on the heap, as the pointer instantiation returns; `event_mode_used`,
+/// `early_return_allowed`: FMI 3.0 Co-Simulation with Event Mode, with early return.
 pub fn new_instance<M: Model>(
     log: Logger,
     guid: String,
     version: Version,
     interface: Interface,
-    event_mode_used: bool,
+    (event_mode_used, early_return_allowed): (bool, bool),
 ) -> Handle {
     let mut instance = Instance::<M>::new(log, guid, version, interface);
     instance.event_mode_used = event_mode_used;
+    instance.early_return_allowed = early_return_allowed;
     Box::into_raw(Box::new(instance)) as Handle
 }
 

@@ -13,7 +13,7 @@
 
 use super::model::{Log, Model, StepError, StepStart};
 use super::variables::{Values, Variable};
-use crate::solver::{OdeSystem, Radau5, SolverStats};
+use crate::solver::{Dense, OdeSystem, Radau5, SolverStats};
 use std::ops::{Deref, DerefMut};
 
 /// The driver's variables' value references (stable: append, never renumber).
@@ -118,31 +118,42 @@ impl<M: Model> Driven<M> {
     /// as needed) or real-time ([`Radau5::integrate_bounded`]: the same within
     /// `solver.rhs_budget` RHS evaluations, the accuracy of its closing step reported instead of
     /// enforced). Neither allocates.
+    ///
+    /// With `early_return`, the step ends at the first root of the model's event indicators
+    /// within it ([`Model::step_event_indicators`], located on the integrator's continuous
+    /// output), and returns its time. The state there has the indicators' new signs, so the
+    /// next step starts past the event.
     pub fn step(
         &mut self,
         values: &Values,
         input_derivatives: &[f64],
         (t, h, tolerance): (f64, f64, f64),
         log: &mut dyn Log,
-    ) -> Result<(), StepError> {
+        early_return: bool,
+    ) -> Result<Option<f64>, StepError> {
         let fail = |time, message: String| StepError { time, message };
         let start = StepStart { values, input_derivatives, t, h };
-        match (self.model.begin_step(&start, log)?, self.solver.as_mut().filter(|_| !M::CLOSED_FORM)) {
-            (Step::Done, _) => return Ok(()),
+        let mut event = None;
+        let end = match (self.model.begin_step(&start, log)?, self.solver.as_mut().filter(|_| !M::CLOSED_FORM)) {
+            (Step::Done, _) => return Ok(None),
             (Step::Integrate(ode, state), Some(solver)) => {
                 solver.set_tolerance(tolerance, || M::scale(ode)).map_err(|e| fail(t, e.to_string()))?;
                 let before = *solver.stats();
-                let result = match values.integer(vr::SOLVER_MODE) {
-                    REALTIME => solver.integrate_bounded(ode, t, state, t + h, values.integer(vr::RHS_BUDGET) as u64),
-                    _ => solver.integrate(ode, t, state, t + h),
-                };
-                result.map_err(|e| fail(e.t, e.to_string()))?;
-                log_step(log, t + h, &before, solver.stats());
+                let budget =
+                    (values.integer(vr::SOLVER_MODE) == REALTIME).then(|| values.integer(vr::RHS_BUDGET) as u64);
+                let mut roots = early_return.then(|| Roots::<M>::new(ode, t, state));
+                let reached = solver.integrate_until(ode, (t, t + h), state, budget, |dense| {
+                    event = roots.as_mut().and_then(|r| r.first(dense));
+                    event
+                });
+                let end = reached.map_err(|e| fail(e.t, e.to_string()))?;
+                log_step(log, end, &before, solver.stats());
+                end
             }
             (Step::Integrate(..), None) => return Err(fail(t, "the model has no ODE state to integrate".into())),
-        }
-        self.model.communication_point(t + h);
-        Ok(())
+        };
+        self.model.communication_point(end);
+        Ok(event)
     }
 
     /// Writes the model's outputs and locals, and the integrator's counters.
@@ -187,6 +198,87 @@ impl<M: Model> Driven<M> {
         };
         Ok(Driven { model, solver })
     }
+}
+
+/// Most event indicators a model may declare (the circuit has 3): kept on the stack.
+pub const MAX_EVENT_INDICATORS: usize = 8;
+
+/// The search for the first root of a model's event indicators within a step.
+struct Roots<'a, M: Model> {
+    ode: &'a M::Ode,
+    /// The indicators at the start of the integrator's current step.
+    z: [f64; MAX_EVENT_INDICATORS],
+    /// Work space: a state on the continuous output.
+    x: Vec<f64>,
+}
+
+impl<'a, M: Model> Roots<'a, M> {
+    const N: usize = {
+        assert!(M::EVENT_INDICATORS.len() <= MAX_EVENT_INDICATORS);
+        M::EVENT_INDICATORS.len()
+    };
+
+    /// The search over a step from `t` with state `x`.
+    fn new(ode: &'a M::Ode, t: f64, x: &[f64]) -> Self {
+        let mut z = [0.0; MAX_EVENT_INDICATORS];
+        M::step_event_indicators(ode, t, x, &mut z[..Self::N]);
+        Roots { ode, z, x: x.to_vec() }
+    }
+
+    /// The indicators at `t` on `dense`.
+    fn at(&mut self, dense: &Dense<'_>, t: f64) -> [f64; MAX_EVENT_INDICATORS] {
+        let mut z = [0.0; MAX_EVENT_INDICATORS];
+        dense.at(t, &mut self.x);
+        M::step_event_indicators(self.ode, t, &self.x, &mut z[..Self::N]);
+        z
+    }
+
+    /// The first root within the integrator's step `dense`, if an indicator changed sign in it:
+    /// the bracket [a, b] of the first sign change shrunk to [`ROOT_TOLERANCE`] by secant
+    /// (regula falsi on the indicator that crosses first) and bisection steps in turn (so that
+    /// it halves at least every second step), and its right end returned: there the indicators
+    /// have their new signs. Without a change the step's end indicators start the next step.
+    fn first(&mut self, dense: &Dense<'_>) -> Option<f64> {
+        let (mut a, mut b) = dense.span();
+        let (mut za, mut zb) = (self.z, self.at(dense, b));
+        if !crossed(&za[..Self::N], &zb[..Self::N]) {
+            self.z = zb;
+            return None;
+        }
+        let tolerance = ROOT_TOLERANCE * b.abs().max(1.0);
+        let mut secant = true;
+        while b - a > tolerance {
+            let w = b - a;
+            let m = match secant {
+                true => za[..Self::N]
+                    .iter()
+                    .zip(&zb[..Self::N])
+                    .filter(|(&za, &zb)| crossed(&[za], &[zb]))
+                    .map(|(&za, &zb)| a + w * za / (za - zb))
+                    .fold(b, f64::min)
+                    .clamp(a + 0.01 * w, b - 0.01 * w),
+                false => a + 0.5 * w,
+            };
+            secant = !secant;
+            let zm = self.at(dense, m);
+            if crossed(&za[..Self::N], &zm[..Self::N]) {
+                (b, zb) = (m, zm);
+            } else {
+                (a, za) = (m, zm);
+            }
+        }
+        self.z = zb;
+        Some(b)
+    }
+}
+
+/// How closely an event's time is located, relative to max(|t|, 1 s): a few hundred ulps.
+pub const ROOT_TOLERANCE: f64 = 1e-13;
+
+/// Whether some indicator changed sign from `before` to `after`, or reached 0 from a sign (one
+/// that stays at 0, as the spool reference at rest, is no event).
+fn crossed(before: &[f64], after: &[f64]) -> bool {
+    before.iter().zip(after).any(|(&p, &q)| p * q < 0.0 || (p != 0.0 && q == 0.0))
 }
 
 /// A saved model's parts: head, state, integrator state.

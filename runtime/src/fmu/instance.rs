@@ -1,7 +1,7 @@
 //! One FMU instance: variable values, model, time and state machine, in safe Rust.
 //! [`super::api`] wraps these methods in the C ABI.
 
-use super::driver::Driven;
+use super::driver::{Driven, MAX_EVENT_INDICATORS};
 use super::log::{num, Logger, Status};
 use super::machine::{Interface, Mode};
 use super::model::{activations, clock_row, initial_unknown, Log, Model, Seeds, ACTIVATION_TOLERANCE};
@@ -40,6 +40,12 @@ pub struct Instance<M: Model> {
     /// FMI 3.0 Co-Simulation with Event Mode (`eventModeUsed`): initialisation ends in Event
     /// Mode, and fmi3EnterEventMode / fmi3EnterStepMode move between it and Step Mode.
     pub event_mode_used: bool,
+    /// FMI 3.0 Co-Simulation with `earlyReturnAllowed`: a step ends early at the first root of
+    /// the model's event indicators.
+    pub early_return_allowed: bool,
+    /// Where the last step ended early at an event (FMI 3.0: `earlyReturn`, and
+    /// `eventHandlingNeeded` with Event Mode).
+    pub event: Option<f64>,
     pub core: Core<M>,
     /// Storage behind the pointers the last fmi2GetString / fmi3GetString returned.
     pub(crate) strings: Vec<std::ffi::CString>,
@@ -111,10 +117,6 @@ fn next_activation<M: Model>(start: f64, t: f64) -> Option<f64> {
 fn clock_active<M: Model>(values: &Values) -> bool {
     clock_row::<M>().is_some_and(|i| *values.at(i) == Value::Clock(true))
 }
-
-/// Most event indicators a model may declare (the circuit has 3): their values are refreshed
-/// with the outputs after every step, on the stack.
-const MAX_EVENT_INDICATORS: usize = 8;
 
 /// Writes the outputs and locals of `model` (the integrator's counters and the event indicators'
 /// variables included).
@@ -197,6 +199,8 @@ impl<M: Model> Instance<M> {
             version,
             interface,
             event_mode_used: false,
+            early_return_allowed: false,
+            event: None,
             core: Core::new(),
             strings: Vec::new(),
             guid,
@@ -787,6 +791,7 @@ impl<M: Model> Instance<M> {
     /// fmi2DoStep. `Ok(Step::Done(warning))`: step done; `Ok(Step::Discarded(why))`: stopped
     /// at the last good time.
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Step, String> {
+        self.event = None;
         let c = &mut self.core;
         if !(h > 0.0 && h.is_finite()) {
             return Err(format!("communicationStepSize = {} is outside its valid range (0, inf)", num(h)));
@@ -837,26 +842,38 @@ impl<M: Model> Instance<M> {
         let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
         // FMI 3.0, 2.2.4: after fmi3Discard "the FMU is in the same state as before the call".
         let before = (self.version == Version::Fmi3).then(|| model.clone());
-        let result = model.step(&c.values, &slopes, (start, end - start, tolerance), &mut ModelLog(&self.log));
+        let early_return = self.early_return_allowed && !M::EVENT_INDICATORS.is_empty();
+        let result =
+            model.step(&c.values, &slopes, (start, end - start, tolerance), &mut ModelLog(&self.log), early_return);
         c.outputs_current = false;
         c.derivatives_current = false;
-        if let Err(e) = result {
-            let why =
-                format!("step from t = {} with h = {} stopped at t = {}: {}", num(t), num(h), num(e.time), e.message);
-            if let Some(before) = before {
-                *model = before;
-                return Ok(Step::Discarded(format!(
-                    "{why}; the instance is back at t = {} (retry with a smaller step)",
-                    num(start)
-                )));
+        let event = match result {
+            Ok(event) => event,
+            Err(e) => {
+                let why = format!(
+                    "step from t = {} with h = {} stopped at t = {}: {}",
+                    num(t),
+                    num(h),
+                    num(e.time),
+                    e.message
+                );
+                if let Some(before) = before {
+                    *model = before;
+                    return Ok(Step::Discarded(format!(
+                        "{why}; the instance is back at t = {} (retry with a smaller step)",
+                        num(start)
+                    )));
+                }
+                // FMI 2.0, 4.2.3: Discard leaves the slave at the last good time (fmi2LastSuccessfulTime),
+                // in state StepFailed.
+                c.time = e.time;
+                c.last_successful_time = e.time;
+                c.mode = Mode::StepFailed;
+                return Ok(Step::Discarded(why));
             }
-            // FMI 2.0, 4.2.3: Discard leaves the slave at the last good time (fmi2LastSuccessfulTime),
-            // in state StepFailed.
-            c.time = e.time;
-            c.last_successful_time = e.time;
-            c.mode = Mode::StepFailed;
-            return Ok(Step::Discarded(why));
-        }
+        };
+        // The step ends at the event where it ended early.
+        let end = event.unwrap_or(end);
         // Inputs with a derivative follow their ramp to the new communication point (only
         // interpolated inputs accept derivatives).
         for &r in inputs {
@@ -870,6 +887,11 @@ impl<M: Model> Instance<M> {
         }
         c.time = end;
         c.last_successful_time = end;
+        if let Some(t) = event {
+            self.event = Some(t);
+            self.log
+                .info("logEvents", &format!("an event indicator changed sign at t = {}: the step ended there", num(t)));
+        }
         // Every Real the importer can read is finite after a good step, or the step is an error.
         c.values.take_non_finite();
         write_outputs(model, &mut c.values);

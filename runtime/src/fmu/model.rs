@@ -201,6 +201,11 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// `()` for a model that steps in closed form.
     type Ode: OdeSystem;
 
+    /// Co-Simulation: the [`Model::EVENT_INDICATORS`] of `ode` at time `t` and state `x` within
+    /// a step (inputs following the step's ramps), where the driver looks for their roots to end
+    /// a step early at an event (FMI 3.0, 4.2.3: early return). Default: none.
+    fn step_event_indicators(_ode: &Self::Ode, _t: f64, _x: &[f64], _z: &mut [f64]) {}
+
     /// Whether the model steps in closed form: no ODE state, [`Step::Done`] from every
     /// [`Model::begin_step`], and no integrator in its driver or its binary. Default: no.
     const CLOSED_FORM: bool = false;
@@ -242,6 +247,12 @@ pub trait Model: Clone + Send + Sized + 'static {
 /// time (it is asked on every step and output refresh).
 pub fn clock_row<M: Model>() -> Option<usize> {
     const { clock_row_in(M::VARIABLES) }
+}
+
+/// Whether the model has Event Mode in FMI 3.0 Co-Simulation (`hasEventMode`): with a Clock
+/// (required, 2.3.1) or event indicators (where a step may end early, 4.2.3).
+pub const fn has_event_mode<M: Model>() -> bool {
+    clock_row_in(M::VARIABLES).is_some() || !M::EVENT_INDICATORS.is_empty()
 }
 
 const fn clock_row_in(table: &[Variable]) -> Option<usize> {

@@ -65,6 +65,13 @@ pub(crate) fn circuit_outputs(c: &circuit::State, e: &Eval, values: &mut Values)
     }
 }
 
+/// The log categories of the models with the circuit: the integrator's, and the events where an
+/// FMI 3.0 Co-Simulation step returned early.
+pub(crate) const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logSolver", "Integrator statistics per communication step"),
+    ("logEvents", "FMI 3.0 Co-Simulation with earlyReturnAllowed: steps that ended early at an event indicator's root"),
+];
+
 /// The circuit's event indicator variables, in the order of [`event_indicators`].
 pub(crate) const EVENT_INDICATORS: &[u32] = &[vr::EVENT_U_REF, vr::EVENT_DEAD_BAND_UPPER, vr::EVENT_DEAD_BAND_LOWER];
 

@@ -222,6 +222,7 @@ impl Model for HydraulicBoom {
         interpolated_inputs: &[vr::U_REF],
         documentation: DOCUMENTATION,
         terminals: &[terminals::VALVE, terminals::PRESSURE],
+        log_categories: super::circuit::LOG_CATEGORIES,
         ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
@@ -290,6 +291,10 @@ impl Model for HydraulicBoom {
     }
 
     type Ode = Plant;
+
+    fn step_event_indicators(plant: &Plant, t: f64, x: &[f64], z: &mut [f64]) {
+        super::circuit::event_indicators(&plant.circuit, x[circuit::X_V], plant.u_ref.at(t), z);
+    }
 
     fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, Plant>, StepError> {
         self.plant.u_ref = Ramp::read(step, vr::U_REF);

@@ -249,6 +249,7 @@ impl Model for HydraulicCircuit {
         interpolated_inputs: &[vr::U_REF, vr::X, vr::V, vr::C_M],
         documentation: DOCUMENTATION,
         terminals: &[terminals::ROD, terminals::ROD_TLM, terminals::VALVE, terminals::PRESSURE],
+        log_categories: super::circuit::LOG_CATEGORIES,
         ..super::plant::MODEL_INFO
     };
     const VARIABLES: &'static [Variable] = &TABLE;
@@ -324,6 +325,10 @@ impl Model for HydraulicCircuit {
     }
 
     type Ode = PortedCircuit;
+
+    fn step_event_indicators(sys: &PortedCircuit, t: f64, x: &[f64], z: &mut [f64]) {
+        super::circuit::event_indicators(&sys.circuit, x[circuit::X_V], sys.u_ref.at(t), z);
+    }
 
     fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, PortedCircuit>, StepError> {
         let sys = &mut self.sys;

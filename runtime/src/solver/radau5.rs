@@ -197,6 +197,36 @@ pub struct Radau5 {
     mats: IterationMatrices,
 }
 
+/// The solution over the last accepted step `[t - h, t]`: its collocation polynomial, of degree
+/// 3 through the step's start, its two inner stages and its end (radau5.f's CONTR5).
+pub struct Dense<'a> {
+    t: f64,
+    h: f64,
+    y: &'a [f64],
+    cont: &'a [Vec<f64>; 3],
+}
+
+impl Dense<'_> {
+    /// The step's start and end times.
+    pub fn span(&self) -> (f64, f64) {
+        (self.t - self.h, self.t)
+    }
+
+    /// The state at the step's end.
+    pub fn end(&self) -> &[f64] {
+        self.y
+    }
+
+    /// The state at `t` (within the step; beyond it, the polynomial extrapolated) into `x`.
+    pub fn at(&self, t: f64, x: &mut [f64]) {
+        let s = (t - self.t) / self.h;
+        let [c0, c1, c2] = self.cont;
+        for (i, x) in x.iter_mut().enumerate() {
+            *x = self.y[i] + s * (c0[i] + (s - C2M1) * (c1[i] + (s - C1M1) * c2[i]));
+        }
+    }
+}
+
 /// Outcome of the Newton iteration that forces a smaller step.
 struct NewtonFail {
     cause: FailureCause,
@@ -435,7 +465,7 @@ impl Radau5 {
         x: &mut [f64],
         t_end: f64,
     ) -> Result<(), SolveError> {
-        self.integrate_within(sys, t0, x, t_end, None)
+        self.integrate_until(sys, (t0, t_end), x, None, |_| None).map(|_| ())
     }
 
     /// The real-time mode: [`integrate`](Self::integrate) with at most `rhs_budget` RHS
@@ -456,23 +486,30 @@ impl Radau5 {
         t_end: f64,
         rhs_budget: u64,
     ) -> Result<(), SolveError> {
-        self.accuracy_loss = 0.0;
-        self.integrate_within(sys, t0, x, t_end, Some(rhs_budget))
+        self.integrate_until(sys, (t0, t_end), x, Some(rhs_budget), |_| None).map(|_| ())
     }
 
     /// [`integrate`](Self::integrate), or [`integrate_bounded`](Self::integrate_bounded) with
-    /// a budget.
-    fn integrate_within<S: OdeSystem + ?Sized>(
+    /// a budget, that shows each accepted step to `stop` as its collocation polynomial
+    /// ([`Dense`]); `stop` returns a time within that step to end the integration there (the
+    /// state there from the polynomial: continuous output of order 3, Hairer & Wanner IV.8,
+    /// eq. 8.12), or `None` to go on. Returns the time reached: `t_end`, or where `stop` ended it.
+    /// A call that starts where one ended inside a step restarts the integration (its first step
+    /// extrapolates nothing), as after any change of the state.
+    pub fn integrate_until<S: OdeSystem + ?Sized>(
         &mut self,
         sys: &S,
-        t0: f64,
+        (t0, t_end): (f64, f64),
         x: &mut [f64],
-        t_end: f64,
         budget: Option<u64>,
-    ) -> Result<(), SolveError> {
+        mut stop: impl FnMut(&Dense<'_>) -> Option<f64>,
+    ) -> Result<f64, SolveError> {
+        if budget.is_some() {
+            self.accuracy_loss = 0.0;
+        }
         let (n, rhs0) = (self.n as u64, self.stats.rhs_evals);
         let Some(continues) = self.begin(sys, t0, x, t_end)? else {
-            return Ok(());
+            return Ok(t_end);
         };
         let mut t = t0;
 
@@ -523,7 +560,7 @@ impl Radau5 {
                     x.copy_from_slice(&self.y);
                     self.accuracy_loss = tail?;
                     self.h_hint = h_nat.min(self.max_step);
-                    return Ok(());
+                    return Ok(self.stop_at(stop(&self.dense()), x));
                 }
             }
             n_attempts += 1;
@@ -615,13 +652,14 @@ impl Radau5 {
             }
             self.accept(h, t);
 
-            if last {
+            let stopped = stop(&self.dense());
+            if last || stopped.is_some() {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
                 let hint = if hnew < h { hnew } else { hnew.max(h_nat) };
                 self.h_hint = hint.min(self.max_step);
                 self.theta = theta;
                 x.copy_from_slice(&self.y);
-                return Ok(());
+                return Ok(self.stop_at(stopped, x));
             }
             hnew = hnew.min(self.max_step);
             if reject {
@@ -732,6 +770,23 @@ impl Radau5 {
         }
         let omitted: f64 = self.y0.iter().zip(&self.scal).map(|(f, s)| (h * f / s).powi(2)).sum();
         (omitted / self.n as f64).sqrt()
+    }
+
+    /// The collocation polynomial of the last accepted step.
+    fn dense(&self) -> Dense<'_> {
+        Dense { t: self.t_cont, h: self.h_cont, y: &self.y, cont: &self.cont }
+    }
+
+    /// Where an integration that reached the last accepted step's end (its state in `x`) ends:
+    /// there, or at the time `stop` chose within the step, with the polynomial's state in `x`.
+    fn stop_at(&self, stop: Option<f64>, x: &mut [f64]) -> f64 {
+        match stop {
+            Some(t) if t < self.t_cont => {
+                self.dense().at(t, x);
+                t
+            }
+            _ => self.t_cont,
+        }
     }
 
     /// Accuracy-loss indicator of the last [`integrate_bounded`](Self::integrate_bounded) call,

@@ -39,8 +39,20 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
 }
 
-/// Fixed steps: a loose tolerance keeps the error test passing and `max_step` pins `h`; the
-/// hint starts at `h`. With the exact Jacobian of a linear problem, Newton is exact, so the
+/// An integrator of [`Linear`] that takes fixed steps `h`: a loose tolerance keeps the error test
+/// passing and `max_step` pins `h`; the hint starts at `h`.
+fn fixed_step(h: f64) -> Radau5 {
+    let mut s = Radau5::new(3);
+    s.set_rtol(0.5).unwrap();
+    s.set_atol(&[1e3; 3]).unwrap();
+    s.set_max_step(h).unwrap();
+    let mut saved = s.save_state();
+    saved[0] = h;
+    s.load_state(&saved).unwrap();
+    s
+}
+
+/// Fixed steps ([`fixed_step`]). With the exact Jacobian of a linear problem, Newton is exact, so the
 /// error is the method's truncation error. Radau IIA with 3 stages has classical order
 /// 2s-1 = 5 at the grid points (Hairer–Wanner IV.5, Thm 5.3): halving `h` divides the error
 /// at t = 1 by 2^5. Accept a measured order within ±0.3 (pre-asymptotic terms at h = 0.1).
@@ -48,13 +60,7 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
 fn convergence_order_is_five() {
     let mut errs = Vec::new();
     for h in [0.1, 0.05, 0.025] {
-        let mut s = Radau5::new(3);
-        s.set_rtol(0.5).unwrap();
-        s.set_atol(&[1e3; 3]).unwrap();
-        s.set_max_step(h).unwrap();
-        let mut saved = s.save_state();
-        saved[0] = h;
-        s.load_state(&saved).unwrap();
+        let mut s = fixed_step(h);
         let mut x = Linear::exact(0.0);
         s.integrate(&Linear, 0.0, &mut x, 1.0).unwrap();
         assert_eq!(s.stats().accepted_steps, (1.0 / h).round() as u64);
@@ -414,4 +420,70 @@ fn closing_steps_have_order_five() {
         let order = (errs[k] / errs[k + 1]).log2();
         assert!((order - 5.0).abs() < 0.3, "measured order {order}, errors {errs:?}");
     }
+}
+
+/// The continuous output between grid points: the collocation polynomial of Radau IIA with 3
+/// stages has stage order 3, so its error inside a step is O(h^4) (Hairer & Wanner IV.8, eq.
+/// 8.12 and the remark after it): halving the fixed step divides the largest error at the
+/// steps' midpoints by 2^4 (within ±0.5 of the order: pre-asymptotic terms); at each step's end
+/// the polynomial is the accepted state exactly.
+#[test]
+fn dense_output_has_order_four_between_grid_points() {
+    let mut errs = Vec::new();
+    for h in [0.1, 0.05, 0.025] {
+        let mut s = fixed_step(h);
+        let mut x = Linear::exact(0.0);
+        let (mut worst, mut mid) = (0.0_f64, [0.0; 3]);
+        let reached = s
+            .integrate_until(&Linear, (0.0, 1.0), &mut x, None, |d| {
+                let (a, b) = d.span();
+                d.at(b, &mut mid);
+                assert_eq!(&mid[..], d.end(), "the polynomial ends at the accepted state");
+                d.at(0.5 * (a + b), &mut mid);
+                worst = worst.max(max_abs_diff(&mid, &Linear::exact(0.5 * (a + b))));
+                None
+            })
+            .unwrap();
+        assert_eq!(reached, 1.0);
+        errs.push(worst);
+    }
+    for k in 0..2 {
+        let order = (errs[k] / errs[k + 1]).log2();
+        assert!((order - 4.0).abs() < 0.5, "measured order {order}, errors {errs:?}");
+    }
+}
+
+/// An integration stopped inside a step: it returns the time asked for with the polynomial's
+/// state there, within the tolerance's accuracy of the exact solution (rtol 1e-8: error 1e-7
+/// stated with a factor 10 for the global error), and the next call from there reaches the end
+/// as a run without the stop does, within the same bound. Stopping at a step's end keeps the
+/// integration going as one (the next call continues it: bit for bit the same end state).
+#[test]
+fn an_integration_stops_where_asked() {
+    let run = |stop_inside: bool| {
+        let mut s = Radau5::new(3);
+        s.set_rtol(1e-8).unwrap();
+        s.set_atol(&[1e-8; 3]).unwrap();
+        let mut x = Linear::exact(0.0);
+        let mut stops = 0;
+        let t = s
+            .integrate_until(&Linear, (0.0, 2.0), &mut x, None, |d| {
+                let (a, b) = d.span();
+                stops += 1;
+                (stops == 3).then_some(if stop_inside { 0.5 * (a + b) } else { b })
+            })
+            .unwrap();
+        assert!(t > 0.0 && t < 2.0, "stopped at {t}");
+        assert!(max_abs_diff(&x, &Linear::exact(t)) < 1e-7, "state at {t}: {x:?}");
+        s.integrate(&Linear, t, &mut x, 2.0).unwrap();
+        x
+    };
+    let mut s = Radau5::new(3);
+    s.set_rtol(1e-8).unwrap();
+    s.set_atol(&[1e-8; 3]).unwrap();
+    let mut whole = Linear::exact(0.0);
+    s.integrate(&Linear, 0.0, &mut whole, 2.0).unwrap();
+    assert_eq!(run(false), whole, "a stop at a step's end changes nothing");
+    let inside = run(true);
+    assert!(max_abs_diff(&inside, &Linear::exact(2.0)) < 1e-7, "{inside:?}");
 }

@@ -18,7 +18,7 @@ use crate::xml::{
 use boomsim::fmu::guid::token;
 use boomsim::fmu::instance::INDEPENDENT_VR;
 use boomsim::fmu::log::num;
-use boomsim::fmu::model::{clock_row, Model};
+use boomsim::fmu::model::{clock_row, has_event_mode, Model};
 use boomsim::fmu::structure::probe;
 use boomsim::fmu::variables::{Causality, Kind, Variable};
 use std::io;
@@ -136,14 +136,15 @@ fn write<M: Model>() -> io::Result<String> {
             ("providesEvaluateDiscreteStates", flag(false)),
         ]);
         element(w, "ModelExchange", &me)?;
-        // A model with a Clock has Event Mode in Co-Simulation (FMI 3.0, 4.4: required then).
+        // A model with a Clock has Event Mode in Co-Simulation (FMI 3.0, 4.4: required then); one
+        // with event indicators too, and may end a step early at their roots (4.2.3).
         let cs = interface(vec![
             ("canHandleVariableCommunicationStepSize", flag(true)),
             ("maxOutputDerivativeOrder", "0".into()),
             ("providesIntermediateUpdate", flag(false)),
-            ("mightReturnEarlyFromDoStep", flag(false)),
+            ("mightReturnEarlyFromDoStep", flag(!M::EVENT_INDICATORS.is_empty())),
             ("canReturnEarlyAfterIntermediateUpdate", flag(false)),
-            ("hasEventMode", flag(clock_row::<M>().is_some())),
+            ("hasEventMode", flag(has_event_mode::<M>())),
             ("providesEvaluateDiscreteStates", flag(false)),
         ]);
         element(w, "CoSimulation", &cs)?;
