@@ -15,7 +15,7 @@ Coupling (Gauss-Seidel, loop-free). The plant's outputs do not depend directly o
 [t_k, t_k+1] is
     plant.doStep(t_k, h)                         with valve.u_ref = u_k held over the step
     p4_k+1 = plant.p4
-    controller.setRealInputDerivatives(p, (p4_k+1 - p4_k) / h)      (unless --hold)
+    controller.setRealInputDerivatives(p, (p4_k+1 - p4_k) / h)      (unless --hold; FMI 3.0: below)
     controller.doStep(t_k, h)                    the filter sees p4 linear over the step
     controller.p = p4_k+1, controller.u_ref = u_ref(t_k+1);  u_k+1 = controller.u
     plant.valve.u_ref = u_k+1
@@ -27,8 +27,10 @@ delay (h/2 on average, a phase lag of omega*h/2). That limits the usable step (s
 docs/python.md and `scripts/regress --step-sweep`).
 
 FMI 3.0 (`--fmi 3`, the .fmu files of target/fmu/fmi3: the same binaries) has no input
-derivatives, so its Co-Simulation runs with `--hold`; with the same hold, FMI 2.0 and FMI 3.0
-give bit-identical results (tests/python/test_fmi3.py).
+derivatives: the controller gets p4 linear over the step by intermediate update instead
+(`fmus.LinearInputs`: its callback sets p on the line from p4_k to p4_k+1 where the FMU asks),
+and FMI 2.0 and FMI 3.0 give bit-identical results, with the slope and with `--hold`
+(tests/python/test_fmi3.py).
 
 The scenario files (scenarios/*.toml beside this module) are documented in docs/python.md, "Scenario files".
 """
@@ -44,7 +46,7 @@ import time
 import numpy as np
 
 from .errors import Skip, UsageError, cli
-from .fmus import FmuFile, boom_switch, initialize_plant, release, with_params
+from .fmus import FmuFile, LinearInputs, boom_switch, initialize_plant, release, with_params
 from .metrics import CBV_OPEN
 from .model_exchange import run_me
 from .paths import OUT
@@ -75,14 +77,13 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
         tolerance: float | None = None, fmi: int = 2, params: dict | None = None, reuse: bool = False,
         timeout: float | None = None) -> Result:
     """Co-simulate one scenario variant. `record_every` thins the recorded rows (default: one
-    row per millisecond or per step, whichever is coarser); `fmi`: the FMUs' FMI version (3: no
-    input derivatives, so `interpolate` must be False); `params`: FMU parameters by variable name
+    row per millisecond or per step, whichever is coarser); `fmi`: the FMUs' FMI version (3: the
+    controller's p4, linear over a step with `interpolate`, by intermediate update, as FMI 3.0 has
+    no input derivatives; that controller is never reused); `params`: FMU parameters by variable name
     (HydraulicBoom's or the controller's), set after the scenario's. `reuse`: take the instances
     of an earlier run with `reuse` (fmi2Reset) instead of instantiating, and keep them after a
     run that succeeds (a failed run frees them). `timeout` [s]: a TimeoutError when the wall
     time exceeds it, checked between communication steps (a single doStep is not interrupted)."""
-    if fmi == 3 and interpolate:
-        raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
     scenario, ctrl_params = with_params(scenario, plant_f, params)
@@ -92,9 +93,12 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
 
     deadline = time.monotonic() + timeout if timeout is not None else math.inf
     new = (lambda f, name: f.reused_slave(name)) if reuse else (lambda f, name: f.slave(name))
-    plant = new(plant_f, f"{scenario['id']}.plant")
-    ctrl = new(ctrl_f, f"{scenario['id']}.controller")
     vp, vc = plant_f.vr, ctrl_f.vr
+    plant = new(plant_f, f"{scenario['id']}.plant")
+    # FMI 3.0: p4 linear over a step by intermediate update (FMI 2.0: its derivative).
+    p_line = LinearInputs([vc["p"]]) if fmi == 3 and interpolate else None
+    ctrl = ctrl_f.slave(f"{scenario['id']}.controller", inputs=p_line) if p_line else new(
+        ctrl_f, f"{scenario['id']}.controller")
     ok = False
     try:
         initialize_plant(plant_f, plant, ctrl, scenario, switch, tolerance, t_end)
@@ -136,7 +140,9 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
             plant.doStep(t, step)
             y = plant.getReal(out_p)
             p4_next = y[i_p4]
-            if interpolate:
+            if p_line:
+                p_line.over(t, step, [p4], [p4_next])
+            elif interpolate:
                 ctrl.setRealInputDerivatives([vc["p"]], [1], [(p4_next - p4) / step])
             ctrl.doStep(t, step)
             p4 = p4_next
@@ -153,7 +159,10 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
     finally:
         if reuse and ok:
             plant_f.give_back(plant)
-            ctrl_f.give_back(ctrl)
+            if p_line is None:
+                ctrl_f.give_back(ctrl)
+            else:
+                release(ctrl)
         else:
             release(plant, ctrl)
     return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at,
@@ -172,7 +181,8 @@ def main(argv=None):
     ap.add_argument("--interface", choices=("cs", "me"), default="cs",
                     help="cs: both FMUs' fmi2DoStep (default); me: both as Model Exchange under fmpy's CVode, one ODE")
     ap.add_argument("--fmi", type=int, choices=(2, 3), default=2,
-                    help="FMI version of the FMUs: 2 (target/fmu, default) or 3 (target/fmu/fmi3; CS needs --hold)")
+                    help="FMI version of the FMUs: 2 (target/fmu, default) or 3 (target/fmu/fmi3; "
+                         "CS passes the slope of p4 by intermediate update)")
     ap.add_argument("--feedback-start", choices=("t0", "cbv_open"), default=None,
                     help="only this feedback start (default: every start listed by the scenario)")
     ap.add_argument("--out", default=str(OUT / "cosim"))

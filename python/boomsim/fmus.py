@@ -43,7 +43,34 @@ class Fmi3:
         return self.m.doStep(t, h)
 
     def setRealInputDerivatives(self, *_):
-        raise UsageError("FMI 3.0 has no input derivatives: run FMI 3.0 Co-Simulation with --hold")
+        raise UsageError("FMI 3.0 has no input derivatives: pass ramped inputs by intermediate update "
+                         "(boomsim.fmus.LinearInputs), or run FMI 3.0 Co-Simulation with --hold")
+
+
+class LinearInputs:
+    """A master's inputs linear over each communication step, passed to an FMI 3.0 Co-Simulation
+    FMU by intermediate update (FMI 3.0, 4.2.3), FMI 3.0's replacement for FMI 2.0's input
+    derivatives: where the FMU's callback requests them, each input `vrs` is set on the line from
+    its value at the step's start to its value at the step's end (that exactly at the end). Give
+    it to `FmuFile.slave(..., inputs=...)` and call `over` before each doStep."""
+
+    def __init__(self, vrs: list[int]):
+        self.vrs = list(vrs)
+        self.line = None
+        self.slave = None
+
+    def over(self, t: float, h: float, start: list[float], end: list[float]) -> None:
+        """The inputs' line over the step from `t` of size `h`."""
+        self.line = (t, h, list(start), list(end))
+
+    def callback(self, _env, t, set_requested, _get_allowed, _finished, _can_return_early, early_return_requested,
+                 _early_return_time):
+        """fmi3IntermediateUpdateCallback: sets the inputs where requested, never asks for an early return."""
+        early_return_requested[0] = False
+        if set_requested and self.line is not None:
+            t0, h, y0, y1 = self.line
+            values = y1 if t == t0 + h else [a + (b - a) * (t - t0) / h for a, b in zip(y0, y1)]
+            self.slave.setFloat64(self.vrs, values)
 
     def getDerivatives(self, p, n):
         return self.m.getContinuousStateDerivatives(p, n)
@@ -101,9 +128,16 @@ class FmuFile:
         i.instantiate(**instantiate)
         return Fmi3(i) if self.fmi == 3 else i
 
-    def slave(self, name: str, event_mode: bool = False):
-        """A Co-Simulation instance; `event_mode`: FMI 3.0 with Event Mode (eventModeUsed)."""
-        return self._instance("CoSimulation", name, **({"eventModeUsed": True} if event_mode else {}))
+    def slave(self, name: str, event_mode: bool = False, inputs: LinearInputs | None = None):
+        """A Co-Simulation instance; `event_mode`: FMI 3.0 with Event Mode (eventModeUsed); `inputs`:
+        FMI 3.0 inputs linear over a step, set by intermediate update."""
+        args = {"eventModeUsed": True} if event_mode else {}
+        if inputs is not None:
+            args.update(intermediateUpdate=inputs.callback, requiredIntermediateVariables=inputs.vrs)
+        s = self._instance("CoSimulation", name, **args)
+        if inputs is not None:
+            inputs.slave = s.m
+        return s
 
     def model(self, name: str):
         """A Model Exchange instance."""

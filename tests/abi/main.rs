@@ -9,5 +9,6 @@ mod directional_derivatives;
 mod fmi2_api;
 mod fmi3_api;
 mod hardening;
+mod intermediate_update;
 mod misuse;
 mod model_exchange;

@@ -88,7 +88,7 @@ pub unsafe fn instantiate<M: Model>(
         if let Err(e) = calls::check_identity(fmu_guid, "fmuGUID", "GUID", &expected) {
             return fail(e);
         }
-        Some(calls::new_instance::<M>(logger, expected, Version::Fmi2, interface, (false, false)))
+        Some(calls::new_instance::<M>(logger, expected, Version::Fmi2, interface, |_| {}))
     })
     .ok()
     .flatten()

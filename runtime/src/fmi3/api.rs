@@ -8,7 +8,7 @@ use super::machine::{allowed, Interface, Rule, Mode};
 use super::types::*;
 use crate::fmu::calls::{self, call, slice, slice_mut, Call};
 use crate::fmu::guid::token;
-use crate::fmu::instance::Instance;
+use crate::fmu::instance::{Instance, Master};
 use crate::fmu::log::{num, Logger};
 use crate::fmu::model::{clock_row, has_event_mode, Model};
 use crate::fmu::variables::{BaseType, Value};
@@ -51,7 +51,7 @@ unsafe fn instantiate<M: Model>(
     (name, instantiation_token): (fmi3String, fmi3String),
     logging_on: bool,
     (environment, log_message): (fmi3InstanceEnvironment, fmi3LogMessageCallback),
-    more: impl FnOnce() -> Result<(), String>,
+    more: impl FnOnce() -> Result<Option<Master>, String>,
 ) -> fmi3Instance {
     catch_unwind(std::panic::AssertUnwindSafe(|| {
         let sink = Box::new(Sink(log_message, environment));
@@ -63,10 +63,9 @@ unsafe fn instantiate<M: Model>(
             })
             .and_then(|_| more());
         match checked {
-            Ok(()) => {
-                let modes = (event_mode_used, early_return_allowed);
-                calls::new_instance::<M>(logger, expected, Version::Fmi3, interface, modes)
-            }
+            Ok(master) => calls::new_instance::<M>(logger, expected, Version::Fmi3, interface, |i| {
+                (i.event_mode_used, i.early_return_allowed, i.master) = (event_mode_used, early_return_allowed, master);
+            }),
             Err(message) => {
                 logger.status(fmi3Status::Error, &format!("{function}: {message}"));
                 std::ptr::null_mut()
@@ -92,14 +91,15 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
         (name, instantiation_token),
         logging_on,
         (environment, log_message),
-        || Ok(()),
+        || Ok(None),
     )
 }
 
 /// fmi3InstantiateCoSimulation: `eventModeUsed` for a model with a Clock (required) or event
 /// indicators (`hasEventMode="true"`), else refused; `earlyReturnAllowed` makes a model with event
-/// indicators end a step at their first root (`mightReturnEarlyFromDoStep="true"`); required
-/// intermediate variables are refused (`providesIntermediateUpdate="false"`).
+/// indicators end a step at their first root (`mightReturnEarlyFromDoStep="true"`); an
+/// `intermediateUpdate` callback is called in every step of a model with intermediate inputs
+/// (`providesIntermediateUpdate="true"`), which sets the `requiredIntermediateVariables` there.
 pub unsafe fn instantiate_co_simulation<M: Model>(
     name: fmi3String,
     instantiation_token: fmi3String,
@@ -108,13 +108,14 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     logging_on: fmi3Boolean,
     event_mode_used: fmi3Boolean,
     early_return_allowed: fmi3Boolean,
-    _required_intermediate_variables: *const fmi3ValueReference,
+    required_intermediate_variables: *const fmi3ValueReference,
     n_required_intermediate_variables: usize,
     environment: fmi3InstanceEnvironment,
     log_message: fmi3LogMessageCallback,
-    _intermediate_update: fmi3IntermediateUpdateCallback,
+    intermediate_update: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
     let more = || {
+        let mut master = None;
         if clock_row::<M>().is_some() && !event_mode_used {
             return Err(
                 "eventModeUsed = false, but the FMU has a Clock, which needs Event Mode (FMI 3.0, 2.3.1: \"For FMUs \
@@ -127,12 +128,32 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
                 "eventModeUsed = true, but the FMU has no event mode in Co-Simulation (hasEventMode=\"false\")".into(),
             );
         }
-        if n_required_intermediate_variables != 0 {
+        let limit = (M::INTERMEDIATE_INPUTS.len(), "the model's intermediate inputs");
+        let inputs = calls::slice(
+            required_intermediate_variables,
+            n_required_intermediate_variables,
+            limit,
+            "requiredIntermediateVariables",
+        )?;
+        if let Some(&r) = inputs.iter().find(|r| !M::INTERMEDIATE_INPUTS.contains(r)) {
+            let intermediate = M::VARIABLES.iter().filter(|v| M::INTERMEDIATE_INPUTS.contains(&v.vr));
+            let names: Vec<&str> = intermediate.map(|v| v.name).collect();
             return Err(format!(
-                "nRequiredIntermediateVariables = {n_required_intermediate_variables}, but the FMU provides no intermediate update (providesIntermediateUpdate=\"false\"); valid: 0"
+                "requiredIntermediateVariables names value reference {r}, which has no intermediateUpdate=\"true\"; \
+                 valid: {}",
+                if names.is_empty() { "none (providesIntermediateUpdate=\"false\")".into() } else { names.join(", ") }
             ));
         }
-        Ok(())
+        match intermediate_update {
+            Some(callback) if !M::INTERMEDIATE_INPUTS.is_empty() => {
+                master = Some(Master { callback, environment, inputs: inputs.to_vec() });
+            }
+            None if !inputs.is_empty() => {
+                return Err("requiredIntermediateVariables are given, but intermediateUpdate is NULL".into());
+            }
+            _ => {}
+        }
+        Ok(master)
     };
     let f = "fmi3InstantiateCoSimulation";
     instantiate::<M>(
@@ -642,8 +663,9 @@ pub unsafe fn get_output_derivatives<M: Model>(c: fmi3Instance) -> fmi3Status {
 }
 
 /// fmi3DoStep. The out-arguments are checked before the step: `earlyReturn` where the step ended
-/// before `t + h` at an event (with `earlyReturnAllowed`), `eventHandlingNeeded` where it ended at
-/// an event and the importer uses Event Mode (4.2.3), `terminateSimulation` once a step was
+/// before `t + h` at an event (with `earlyReturnAllowed`) or where the master asked from its
+/// intermediate update, `eventHandlingNeeded` where it ended at an event and the importer uses
+/// Event Mode (4.2.3), `terminateSimulation` once a step was
 /// discarded (the instance is then in Step Discarded), and the time the instance reached.
 pub unsafe fn do_step<M: Model>(
     c: fmi3Instance,
@@ -654,14 +676,15 @@ pub unsafe fn do_step<M: Model>(
     last_successful_time: *mut f64,
 ) -> fmi3Status {
     let f = at("fmi3DoStep", allowed::DO_STEP);
-    call::<M>(c, f, |inst| {
+    calls::call_reentrant::<M>(c, f, |c| {
         let event = event_handling_needed.as_mut().ok_or("eventHandlingNeeded is NULL")?;
         let term = terminate.as_mut().ok_or("terminateSimulation is NULL")?;
         let early = early_return.as_mut().ok_or("earlyReturn is NULL")?;
         let last = last_successful_time.as_mut().ok_or("lastSuccessfulTime is NULL")?;
-        let status = calls::do_step(inst, f.function, t, h);
-        *event = inst.event.is_some() && inst.event_mode_used;
-        *early = inst.event.is_some_and(|t_event| t_event < t + h);
+        let status = calls::do_step_with_master::<M>(c, f, t, h);
+        let inst = calls::borrow::<M>(c, f)?;
+        *event = inst.ended.is_some_and(|e| e.event) && inst.event_mode_used;
+        *early = inst.ended.is_some_and(|e| e.t < t + h);
         *term = inst.core.mode == Mode::StepFailed;
         *last = inst.core.last_successful_time;
         status

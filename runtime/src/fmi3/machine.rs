@@ -4,8 +4,8 @@
 //! FMI 3.0's Step Mode, `StepFailed` its Step Discarded; `StepCanceled` is never entered. There
 //! are no structural parameters, and Event Mode in Co-Simulation only for the one model with a
 //! Clock (`hasEventMode="true"`, instantiated with `eventModeUsed`, checked per instance), so
-//! Configuration, Reconfiguration, Clock Activation and Intermediate Update Mode are never
-//! entered.
+//! Configuration, Reconfiguration and Clock Activation Mode are never entered; Intermediate
+//! Update Mode (`IntermediateUpdate`) only while the master's callback runs inside doStep.
 
 pub use crate::fmu::machine::*;
 
@@ -24,8 +24,9 @@ pub mod allowed {
     pub const RESET: Rule = both(ANY);
     pub const GET: Rule = both(INIT | DONE | FAIL | EVENT | CONT | TERM | ERR);
     /// fmi3SetFloat64; in Continuous-Time Mode only continuous inputs and continuous-time states
-    /// (3.2.1, as of FMI 3.0.2; checked per variable).
-    pub const SET_FLOAT64: Rule = both(INST | INIT | DONE | EVENT | CONT);
+    /// (3.2.1, as of FMI 3.0.2; checked per variable); in Intermediate Update Mode the required
+    /// intermediate inputs while the callback requests them (4.2.3; checked per instance).
+    pub const SET_FLOAT64: Rule = both(INST | INIT | DONE | EVENT | CONT | IU);
     /// fmi3SetInt32, fmi3SetBoolean, fmi3SetString (and the other types): not in Continuous-Time Mode.
     pub const SET_DISCRETE: Rule = both(INST | INIT | DONE | EVENT);
     pub const FMU_STATE: Rule = both(ANY);

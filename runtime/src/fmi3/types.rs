@@ -25,7 +25,8 @@ pub type fmi3Status = crate::fmu::Status;
 /// fmi3LogMessageCallback: not variadic (unlike FMI 2.0's logger), no instance name.
 pub type fmi3LogMessageCallback =
     Option<unsafe extern "C" fn(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String)>;
-/// fmi3IntermediateUpdateCallback (never called: `providesIntermediateUpdate="false"`).
+/// fmi3IntermediateUpdateCallback: called inside fmi3DoStep where the master required intermediate
+/// inputs or allowed an early return (`crate::fmu::calls::do_step_with_master`).
 pub type fmi3IntermediateUpdateCallback = Option<
     unsafe extern "C" fn(
         fmi3InstanceEnvironment,

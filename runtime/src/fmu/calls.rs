@@ -7,14 +7,16 @@
 #![allow(clippy::missing_safety_doc)]
 
 use super::snapshot;
-use super::instance::{Core, Instance, Step, Warning};
+use super::driver::Intermediate;
+use super::instance::{Core, Instance, Master, Step, Warning};
 use super::log::{Logger, Status, GENERIC_CATEGORIES, LOG_FMI_CALLS};
-use super::model::Model;
+use super::model::{Log, Model};
 use super::machine::{describe, Interface, Rule, Mode};
-use super::variables::{BaseType, Value};
+use super::variables::{BaseType, Value, Values};
 use super::version::Version;
 use std::ffi::{CStr, CString};
 use std::os::raw::{c_char, c_void};
+use std::marker::PhantomData;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// An instance pointer as both versions pass it (fmi2Component, fmi3Instance).
@@ -42,9 +44,20 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
 
 /// Runs `body` for a valid instance in an allowed state; errors are logged, panics caught.
 pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) -> Result<Status, String>) -> Status {
+    // SAFETY: `call_reentrant` gives `c` only after it found a valid instance there.
+    call_reentrant::<M>(c, f, |c| body(unsafe { instance::<M>(c, f.version) }.ok_or("no instance")?))
+}
+
+/// [`call`] for a body that borrows the instance itself, anew for each of its phases, so that
+/// the instance can be called between them (FMI 3.0 intermediate update: the master's callback,
+/// inside doStep, calls the instance's setters). No borrow of the instance is held while `body`
+/// runs.
+pub fn call_reentrant<M: Model>(c: Handle, f: Call, body: impl FnOnce(Handle) -> Result<Status, String>) -> Status {
     // SAFETY: FMI requires `c` to be a pointer returned by instantiation; a null or foreign
-    // pointer is detected by the magic tag where the memory is readable.
-    let Some(inst) = (unsafe { instance::<M>(c, f.version) }) else {
+    // pointer is detected by the magic tag where the memory is readable. Each borrow below ends
+    // before the next begins.
+    let borrow = || unsafe { instance::<M>(c, f.version) };
+    let Some(inst) = borrow() else {
         return Status::Error;
     };
     let function = f.function;
@@ -62,8 +75,11 @@ pub fn call<M: Model>(c: Handle, f: Call, body: impl FnOnce(&mut Instance<M>) ->
         if f.rule.states & state.bit() == 0 {
             return Err(format!("illegal call in state {state:?}; it is allowed in: {}", describe(f.rule.states)));
         }
-        body(inst)
+        body(c)
     }));
+    let Some(inst) = borrow() else {
+        return Status::Error;
+    };
     match result {
         Ok(Ok(status)) => status,
         Ok(Err(message)) => {
@@ -176,18 +192,17 @@ pub unsafe fn check_identity(identity: *const c_char, what: &str, kind: &str, ex
     }
 }
 
-/// A new instance on the heap, as the pointer instantiation returns; `event_mode_used`,
-/// `early_return_allowed`: FMI 3.0 Co-Simulation with Event Mode, with early return.
+/// A new instance on the heap, as the pointer instantiation returns, with `configure`'s settings
+/// (FMI 3.0 Co-Simulation: Event Mode, early return, the master's intermediate update).
 pub fn new_instance<M: Model>(
     log: Logger,
     guid: String,
     version: Version,
     interface: Interface,
-    (event_mode_used, early_return_allowed): (bool, bool),
+    configure: impl FnOnce(&mut Instance<M>),
 ) -> Handle {
     let mut instance = Instance::<M>::new(log, guid, version, interface);
-    instance.event_mode_used = event_mode_used;
-    instance.early_return_allowed = early_return_allowed;
+    configure(&mut instance);
     Box::into_raw(Box::new(instance)) as Handle
 }
 
@@ -487,12 +502,156 @@ pub unsafe fn get_directional_derivative<M: Model>(
 
 /// doStep: OK or Warning when done, Discard (logged) when stopped at the last good time.
 pub fn do_step<M: Model>(inst: &mut Instance<M>, function: &str, t: f64, h: f64) -> Result<Status, String> {
-    match inst.do_step(t, h)? {
-        Step::Done(warning) => Ok(warn(inst, function, warning)),
+    let step = inst.do_step(t, h)?;
+    Ok(step_status(inst, function, step))
+}
+
+/// The status of a step carried out, its warning or why it was discarded logged.
+fn step_status<M: Model>(inst: &Instance<M>, function: &str, step: Step) -> Status {
+    match step {
+        Step::Done(warning) => warn(inst, function, warning),
         Step::Discarded(why) => {
             inst.log.status(Status::Discard, &format!("{function}: {why}"));
-            Ok(Status::Discard)
+            Status::Discard
         }
+    }
+}
+
+/// The instance behind `c` for one phase of a [`call_reentrant`] body.
+///
+/// # Safety
+/// `c` was checked by `call_reentrant`; no other borrow of the instance may be alive.
+pub unsafe fn borrow<'a, M: Model>(c: Handle, f: Call) -> Result<&'a mut Instance<M>, String> {
+    instance::<M>(c, f.version).ok_or_else(|| "no instance".into())
+}
+
+/// FMI 3.0 doStep of an instance whose master provides intermediate update (4.2.3): the step
+/// runs while the instance is free for the master's calls from its callback (the model and the
+/// step's values are the step's own meanwhile, the model's log messages are kept and logged when
+/// it ends); without a master, [`do_step`].
+///
+/// # Safety
+/// As [`borrow`]: `c` was checked by `call_reentrant`, and no borrow of the instance is alive.
+pub unsafe fn do_step_with_master<M: Model>(c: Handle, f: Call, t: f64, h: f64) -> Result<Status, String> {
+    let inst = borrow::<M>(c, f)?;
+    let Some(master) = inst.master.clone() else {
+        return do_step(inst, f.function, t, h);
+    };
+    let mut begun = inst.begin_step(t, h)?;
+    let mut log = KeptLog::new(&inst.log, M::INFO.log_categories);
+    let (values, input_derivatives) = (inst.core.values.clone(), inst.core.input_derivatives.clone());
+    let can_return_early = inst.early_return_allowed;
+    let mut callback = Callback::<M> { c, f, values: values.clone(), master, can_return_early, model: PhantomData };
+    // No borrow of the instance while the step runs: the callback's calls borrow it.
+    let result = begun.run((&values, &input_derivatives), &mut log, Some(&mut callback));
+    let inst = borrow::<M>(c, f)?;
+    log.replay(&inst.log);
+    let step = inst.end_step(begun, result)?;
+    Ok(step_status(inst, f.function, step))
+}
+
+/// The master's intermediateUpdate callback during one doStep (FMI 3.0, 4.2.3), through the
+/// instance's handle: before each attempted integrator step it asks for the intermediate inputs
+/// at the step's end (`intermediateVariableSetRequested`, tentative: `intermediateStepFinished`
+/// false), after each accepted one it tells the time reached (`intermediateStepFinished`) and
+/// takes an early-return request (`canReturnEarly` with `earlyReturnAllowed`). Outputs are not
+/// offered (`intermediateVariableGetAllowed` false: no output has `intermediateUpdate="true"`).
+struct Callback<M: Model> {
+    c: Handle,
+    f: Call,
+    master: Master,
+    /// The variable values at the step's start (the inputs the master did not require).
+    values: Values,
+    can_return_early: bool,
+    model: PhantomData<M>,
+}
+
+impl<M: Model> Callback<M> {
+    /// Calls the master in Intermediate Update Mode at `t`; returns its early-return request.
+    fn call(&mut self, t: f64, set_requested: bool, finished: bool) -> Result<Option<f64>, String> {
+        // SAFETY: each borrow ends before the callback runs, and the callback's own calls end
+        // before the next borrow.
+        let inst = unsafe { borrow::<M>(self.c, self.f) }?;
+        inst.core.mode = Mode::IntermediateUpdate;
+        inst.set_requested = set_requested;
+        let can_return_early = self.can_return_early && finished;
+        let (mut requested, mut time) = (false, t);
+        unsafe {
+            (self.master.callback)(
+                self.master.environment,
+                t,
+                set_requested,
+                false,
+                finished,
+                can_return_early,
+                &mut requested,
+                &mut time,
+            )
+        };
+        let inst = unsafe { borrow::<M>(self.c, self.f) }?;
+        inst.set_requested = false;
+        if inst.core.mode != Mode::IntermediateUpdate {
+            return Err("a call in intermediate update failed".into());
+        }
+        inst.core.mode = Mode::StepComplete;
+        Ok((requested && can_return_early && time.is_finite()).then_some(time))
+    }
+}
+
+impl<M: Model> Intermediate for Callback<M> {
+    /// The master's values of the inputs it required, the step's start values of the others.
+    fn inputs(&mut self, t: f64, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
+        if !self.master.inputs.is_empty() {
+            self.call(t, true, false)?;
+        }
+        let inst = unsafe { borrow::<M>(self.c, self.f) }?;
+        for (&r, u) in vrs.iter().zip(out) {
+            let values = if self.master.inputs.contains(&r) { &inst.core.values } else { &self.values };
+            *u = values.real(r);
+        }
+        Ok(())
+    }
+
+    fn accepted(&mut self, t: f64) -> Option<f64> {
+        self.call(t, false, true).ok().flatten()
+    }
+}
+
+/// A model's log during a step that runs without a borrow of the instance: the messages of its
+/// enabled categories and its warnings, logged through the instance's logger when the step ends.
+struct KeptLog {
+    enabled: Vec<&'static str>,
+    /// (category, or None for a warning; message).
+    messages: Vec<(Option<&'static str>, String)>,
+}
+
+impl KeptLog {
+    fn new(logger: &Logger, categories: &[(&'static str, &'static str)]) -> Self {
+        let enabled = categories.iter().map(|&(c, _)| c).filter(|c| logger.category_enabled(c)).collect();
+        KeptLog { enabled, messages: Vec::new() }
+    }
+
+    fn replay(self, logger: &Logger) {
+        for (category, message) in self.messages {
+            match category {
+                Some(c) => logger.info(c, &message),
+                None => logger.status(Status::Warning, &message),
+            }
+        }
+    }
+}
+
+impl Log for KeptLog {
+    fn enabled(&self, category: &str) -> bool {
+        self.enabled.contains(&category)
+    }
+    fn info(&mut self, category: &str, message: &str) {
+        if let Some(&c) = self.enabled.iter().find(|&&c| c == category) {
+            self.messages.push((Some(c), message.to_owned()));
+        }
+    }
+    fn warning(&mut self, message: &str) {
+        self.messages.push((None, message.to_owned()));
     }
 }
 

@@ -13,7 +13,7 @@
 
 use super::model::{Log, Model, StepError, StepStart};
 use super::variables::{Values, Variable};
-use crate::solver::{Dense, OdeSystem, Radau5, SolverStats};
+use crate::solver::{Dense, OdeSystem, Radau5, SolverStats, Watch};
 use std::ops::{Deref, DerefMut};
 
 /// The driver's variables' value references (stable: append, never renumber).
@@ -58,7 +58,7 @@ pub const SOLVER_VARIABLES: [Variable; 8] = [
 /// What a model asks of the driver at the start of a communication step.
 pub enum Step<'a, S> {
     /// Integrate `ode` from `state` (the model's, advanced in place) over the step.
-    Integrate(&'a S, &'a mut [f64]),
+    Integrate(&'a mut S, &'a mut [f64]),
     /// The model advanced itself over the step in closed form.
     Done,
 }
@@ -121,8 +121,13 @@ impl<M: Model> Driven<M> {
     ///
     /// With `early_return`, the step ends at the first root of the model's event indicators
     /// within it ([`Model::step_event_indicators`], located on the integrator's continuous
-    /// output), and returns its time. The state there has the indicators' new signs, so the
-    /// next step starts past the event.
+    /// output): the state there has the indicators' new signs, so the next step starts past the
+    /// event. With a `master` (FMI 3.0 intermediate update), the model's intermediate inputs
+    /// follow the values the master gives for the end of each attempted integrator step
+    /// ([`Model::intermediate_inputs`]), and after each accepted step the master may ask the step
+    /// to end at a time. Returns where the step ended, if not at `t + h`'s integration end: its
+    /// time and whether it was at an event.
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
         values: &Values,
@@ -130,30 +135,29 @@ impl<M: Model> Driven<M> {
         (t, h, tolerance): (f64, f64, f64),
         log: &mut dyn Log,
         early_return: bool,
-    ) -> Result<Option<f64>, StepError> {
+        master: Option<&mut dyn Intermediate>,
+    ) -> Result<Option<Ended>, StepError> {
         let fail = |time, message: String| StepError { time, message };
         let start = StepStart { values, input_derivatives, t, h };
-        let mut event = None;
-        let end = match (self.model.begin_step(&start, log)?, self.solver.as_mut().filter(|_| !M::CLOSED_FORM)) {
+        let (end, ended) = match (self.model.begin_step(&start, log)?, self.solver.as_mut().filter(|_| !M::CLOSED_FORM))
+        {
             (Step::Done, _) => return Ok(None),
             (Step::Integrate(ode, state), Some(solver)) => {
                 solver.set_tolerance(tolerance, || M::scale(ode)).map_err(|e| fail(t, e.to_string()))?;
                 let before = *solver.stats();
                 let budget =
                     (values.integer(vr::SOLVER_MODE) == REALTIME).then(|| values.integer(vr::RHS_BUDGET) as u64);
-                let mut roots = early_return.then(|| Roots::<M>::new(ode, t, state));
-                let reached = solver.integrate_until(ode, (t, t + h), state, budget, |dense| {
-                    event = roots.as_mut().and_then(|r| r.first(dense));
-                    event
-                });
+                let roots = early_return.then(|| Roots::<M>::new(ode, t, state));
+                let mut watch = Watched::<M> { ode, roots, master, ended: None, requested: None };
+                let reached = solver.integrate_until(&mut watch, (t, t + h), state, budget);
                 let end = reached.map_err(|e| fail(e.t, e.to_string()))?;
                 log_step(log, end, &before, solver.stats());
-                end
+                (end, watch.ended)
             }
             (Step::Integrate(..), None) => return Err(fail(t, "the model has no ODE state to integrate".into())),
         };
         self.model.communication_point(end);
-        Ok(event)
+        Ok(ended)
     }
 
     /// Writes the model's outputs and locals, and the integrator's counters.
@@ -202,34 +206,107 @@ impl<M: Model> Driven<M> {
 
 /// Most event indicators a model may declare (the circuit has 3): kept on the stack.
 pub const MAX_EVENT_INDICATORS: usize = 8;
+/// Most intermediate inputs a model may declare (the circuit has 3), checked at compile time.
+pub const MAX_INTERMEDIATE_INPUTS: usize = 4;
+
+/// A master that sets inputs between communication points: FMI 3.0's intermediate update
+/// (4.2.3), as the driver sees it.
+pub trait Intermediate {
+    /// Before an attempted integrator step, for each time at which it evaluates the model: the
+    /// master's values of the inputs `vrs` at `t` into `out`.
+    fn inputs(&mut self, t: f64, vrs: &[u32], out: &mut [f64]) -> Result<(), String>;
+
+    /// After an accepted integrator step ending at `t`: the time at which the master asks the
+    /// step to end, if it asks.
+    fn accepted(&mut self, t: f64) -> Option<f64>;
+}
+
+/// Why a step ended before the end of its communication step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ended {
+    pub t: f64,
+    /// At a root of an event indicator (else where the master asked).
+    pub event: bool,
+}
+
+/// The driver's watch of a step ([`Watch`]): the model's ODE, the search for event roots, the
+/// master's intermediate update.
+struct Watched<'a, 'b, M: Model> {
+    ode: &'a mut M::Ode,
+    roots: Option<Roots<M>>,
+    master: Option<&'b mut dyn Intermediate>,
+    ended: Option<Ended>,
+    /// The time the master asked the step to end at.
+    requested: Option<f64>,
+}
+
+impl<M: Model> Watch for Watched<'_, '_, M> {
+    type Ode = M::Ode;
+
+    fn ode(&self) -> &M::Ode {
+        self.ode
+    }
+
+    fn attempt(&mut self, t: f64, stages: [f64; 3]) {
+        let Some(master) = self.master.as_mut() else { return };
+        const { assert!(M::INTERMEDIATE_INPUTS.len() <= MAX_INTERMEDIATE_INPUTS) };
+        let vrs = M::INTERMEDIATE_INPUTS;
+        let mut u = [[0.0; MAX_INTERMEDIATE_INPUTS]; 3];
+        for (&ts, u) in stages.iter().zip(&mut u) {
+            // A failed call leaves the inputs as they were: the instance is Terminated, the
+            // master's error logged, and the step fails when it ends.
+            if master.inputs(ts, vrs, &mut u[..vrs.len()]).is_err() {
+                return;
+            }
+        }
+        let [a, b, c] = &u;
+        M::intermediate_inputs(self.ode, t, &[(stages[0], &a[..]), (stages[1], &b[..]), (stages[2], &c[..])]);
+    }
+
+    /// An event root first; else the master, told of the accepted step, may ask for an end
+    /// (within this step: there; later: at the step that reaches it; before it: at its start).
+    fn accepted(&mut self, dense: &Dense<'_>) -> Option<f64> {
+        if let Some(t) = self.roots.as_mut().and_then(|r| r.first(self.ode, dense)) {
+            self.ended = Some(Ended { t, event: true });
+            return Some(t);
+        }
+        let (a, b) = dense.span();
+        if let Some(t) = self.master.as_mut().and_then(|m| m.accepted(b)) {
+            self.requested = Some(t);
+        }
+        let t = self.requested.filter(|&t| t <= b)?.max(a);
+        self.ended = Some(Ended { t, event: false });
+        Some(t)
+    }
+}
 
 /// The search for the first root of a model's event indicators within a step.
-struct Roots<'a, M: Model> {
-    ode: &'a M::Ode,
+struct Roots<M: Model> {
     /// The indicators at the start of the integrator's current step.
     z: [f64; MAX_EVENT_INDICATORS],
     /// Work space: a state on the continuous output.
     x: Vec<f64>,
+    _model: std::marker::PhantomData<M>,
 }
 
-impl<'a, M: Model> Roots<'a, M> {
+impl<M: Model> Roots<M> {
     const N: usize = {
         assert!(M::EVENT_INDICATORS.len() <= MAX_EVENT_INDICATORS);
         M::EVENT_INDICATORS.len()
     };
 
-    /// The search over a step from `t` with state `x`.
-    fn new(ode: &'a M::Ode, t: f64, x: &[f64]) -> Self {
+    /// The search over a step of `ode` from `t` with state `x`.
+    fn new(ode: &M::Ode, t: f64, x: &[f64]) -> Self {
         let mut z = [0.0; MAX_EVENT_INDICATORS];
         M::step_event_indicators(ode, t, x, &mut z[..Self::N]);
-        Roots { ode, z, x: x.to_vec() }
+        Roots { z, x: x.to_vec(), _model: std::marker::PhantomData }
     }
 
     /// The indicators at `t` on `dense`.
-    fn at(&mut self, dense: &Dense<'_>, t: f64) -> [f64; MAX_EVENT_INDICATORS] {
+    fn at(&mut self, ode: &M::Ode, dense: &Dense<'_>, t: f64) -> [f64; MAX_EVENT_INDICATORS] {
         let mut z = [0.0; MAX_EVENT_INDICATORS];
         dense.at(t, &mut self.x);
-        M::step_event_indicators(self.ode, t, &self.x, &mut z[..Self::N]);
+        M::step_event_indicators(ode, t, &self.x, &mut z[..Self::N]);
         z
     }
 
@@ -238,9 +315,9 @@ impl<'a, M: Model> Roots<'a, M> {
     /// (regula falsi on the indicator that crosses first) and bisection steps in turn (so that
     /// it halves at least every second step), and its right end returned: there the indicators
     /// have their new signs. Without a change the step's end indicators start the next step.
-    fn first(&mut self, dense: &Dense<'_>) -> Option<f64> {
+    fn first(&mut self, ode: &M::Ode, dense: &Dense<'_>) -> Option<f64> {
         let (mut a, mut b) = dense.span();
-        let (mut za, mut zb) = (self.z, self.at(dense, b));
+        let (mut za, mut zb) = (self.z, self.at(ode, dense, b));
         if !crossed(&za[..Self::N], &zb[..Self::N]) {
             self.z = zb;
             return None;
@@ -260,7 +337,7 @@ impl<'a, M: Model> Roots<'a, M> {
                 false => a + 0.5 * w,
             };
             secant = !secant;
-            let zm = self.at(dense, m);
+            let zm = self.at(ode, dense, m);
             if crossed(&za[..Self::N], &zm[..Self::N]) {
                 (b, zb) = (m, zm);
             } else {

@@ -1,10 +1,10 @@
 //! One FMU instance: variable values, model, time and state machine, in safe Rust.
 //! [`super::api`] wraps these methods in the C ABI.
 
-use super::driver::{Driven, MAX_EVENT_INDICATORS};
+use super::driver::{Driven, Ended, Intermediate, MAX_EVENT_INDICATORS};
 use super::log::{num, Logger, Status};
 use super::machine::{Interface, Mode};
-use super::model::{activations, clock_row, initial_unknown, Log, Model, Seeds, ACTIVATION_TOLERANCE};
+use super::model::{activations, clock_row, initial_unknown, Log, Model, Seeds, StepError, ACTIVATION_TOLERANCE};
 use super::variables::{fmi_name, BaseType, Causality, Initial, Kind, Value, Values, Variability, Variable};
 use super::version::Version;
 use std::borrow::Cow;
@@ -23,6 +23,21 @@ pub const TOLERANCE_RANGE: (f64, f64) = (1e-12, 1e-2);
 /// one variable has causality="independent"). It is not a row of the tables (FMI 2.0 declares
 /// no independent variable), so it lies far above every table's references.
 pub const INDEPENDENT_VR: u32 = 1_000_000;
+
+/// FMI 3.0's intermediateUpdate callback (fmi3IntermediateUpdateCallback): instanceEnvironment,
+/// intermediateUpdateTime, intermediateVariableSetRequested, intermediateVariableGetAllowed,
+/// intermediateStepFinished, canReturnEarly, earlyReturnRequested, earlyReturnTime.
+pub type IntermediateUpdate =
+    unsafe extern "C" fn(*mut std::ffi::c_void, f64, bool, bool, bool, bool, *mut bool, *mut f64);
+
+/// A master's intermediate update (FMI 3.0, 4.2.3): its callback and environment, and the
+/// intermediate inputs it sets (`requiredIntermediateVariables`).
+#[derive(Clone)]
+pub struct Master {
+    pub callback: IntermediateUpdate,
+    pub environment: *mut std::ffi::c_void,
+    pub inputs: Vec<u32>,
+}
 
 /// What a call did besides succeeding: a warning to log with status Warning.
 pub type Warning = Option<String>;
@@ -43,9 +58,13 @@ pub struct Instance<M: Model> {
     /// FMI 3.0 Co-Simulation with `earlyReturnAllowed`: a step ends early at the first root of
     /// the model's event indicators.
     pub early_return_allowed: bool,
-    /// Where the last step ended early at an event (FMI 3.0: `earlyReturn`, and
-    /// `eventHandlingNeeded` with Event Mode).
-    pub event: Option<f64>,
+    /// Where the last step ended before its communication step's end, at an event or where the
+    /// master asked (FMI 3.0: `earlyReturn`; `eventHandlingNeeded` for an event with Event Mode).
+    pub ended: Option<Ended>,
+    /// FMI 3.0 Co-Simulation: the master's intermediate update, if it provides one.
+    pub master: Option<Master>,
+    /// In Intermediate Update Mode: whether the master may set the intermediate inputs now.
+    pub set_requested: bool,
     pub core: Core<M>,
     /// Storage behind the pointers the last fmi2GetString / fmi3GetString returned.
     pub(crate) strings: Vec<std::ffi::CString>,
@@ -200,7 +219,9 @@ impl<M: Model> Instance<M> {
             interface,
             event_mode_used: false,
             early_return_allowed: false,
-            event: None,
+            ended: None,
+            master: None,
+            set_requested: false,
             core: Core::new(),
             strings: Vec::new(),
             guid,
@@ -640,7 +661,10 @@ impl<M: Model> Instance<M> {
             let (i, v) = self.lookup(vr, value.base_type())?;
             self.clocked_access(v)?;
             let state = M::STATES.iter().position(|s| s.state == vr);
-            settable(v, state.is_some(), self.core.mode)?;
+            match self.core.mode {
+                Mode::IntermediateUpdate => self.intermediate_settable(v)?,
+                mode => settable(v, state.is_some(), mode)?,
+            }
             in_range(v, &value)?;
             if let (Mode::ContinuousTimeMode, Some(k), Value::Real(x)) = (self.core.mode, state, &value) {
                 let x0 = states.get_or_insert_with(|| self.exposed_states());
@@ -671,6 +695,29 @@ impl<M: Model> Instance<M> {
         }
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
+        Ok(())
+    }
+
+    /// FMI 3.0, 4.2.3: in Intermediate Update Mode the master sets the intermediate inputs it
+    /// required, and only when the callback requests them (`intermediateVariableSetRequested`).
+    fn intermediate_settable(&self, v: &Variable) -> Result<(), String> {
+        let inputs = self.master.as_ref().map_or(&[][..], |m| &m.inputs[..]);
+        if !inputs.contains(&v.vr) {
+            let names: Vec<&str> = inputs.iter().filter_map(|&r| self.name(r)).collect();
+            return Err(format!(
+                "cannot set \"{}\" in Intermediate Update Mode: only the requiredIntermediateVariables of \
+                 fmi3InstantiateCoSimulation may be set there ({}; FMI 3.0, 4.2.3)",
+                v.name,
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            ));
+        }
+        if !self.set_requested {
+            return Err(format!(
+                "cannot set \"{}\" now: this intermediate update did not request inputs \
+                 (intermediateVariableSetRequested = false; FMI 3.0, 4.2.3)",
+                v.name
+            ));
+        }
         Ok(())
     }
 
@@ -791,7 +838,17 @@ impl<M: Model> Instance<M> {
     /// fmi2DoStep. `Ok(Step::Done(warning))`: step done; `Ok(Step::Discarded(why))`: stopped
     /// at the last good time.
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Step, String> {
-        self.event = None;
+        let mut begun = self.begin_step(t, h)?;
+        let c = &self.core;
+        let result = begun.run((&c.values, &c.input_derivatives), &mut ModelLog(&self.log), None);
+        self.end_step(begun, result)
+    }
+
+    /// The start of doStep: the checks of its arguments, and the step's inputs with the model,
+    /// which leaves the instance until [`Instance::end_step`] (so that the instance can be called
+    /// while the step runs: FMI 3.0 intermediate update).
+    pub fn begin_step(&mut self, t: f64, h: f64) -> Result<Begun<M>, String> {
+        self.ended = None;
         let c = &mut self.core;
         if !(h > 0.0 && h.is_finite()) {
             return Err(format!("communicationStepSize = {} is outside its valid range (0, inf)", num(h)));
@@ -826,7 +883,6 @@ impl<M: Model> Instance<M> {
             }
         }
         let tolerance = c.tolerance.unwrap_or(M::INFO.default_tolerance);
-        let model = c.model.as_mut().ok_or("the model is not initialised")?;
         // The model steps from the instance's own clock to the master's t + h: a master that
         // accumulates t_k + h instead of k h (rounding-level differences, accepted above) then
         // still continues exactly where the last step ended, so results do not depend on it.
@@ -838,17 +894,35 @@ impl<M: Model> Instance<M> {
                 num(start)
             ));
         }
-        let inputs = M::INFO.interpolated_inputs;
-        let (slopes, warning) = bounded_slopes(&c.values, &c.input_derivatives, inputs, end - start);
-        // FMI 3.0, 2.2.4: after fmi3Discard "the FMU is in the same state as before the call".
-        let before = (self.version == Version::Fmi3).then(|| model.clone());
-        let early_return = self.early_return_allowed && !M::EVENT_INDICATORS.is_empty();
-        let result =
-            model.step(&c.values, &slopes, (start, end - start, tolerance), &mut ModelLog(&self.log), early_return);
+        let model = c.model.take().ok_or("the model is not initialised")?;
+        let (slopes, warning) =
+            bounded_slopes(&c.values, &c.input_derivatives, M::INFO.interpolated_inputs, end - start);
+        Ok(Begun {
+            // FMI 3.0, 2.2.4: after fmi3Discard "the FMU is in the same state as before the call".
+            before: (self.version == Version::Fmi3).then(|| model.clone()),
+            model,
+            // Only a slope bounded to its input's range is the step's own (no allocation else).
+            bounded: matches!(slopes, Cow::Owned(_)).then(|| slopes.into_owned()),
+            warning,
+            span: (t, h, start, end, tolerance),
+            early_return: self.early_return_allowed && !M::EVENT_INDICATORS.is_empty(),
+        })
+    }
+
+    /// The end of doStep: the model back in the instance at the time the step reached, the
+    /// inputs there, the outputs.
+    pub fn end_step(&mut self, begun: Begun<M>, result: Result<Option<Ended>, StepError>) -> Result<Step, String> {
+        let Begun { model, before, bounded, warning, span: (t, h, start, end, _), .. } = begun;
+        let c = &mut self.core;
         c.outputs_current = false;
         c.derivatives_current = false;
-        let event = match result {
-            Ok(event) => event,
+        if c.mode != Mode::StepComplete {
+            // A call of the master's from intermediate update failed (the instance is Terminated).
+            c.model = Some(before.unwrap_or(model));
+            return Err(format!("the step from t = {} stopped: a call in intermediate update failed", num(t)));
+        }
+        let ended = match result {
+            Ok(ended) => ended,
             Err(e) => {
                 let why = format!(
                     "step from t = {} with h = {} stopped at t = {}: {}",
@@ -858,7 +932,7 @@ impl<M: Model> Instance<M> {
                     e.message
                 );
                 if let Some(before) = before {
-                    *model = before;
+                    c.model = Some(before);
                     return Ok(Step::Discarded(format!(
                         "{why}; the instance is back at t = {} (retry with a smaller step)",
                         num(start)
@@ -866,17 +940,19 @@ impl<M: Model> Instance<M> {
                 }
                 // FMI 2.0, 4.2.3: Discard leaves the slave at the last good time (fmi2LastSuccessfulTime),
                 // in state StepFailed.
+                c.model = Some(model);
                 c.time = e.time;
                 c.last_successful_time = e.time;
                 c.mode = Mode::StepFailed;
                 return Ok(Step::Discarded(why));
             }
         };
-        // The step ends at the event where it ended early.
-        let end = event.unwrap_or(end);
+        // The step ends where it ended early.
+        let end = ended.map_or(end, |e| e.t);
         // Inputs with a derivative follow their ramp to the new communication point (only
         // interpolated inputs accept derivatives).
-        for &r in inputs {
+        let slopes = bounded.as_deref().unwrap_or(&c.input_derivatives);
+        for &r in M::INFO.interpolated_inputs {
             let Some(i) = c.values.position(r) else { continue };
             if let (Value::Real(x), Kind::Real { min, max, .. }, true) =
                 (c.values.at(i), M::VARIABLES[i].kind, slopes[i] != 0.0)
@@ -887,14 +963,15 @@ impl<M: Model> Instance<M> {
         }
         c.time = end;
         c.last_successful_time = end;
-        if let Some(t) = event {
-            self.event = Some(t);
-            self.log
-                .info("logEvents", &format!("an event indicator changed sign at t = {}: the step ended there", num(t)));
+        self.ended = ended;
+        if let Some(Ended { t, event }) = ended {
+            let why = if event { "an event indicator changed sign" } else { "the master asked" };
+            self.log.info("logEvents", &format!("{why}: the step ended at t = {}", num(t)));
         }
         // Every Real the importer can read is finite after a good step, or the step is an error.
         c.values.take_non_finite();
-        write_outputs(model, &mut c.values);
+        write_outputs(&model, &mut c.values);
+        c.model = Some(model);
         c.outputs_current = true;
         c.derivatives_current = false;
         if let Some(i) = c.values.take_non_finite() {
@@ -908,6 +985,51 @@ impl<M: Model> Instance<M> {
             ));
         }
         Ok(Step::Done(warning))
+    }
+}
+
+/// A step between [`Instance::begin_step`] and [`Instance::end_step`]: the model, its state
+/// before the step (FMI 3.0), the input slopes where bounded to their range.
+pub struct Begun<M: Model> {
+    model: Driven<M>,
+    before: Option<Driven<M>>,
+    bounded: Option<Vec<f64>>,
+    warning: Warning,
+    /// The master's t and h, the instance's start and end time, the tolerance.
+    span: (f64, f64, f64, f64, f64),
+    early_return: bool,
+}
+
+impl<M: Model> Begun<M> {
+    /// Integrates the step (the driver, [`Driven::step`]) from the instance's values and input
+    /// derivatives at its start, with the master's intermediate update.
+    pub fn run(
+        &mut self,
+        (values, input_derivatives): (&Values, &[f64]),
+        log: &mut dyn Log,
+        master: Option<&mut dyn Intermediate>,
+    ) -> Result<Option<Ended>, StepError> {
+        let (_, h, start, end, tolerance) = self.span;
+        let slopes = self.bounded.as_deref().unwrap_or(input_derivatives);
+        match master {
+            // A model that steps in closed form takes each intermediate input linear over the
+            // step, to the master's value at its end: the slope the master would have passed to
+            // FMI 2.0 (over its communication step h).
+            Some(master) if M::CLOSED_FORM && !M::INTERMEDIATE_INPUTS.is_empty() => {
+                let vrs = M::INTERMEDIATE_INPUTS;
+                let mut at_end = vec![0.0; vrs.len()];
+                let mut slopes = slopes.to_vec();
+                if master.inputs(end, vrs, &mut at_end).is_ok() {
+                    for (&r, u) in vrs.iter().zip(at_end) {
+                        if let Some(i) = values.position(r) {
+                            slopes[i] = (u - values.real(r)) / h;
+                        }
+                    }
+                }
+                self.model.step(values, &slopes, (start, end - start, tolerance), log, self.early_return, None)
+            }
+            master => self.model.step(values, slopes, (start, end - start, tolerance), log, self.early_return, master),
+        }
     }
 }
 

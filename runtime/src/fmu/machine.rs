@@ -17,6 +17,9 @@ pub enum Mode {
     ContinuousTimeMode,
     Terminated,
     Error,
+    /// FMI 3.0 Co-Simulation: inside doStep, while the master's intermediateUpdate callback runs
+    /// (4.2.3); the master may set the intermediate inputs there and call nothing else.
+    IntermediateUpdate,
 }
 
 impl Mode {
@@ -28,14 +31,16 @@ impl Mode {
     /// The interface whose state this is; `None` for the states both share.
     pub const fn interface(self) -> Option<Interface> {
         match self {
-            Mode::StepComplete | Mode::StepFailed | Mode::StepCanceled => Some(Interface::CoSimulation),
+            Mode::StepComplete | Mode::StepFailed | Mode::StepCanceled | Mode::IntermediateUpdate => {
+                Some(Interface::CoSimulation)
+            }
             Mode::EventMode | Mode::ContinuousTimeMode => Some(Interface::ModelExchange),
             _ => None,
         }
     }
 
     /// Every state, for messages and the FMU state bytes.
-    pub const ALL: [Mode; 9] = [
+    pub const ALL: [Mode; 10] = [
         Mode::Instantiated,
         Mode::InitializationMode,
         Mode::StepComplete,
@@ -45,6 +50,7 @@ impl Mode {
         Mode::ContinuousTimeMode,
         Mode::Terminated,
         Mode::Error,
+        Mode::IntermediateUpdate,
     ];
 }
 
@@ -74,6 +80,7 @@ pub const EVENT: Mask = Mode::EventMode.bit();
 pub const CONT: Mask = Mode::ContinuousTimeMode.bit();
 pub const TERM: Mask = Mode::Terminated.bit();
 pub const ERR: Mask = Mode::Error.bit();
+pub const IU: Mask = Mode::IntermediateUpdate.bit();
 
 pub const fn both(states: Mask) -> Rule {
     Rule { interface: None, states }

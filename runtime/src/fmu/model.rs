@@ -206,6 +206,17 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// a step early at an event (FMI 3.0, 4.2.3: early return). Default: none.
     fn step_event_indicators(_ode: &Self::Ode, _t: f64, _x: &[f64], _z: &mut [f64]) {}
 
+    /// FMI 3.0 intermediate update (4.2.3): the Real inputs a master may set between
+    /// communication points (`intermediateUpdate="true"`), each continuous over a step. Default:
+    /// none (`providesIntermediateUpdate="false"`).
+    const INTERMEDIATE_INPUTS: &'static [u32] = &[];
+
+    /// Intermediate update: over the integrator's next attempted step from `t`, each of
+    /// [`Model::INTERMEDIATE_INPUTS`] of `ode` takes the master's values at the step's stage
+    /// times (`samples`: each time with the inputs in that order), linear between them from its
+    /// value at `t` ([`super::super::models::port::Ramp::through`]).
+    fn intermediate_inputs(_ode: &mut Self::Ode, _t: f64, _samples: &[(f64, &[f64]); 3]) {}
+
     /// Whether the model steps in closed form: no ODE state, [`Step::Done`] from every
     /// [`Model::begin_step`], and no integrator in its driver or its binary. Default: no.
     const CLOSED_FORM: bool = false;

@@ -174,7 +174,7 @@ impl BoomMechanics {
         }
         let rest =
             boom.mechanics().equilibrium(x0).map_err(|e| format!("no boom equilibrium at start.x = {x0} m: {e}"))?;
-        let input = Ramp { t0: t, y0: input, slope: 0.0 };
+        let input = Ramp::new(t, input, 0.0);
         let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input, cylinder };
         let state =
             super::plant::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
@@ -183,10 +183,15 @@ impl BoomMechanics {
 
     /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
     fn input_vr(&self) -> u32 {
-        match self.sys.coupling {
-            Coupling::Plain => vr::F,
-            Coupling::Tlm { .. } => vr::C_H,
-        }
+        input_vr(self.sys.coupling)
+    }
+}
+
+/// The port's input: the cylinder force (plain) or the wave c_h (TLM).
+fn input_vr(coupling: Coupling) -> u32 {
+    match coupling {
+        Coupling::Plain => vr::F,
+        Coupling::Tlm { .. } => vr::C_H,
     }
 }
 
@@ -276,7 +281,7 @@ impl Model for BoomMechanics {
     fn outputs(&self, values: &mut Values) {
         let mut sys = self.sys.clone();
         if sys.coupling == Coupling::Plain {
-            sys.input = Ramp { t0: self.t, y0: values.real(vr::F), slope: 0.0 };
+            sys.input = Ramp::new(self.t, values.real(vr::F), 0.0);
         }
         let b = sys.boom.mechanics();
         let (q, qd) = self.state.split_at(b.dof());
@@ -291,9 +296,16 @@ impl Model for BoomMechanics {
 
     type Ode = PortedBoom;
 
+    const INTERMEDIATE_INPUTS: &'static [u32] = &[vr::F, vr::C_H];
+
+    fn intermediate_inputs(sys: &mut PortedBoom, t: f64, samples: &[(f64, &[f64]); 3]) {
+        let k = usize::from(input_vr(sys.coupling) == vr::C_H);
+        sys.input = sys.input.through(t, samples.map(|(ts, u)| (ts, u[k])));
+    }
+
     fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, PortedBoom>, StepError> {
         self.sys.input = Ramp::read(step, self.input_vr());
-        Ok(Step::Integrate(&self.sys, &mut self.state))
+        Ok(Step::Integrate(&mut self.sys, &mut self.state))
     }
 
     fn scale(sys: &PortedBoom) -> Vec<f64> {

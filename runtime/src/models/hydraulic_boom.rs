@@ -165,7 +165,7 @@ impl Plant {
     pub fn from_values(values: &Values) -> Result<Self, String> {
         let circuit = super::circuit::circuit_from_values(values)?;
         let boom = Boom::from_values(values, circuit.cylinder.stroke)?;
-        Ok(Plant { circuit, boom, u_ref: Ramp { t0: 0.0, y0: values.real(vr::U_REF), slope: 0.0 } })
+        Ok(Plant { circuit, boom, u_ref: Ramp::new(0.0, values.real(vr::U_REF), 0.0) })
     }
 
     /// Static equilibrium at stroke `x0`: the load held at rest by the closed CBV, the rod side
@@ -292,13 +292,19 @@ impl Model for HydraulicBoom {
 
     type Ode = Plant;
 
+    const INTERMEDIATE_INPUTS: &'static [u32] = &[vr::U_REF];
+
+    fn intermediate_inputs(plant: &mut Plant, t: f64, samples: &[(f64, &[f64]); 3]) {
+        plant.u_ref = plant.u_ref.through(t, samples.map(|(ts, u)| (ts, u[0])));
+    }
+
     fn step_event_indicators(plant: &Plant, t: f64, x: &[f64], z: &mut [f64]) {
         super::circuit::event_indicators(&plant.circuit, x[circuit::X_V], plant.u_ref.at(t), z);
     }
 
     fn begin_step(&mut self, step: &StepStart<'_>, _log: &mut dyn Log) -> Result<Step<'_, Plant>, StepError> {
         self.plant.u_ref = Ramp::read(step, vr::U_REF);
-        Ok(Step::Integrate(&self.plant, &mut self.state))
+        Ok(Step::Integrate(&mut self.plant, &mut self.state))
     }
 
     fn scale(plant: &Plant) -> Vec<f64> {

@@ -213,10 +213,10 @@ impl HydraulicCircuit {
             circuit,
             coupling: Coupling::from_values(values),
             m: values.real(vr::M),
-            u_ref: Ramp { t0: t, y0: values.real(vr::U_REF), slope: 0.0 },
+            u_ref: Ramp::new(t, values.real(vr::U_REF), 0.0),
             x0: values.real(vr::X),
-            v: Ramp { t0: t, y0: values.real(vr::V), slope: 0.0 },
-            c_m: Ramp { t0: t, y0: c_m, slope: 0.0 },
+            v: Ramp::new(t, values.real(vr::V), 0.0),
+            c_m: Ramp::new(t, c_m, 0.0),
         };
         let state = super::plant::checked_state(sys.dim(), state, || {
             if !(0.0..=stroke).contains(&x0) {
@@ -310,9 +310,9 @@ impl Model for HydraulicCircuit {
 
     fn outputs(&self, values: &mut Values) {
         let mut sys = self.sys.clone();
-        sys.u_ref = Ramp { t0: self.t, y0: values.real(vr::U_REF), slope: 0.0 };
+        sys.u_ref = Ramp::new(self.t, values.real(vr::U_REF), 0.0);
         if sys.coupling == Coupling::Plain {
-            (sys.x0, sys.v) = (values.real(vr::X), Ramp { t0: self.t, y0: values.real(vr::V), slope: 0.0 });
+            (sys.x0, sys.v) = (values.real(vr::X), Ramp::new(self.t, values.real(vr::V), 0.0));
         }
         let s = &self.state;
         let (x, v) = sys.motion(self.t, s);
@@ -326,6 +326,18 @@ impl Model for HydraulicCircuit {
 
     type Ode = PortedCircuit;
 
+    /// cylinder.x follows the integral of cylinder.v within a step, as with input derivatives.
+    const INTERMEDIATE_INPUTS: &'static [u32] = &[vr::U_REF, vr::V, vr::C_M];
+
+    fn intermediate_inputs(sys: &mut PortedCircuit, t: f64, samples: &[(f64, &[f64]); 3]) {
+        let input = |k: usize| samples.map(|(ts, u)| (ts, u[k]));
+        sys.u_ref = sys.u_ref.through(t, input(0));
+        // The stroke at t, from which the new velocity integrates.
+        sys.x0 += sys.v.integral(t);
+        sys.v = sys.v.through(t, input(1));
+        sys.c_m = sys.c_m.through(t, input(2));
+    }
+
     fn step_event_indicators(sys: &PortedCircuit, t: f64, x: &[f64], z: &mut [f64]) {
         super::circuit::event_indicators(&sys.circuit, x[circuit::X_V], sys.u_ref.at(t), z);
     }
@@ -336,7 +348,7 @@ impl Model for HydraulicCircuit {
         sys.x0 = step.values.real(vr::X);
         sys.v = Ramp::read(step, vr::V);
         sys.c_m = Ramp::read(step, vr::C_M);
-        Ok(Step::Integrate(&self.sys, &mut self.state))
+        Ok(Step::Integrate(&mut self.sys, &mut self.state))
     }
 
     fn scale(sys: &PortedCircuit) -> Vec<f64> {

@@ -170,30 +170,74 @@ pub const PORT_F: Variable = Variable::real_output(
 );
 
 /// A Real input over the current step: its value at `t0` and its slope (set with
-/// fmi2SetRealInputDerivatives; 0 holds it).
+/// fmi2SetRealInputDerivatives; 0 holds it); or, in FMI 3.0 intermediate update, the values the
+/// master gave for the times of the integrator's attempted step after `t0` (`samples`: its stage
+/// times, [`crate::solver::stage_times`]), linear in between, so that the right-hand side sees
+/// the master's values exactly where the integrator evaluates it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Ramp {
     pub t0: f64,
     pub y0: f64,
     pub slope: f64,
+    pub samples: Option<[(f64, f64); 3]>,
 }
 
 impl Ramp {
     /// Input `r` and its derivative at the start of a step.
     pub fn read(step: &StepStart<'_>, r: u32) -> Self {
         let slope = step.values.position(r).map_or(0.0, |i| step.input_derivatives[i]);
-        Ramp { t0: step.t, y0: step.values.real(r), slope }
+        Ramp::new(step.t, step.values.real(r), slope)
     }
 
-    /// The value at `t`.
+    /// The ramp through `y0` at `t0` with `slope`.
+    pub fn new(t0: f64, y0: f64, slope: f64) -> Self {
+        Ramp { t0, y0, slope, samples: None }
+    }
+
+    /// The value at `t`: the master's sample where it gave one.
     pub fn at(&self, t: f64) -> f64 {
-        self.y0 + self.slope * (t - self.t0)
+        let Some(samples) = &self.samples else {
+            return self.y0 + self.slope * (t - self.t0);
+        };
+        let mut before = (self.t0, self.y0);
+        for &(ts, ys) in samples {
+            if t == ts {
+                return ys;
+            }
+            if t < ts || ts == samples[2].0 {
+                return before.1 + (ys - before.1) * (t - before.0) / (ts - before.0);
+            }
+            before = (ts, ys);
+        }
+        before.1
+    }
+
+    /// The input from its value at `t` through the master's `samples` at the times after `t` of
+    /// the integrator's next attempted step (FMI 3.0 intermediate update).
+    pub fn through(&self, t: f64, samples: [(f64, f64); 3]) -> Self {
+        Ramp { t0: t, y0: self.at(t), slope: 0.0, samples: Some(samples) }
     }
 
     /// Its integral from `t0` to `t`.
     pub fn integral(&self, t: f64) -> f64 {
-        let tau = t - self.t0;
-        tau * (self.y0 + 0.5 * self.slope * tau)
+        let Some(samples) = &self.samples else {
+            let tau = t - self.t0;
+            return tau * (self.y0 + 0.5 * self.slope * tau);
+        };
+        // The trapezoids of the samples up to t.
+        let (mut sum, mut before) = (0.0, (self.t0, self.y0));
+        for &(ts, _) in samples {
+            let end = ts.min(t);
+            if end > before.0 {
+                let y = self.at(end);
+                sum += 0.5 * (before.1 + y) * (end - before.0);
+                before = (end, y);
+            }
+        }
+        if t > before.0 {
+            sum += before.1 * (t - before.0);
+        }
+        sum
     }
 }
 
@@ -257,8 +301,30 @@ mod tests {
 
     #[test]
     fn ramp_value_and_integral() {
-        let r = Ramp { t0: 1.0, y0: 2.0, slope: 4.0 };
+        let r = Ramp::new(1.0, 2.0, 4.0);
         assert_eq!(r.at(1.5), 4.0);
         assert_eq!(r.integral(1.5), 0.5 * (2.0 + 4.0) / 2.0);
+    }
+
+    /// FMI 3.0 intermediate update: through the master's samples at the stage times of a step
+    /// from t = 1 of 0.5 s, the input is exactly the sample at each (the right-hand side sees the
+    /// master's values), continuous at the step's start, and linear in between: for samples of
+    /// a quadratic y = t^2 the integral is the trapezoids' sum, within rounding (1e-15) of the
+    /// exact sum of the three trapezoids computed here by hand.
+    #[test]
+    fn ramp_through_samples() {
+        let stages = crate::solver::stage_times(1.0, 0.5, 1.5);
+        let samples = stages.map(|t| (t, t * t));
+        let r = Ramp::new(0.0, 1.0, 0.0).through(1.0, samples);
+        assert_eq!(r.at(1.0), 1.0, "its value at the start");
+        for (t, y) in samples {
+            assert_eq!(r.at(t), y, "the sample at {t}");
+        }
+        let [(t1, y1), (t2, y2), (t3, y3)] = samples;
+        let mid = 0.5 * (t1 + t2);
+        assert!((r.at(mid) - 0.5 * (y1 + y2)).abs() < 1e-15, "linear between samples");
+        let trapezoids = 0.5 * (1.0 + y1) * (t1 - 1.0) + 0.5 * (y1 + y2) * (t2 - t1) + 0.5 * (y2 + y3) * (t3 - t2);
+        assert!((r.integral(1.5) - trapezoids).abs() < 1e-15, "{} vs {trapezoids}", r.integral(1.5));
+        assert!((r.integral(t1) - 0.5 * (1.0 + y1) * (t1 - 1.0)).abs() < 1e-15);
     }
 }

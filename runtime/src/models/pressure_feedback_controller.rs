@@ -227,7 +227,7 @@ impl PressureFeedbackController {
             extrapolate: values.boolean(vr::EXTRAPOLATION),
             x,
             t: 0.0,
-            p: Ramp { t0: 0.0, y0: values.real(vr::P), slope: 0.0 },
+            p: Ramp::new(0.0, values.real(vr::P), 0.0),
             sampled: false,
             fresh: true,
         };
@@ -272,7 +272,7 @@ impl PressureFeedbackController {
         if slope == ramp.slope {
             ramp
         } else {
-            Ramp { t0: t, y0: y, slope }
+            Ramp::new(t, y, slope)
         }
     }
 }
@@ -330,6 +330,10 @@ impl Model for PressureFeedbackController {
     type Ode = ();
     const CLOSED_FORM: bool = true;
 
+    /// FMI 3.0 intermediate update: the command and the pressure at the step's end, each linear
+    /// over the step, as FMI 2.0's input derivatives take them.
+    const INTERMEDIATE_INPUTS: &'static [u32] = &[vr::U_REF, vr::P];
+
     /// The filter x' = omega_f (p - x) over the step, exact for the pressure ramped with its
     /// slope ([`HighPassFeedback::advance`]): a closed form no integrator beats.
     fn begin_step(&mut self, step: &StepStart<'_>, log: &mut dyn Log) -> Result<Step<'_, ()>, StepError> {
@@ -356,7 +360,7 @@ impl Model for PressureFeedbackController {
                 if head.iter().all(|v| v.is_finite()) && [sampled, fresh].iter().all(|f| *f == 0.0 || *f == 1.0) =>
             {
                 let c = Self::from_values(values, x)?;
-                let p = Ramp { t0, y0, slope };
+                let p = Ramp::new(t0, y0, slope);
                 Ok(PressureFeedbackController { t, p, sampled: sampled == 1.0, fresh: fresh == 1.0, ..c })
             }
             _ => Err(format!(

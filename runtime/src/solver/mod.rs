@@ -15,7 +15,7 @@ pub mod radau5;
 mod tests;
 
 pub use iteration::SecondOrder;
-pub use radau5::{plan, tail_rhs, Dense, Radau5, NEWTON_BUDGET};
+pub use radau5::{plan, stage_times, tail_rhs, Dense, Radau5, Watch, NEWTON_BUDGET};
 
 /// An ODE `dx/dt = f(t, x)` of fixed dimension.
 pub trait OdeSystem {

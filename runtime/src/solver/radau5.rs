@@ -197,6 +197,36 @@ pub struct Radau5 {
     mats: IterationMatrices,
 }
 
+/// What the caller of [`Radau5::integrate_until`] does between the integrator's steps; it holds
+/// the system.
+pub trait Watch {
+    type Ode: OdeSystem + ?Sized;
+
+    /// The system integrated.
+    fn ode(&self) -> &Self::Ode;
+
+    /// Before each attempted step from `t` (again after a rejection, with a smaller one), with
+    /// the times at which its Newton iteration evaluates the system ([`stage_times`]; the last is
+    /// the step's end): may change the system's inputs over the step, keeping their values at `t`.
+    fn attempt(&mut self, _t: f64, _stages: [f64; 3]) {}
+
+    /// After each accepted step, shown as its collocation polynomial: a time within the step to
+    /// end the integration there, or `None` to go on.
+    fn accepted(&mut self, _dense: &Dense<'_>) -> Option<f64> {
+        None
+    }
+}
+
+/// A system integrated without a watch.
+struct Plain<'a, S: ?Sized>(&'a S);
+
+impl<S: OdeSystem + ?Sized> Watch for Plain<'_, S> {
+    type Ode = S;
+    fn ode(&self) -> &S {
+        self.0
+    }
+}
+
 /// The solution over the last accepted step `[t - h, t]`: its collocation polynomial, of degree
 /// 3 through the step's start, its two inner stages and its end (radau5.f's CONTR5).
 pub struct Dense<'a> {
@@ -465,7 +495,7 @@ impl Radau5 {
         x: &mut [f64],
         t_end: f64,
     ) -> Result<(), SolveError> {
-        self.integrate_until(sys, (t0, t_end), x, None, |_| None).map(|_| ())
+        self.integrate_until(&mut Plain(sys), (t0, t_end), x, None).map(|_| ())
     }
 
     /// The real-time mode: [`integrate`](Self::integrate) with at most `rhs_budget` RHS
@@ -486,29 +516,29 @@ impl Radau5 {
         t_end: f64,
         rhs_budget: u64,
     ) -> Result<(), SolveError> {
-        self.integrate_until(sys, (t0, t_end), x, Some(rhs_budget), |_| None).map(|_| ())
+        self.integrate_until(&mut Plain(sys), (t0, t_end), x, Some(rhs_budget)).map(|_| ())
     }
 
     /// [`integrate`](Self::integrate), or [`integrate_bounded`](Self::integrate_bounded) with
-    /// a budget, that shows each accepted step to `stop` as its collocation polynomial
-    /// ([`Dense`]); `stop` returns a time within that step to end the integration there (the
-    /// state there from the polynomial: continuous output of order 3, Hairer & Wanner IV.8,
-    /// eq. 8.12), or `None` to go on. Returns the time reached: `t_end`, or where `stop` ended it.
-    /// A call that starts where one ended inside a step restarts the integration (its first step
-    /// extrapolates nothing), as after any change of the state.
-    pub fn integrate_until<S: OdeSystem + ?Sized>(
+    /// a budget, of the system `watch` holds, which it lets change the system's inputs before
+    /// each attempted step ([`Watch::attempt`]) and shows each accepted step as its collocation
+    /// polynomial ([`Watch::accepted`], [`Dense`]): that may return a time within the step to end
+    /// the integration there (the state there from the polynomial: continuous output of order 3,
+    /// Hairer & Wanner IV.8, eq. 8.12). Returns the time reached: `t_end`, or where the watch
+    /// ended it. A call that starts where one ended inside a step restarts the integration (its
+    /// first step extrapolates nothing), as after any change of the state.
+    pub fn integrate_until<W: Watch + ?Sized>(
         &mut self,
-        sys: &S,
+        watch: &mut W,
         (t0, t_end): (f64, f64),
         x: &mut [f64],
         budget: Option<u64>,
-        mut stop: impl FnMut(&Dense<'_>) -> Option<f64>,
     ) -> Result<f64, SolveError> {
         if budget.is_some() {
             self.accuracy_loss = 0.0;
         }
         let (n, rhs0) = (self.n as u64, self.stats.rhs_evals);
-        let Some(continues) = self.begin(sys, t0, x, t_end)? else {
+        let Some(continues) = self.begin(watch.ode(), t0, x, t_end)? else {
             return Ok(t_end);
         };
         let mut t = t0;
@@ -556,11 +586,12 @@ impl Radau5 {
             if let Some(budget) = budget {
                 let attempt = if need_jac { n } else { 0 } + 3 * NIT as u64 + 2;
                 if self.stats.rhs_evals - rhs0 + attempt + tail_rhs(self.n) > budget {
-                    let tail = self.tail_step(sys, t, t_end, (hold, zero_start));
+                    watch.attempt(t, stage_times(t, t_end - t, t_end));
+                    let tail = self.tail_step(watch.ode(), t, t_end, (hold, zero_start));
                     x.copy_from_slice(&self.y);
                     self.accuracy_loss = tail?;
                     self.h_hint = h_nat.min(self.max_step);
-                    return Ok(self.stop_at(stop(&self.dense()), x));
+                    return Ok(self.stop_at(watch.accepted(&self.dense()), x));
                 }
             }
             n_attempts += 1;
@@ -569,7 +600,7 @@ impl Radau5 {
                 return Err(SolveError { kind: SolveErrorKind::TooManySteps(self.max_steps), t, h });
             }
             if need_jac {
-                if !self.compute_jacobian(sys, t) {
+                if !self.compute_jacobian(watch.ode(), t) {
                     x.copy_from_slice(&self.y);
                     return Err(SolveError { kind: SolveErrorKind::NonFiniteJacobian, t, h });
                 }
@@ -586,6 +617,7 @@ impl Radau5 {
                 need_lu = false;
             }
             let tph = if last { t_end } else { t + h };
+            watch.attempt(t, stage_times(t, h, tph));
 
             // Starting values for Z and W = T⁻¹ Z.
             if zero_start {
@@ -597,7 +629,7 @@ impl Radau5 {
                 self.extrapolate(h / hold);
             }
 
-            let newt = match self.newton(sys, t, h, tph, fnewt, &mut theta, None) {
+            let newt = match self.newton(watch.ode(), t, h, tph, fnewt, &mut theta, None) {
                 Ok((newt, _)) => newt,
                 Err(NewtonFail { cause, hfac }) => {
                     h *= hfac;
@@ -607,7 +639,7 @@ impl Radau5 {
                 }
             };
 
-            let err = self.error_estimate(sys, t, h, first || reject);
+            let err = self.error_estimate(watch.ode(), t, h, first || reject);
             let fac = SAFE.min(cfac / (newt + 2 * NIT) as f64);
             let mut quot = FACR.max(FACL.min(err.powf(0.25) / fac));
             let mut hnew = h / quot;
@@ -623,7 +655,7 @@ impl Radau5 {
             // of the final stage lies within its tolerance of this state.
             self.stage_end();
             if !last {
-                sys.rhs(tph, &self.tmp, &mut self.ftmp);
+                watch.ode().rhs(tph, &self.tmp, &mut self.ftmp);
                 self.stats.rhs_evals += 1;
                 if !all_finite(&self.ftmp) {
                     h *= 0.5;
@@ -652,7 +684,7 @@ impl Radau5 {
             }
             self.accept(h, t);
 
-            let stopped = stop(&self.dense());
+            let stopped = watch.accepted(&self.dense());
             if last || stopped.is_some() {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
                 let hint = if hnew < h { hnew } else { hnew.max(h_nat) };
@@ -966,7 +998,7 @@ impl Radau5 {
             if newt >= NIT {
                 return Err(diverged);
             }
-            let times = [t + C1 * h, t + C2 * h, tph];
+            let times = stage_times(t, h, tph);
             for (zk, &tk) in self.z.iter_mut().zip(&times) {
                 for ((x, &y), &z) in self.tmp.iter_mut().zip(&self.y).zip(zk.iter()) {
                     *x = y + z;
@@ -1101,6 +1133,13 @@ impl Radau5 {
             r.max(1e-10)
         }
     }
+}
+
+/// The times at which a step from `t` of size `h` ending at `t_end_of_step` evaluates the
+/// right-hand side in its Newton iteration: the collocation points `t + c_i h` (the last is the
+/// step's end, given exactly).
+pub fn stage_times(t: f64, h: f64, t_end_of_step: f64) -> [f64; 3] {
+    [t + C1 * h, t + C2 * h, t_end_of_step]
 }
 
 /// Step towards `t_end`: land exactly if `h` reaches it (with 1e-4 relative slack), split the

@@ -422,6 +422,19 @@ fn closing_steps_have_order_five() {
     }
 }
 
+/// A watch of [`Linear`] that shows each accepted step to a closure.
+struct Stops<F>(F);
+
+impl<F: FnMut(&Dense<'_>) -> Option<f64>> Watch for Stops<F> {
+    type Ode = Linear;
+    fn ode(&self) -> &Linear {
+        &Linear
+    }
+    fn accepted(&mut self, dense: &Dense<'_>) -> Option<f64> {
+        (self.0)(dense)
+    }
+}
+
 /// The continuous output between grid points: the collocation polynomial of Radau IIA with 3
 /// stages has stage order 3, so its error inside a step is O(h^4) (Hairer & Wanner IV.8, eq.
 /// 8.12 and the remark after it): halving the fixed step divides the largest error at the
@@ -434,16 +447,15 @@ fn dense_output_has_order_four_between_grid_points() {
         let mut s = fixed_step(h);
         let mut x = Linear::exact(0.0);
         let (mut worst, mut mid) = (0.0_f64, [0.0; 3]);
-        let reached = s
-            .integrate_until(&Linear, (0.0, 1.0), &mut x, None, |d| {
-                let (a, b) = d.span();
-                d.at(b, &mut mid);
-                assert_eq!(&mid[..], d.end(), "the polynomial ends at the accepted state");
-                d.at(0.5 * (a + b), &mut mid);
-                worst = worst.max(max_abs_diff(&mid, &Linear::exact(0.5 * (a + b))));
-                None
-            })
-            .unwrap();
+        let mut watch = Stops(|d: &Dense<'_>| {
+            let (a, b) = d.span();
+            d.at(b, &mut mid);
+            assert_eq!(&mid[..], d.end(), "the polynomial ends at the accepted state");
+            d.at(0.5 * (a + b), &mut mid);
+            worst = worst.max(max_abs_diff(&mid, &Linear::exact(0.5 * (a + b))));
+            None
+        });
+        let reached = s.integrate_until(&mut watch, (0.0, 1.0), &mut x, None).unwrap();
         assert_eq!(reached, 1.0);
         errs.push(worst);
     }
@@ -466,13 +478,12 @@ fn an_integration_stops_where_asked() {
         s.set_atol(&[1e-8; 3]).unwrap();
         let mut x = Linear::exact(0.0);
         let mut stops = 0;
-        let t = s
-            .integrate_until(&Linear, (0.0, 2.0), &mut x, None, |d| {
-                let (a, b) = d.span();
-                stops += 1;
-                (stops == 3).then_some(if stop_inside { 0.5 * (a + b) } else { b })
-            })
-            .unwrap();
+        let mut watch = Stops(|d: &Dense<'_>| {
+            let (a, b) = d.span();
+            stops += 1;
+            (stops == 3).then_some(if stop_inside { 0.5 * (a + b) } else { b })
+        });
+        let t = s.integrate_until(&mut watch, (0.0, 2.0), &mut x, None).unwrap();
         assert!(t > 0.0 && t < 2.0, "stopped at {t}");
         assert!(max_abs_diff(&x, &Linear::exact(t)) < 1e-7, "state at {t}: {x:?}");
         s.integrate(&Linear, t, &mut x, 2.0).unwrap();

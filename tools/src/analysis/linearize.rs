@@ -206,7 +206,7 @@ pub fn time_point(
         Some(f) => run_to(plant, &rest, u_ref, f, t),
         None => {
             let mut plant = plant.clone();
-            plant.u_ref = Ramp { t0: 0.0, y0: u_ref, slope: 0.0 };
+            plant.u_ref = Ramp::new(0.0, u_ref, 0.0);
             let mut x = rest;
             let mut solver = Radau5::new(x.len());
             solver.set_tolerance(1e-8, || plant.state_scale()).map_err(|e| e.to_string())?;

@@ -77,6 +77,10 @@ fn variable<M: Model>(v: &Variable) -> (&'static str, Attrs, Option<String>) {
             if let Some(state) = M::STATES.iter().find(|x| x.derivative == v.vr) {
                 a.push(("derivative", state.state.to_string()));
             }
+            // An input the master may set in intermediate update (4.2.3).
+            if M::INTERMEDIATE_INPUTS.contains(&v.vr) {
+                a.push(("intermediateUpdate", "true".into()));
+            }
             ("Float64", None)
         }
         Kind::Integer { start: s, min, max } => {
@@ -141,9 +145,9 @@ fn write<M: Model>() -> io::Result<String> {
         let cs = interface(vec![
             ("canHandleVariableCommunicationStepSize", flag(true)),
             ("maxOutputDerivativeOrder", "0".into()),
-            ("providesIntermediateUpdate", flag(false)),
-            ("mightReturnEarlyFromDoStep", flag(!M::EVENT_INDICATORS.is_empty())),
-            ("canReturnEarlyAfterIntermediateUpdate", flag(false)),
+            ("providesIntermediateUpdate", flag(!M::INTERMEDIATE_INPUTS.is_empty())),
+            ("mightReturnEarlyFromDoStep", flag(!M::EVENT_INDICATORS.is_empty() || !M::INTERMEDIATE_INPUTS.is_empty())),
+            ("canReturnEarlyAfterIntermediateUpdate", flag(!M::INTERMEDIATE_INPUTS.is_empty())),
             ("hasEventMode", flag(has_event_mode::<M>())),
             ("providesEvaluateDiscreteStates", flag(false)),
         ]);
