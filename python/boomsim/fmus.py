@@ -46,6 +46,12 @@ class Fmi3:
         raise UsageError("FMI 3.0 has no input derivatives: pass ramped inputs by intermediate update "
                          "(boomsim.fmus.LinearInputs), or run FMI 3.0 Co-Simulation with --hold")
 
+    def getDerivatives(self, p, n):
+        return self.m.getContinuousStateDerivatives(p, n)
+
+    def newDiscreteStates(self):
+        return self.m.updateDiscreteStates()
+
 
 class LinearInputs:
     """A master's inputs linear over each communication step, passed to an FMI 3.0 Co-Simulation
@@ -71,12 +77,6 @@ class LinearInputs:
             t0, h, y0, y1 = self.line
             values = y1 if t == t0 + h else [a + (b - a) * (t - t0) / h for a, b in zip(y0, y1)]
             self.slave.setFloat64(self.vrs, values)
-
-    def getDerivatives(self, p, n):
-        return self.m.getContinuousStateDerivatives(p, n)
-
-    def newDiscreteStates(self):
-        return self.m.updateDiscreteStates()
 
 
 class FmuFile:
