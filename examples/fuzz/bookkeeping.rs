@@ -34,6 +34,10 @@ pub struct Bookkeeping<'a> {
     pub opened: bool,
     /// The main instance is a Model Exchange one.
     pub me: bool,
+    /// The main instance is a Co-Simulation one with eventModeUsed, and with earlyReturnAllowed
+    /// (FMI 3.0).
+    pub event_mode: bool,
+    pub early_return: bool,
     /// The main instance has a logger.
     pub logger: bool,
     /// The continuous states the main instance last returned (Model Exchange).
@@ -56,6 +60,8 @@ impl<'a> Bookkeeping<'a> {
             second: null_mut(),
             opened: false,
             me: false,
+            event_mode: false,
+            early_return: false,
             logger: false,
             x: Vec::new(),
             x_fresh: false,

@@ -15,8 +15,9 @@ use crate::oversized::{too_many_refs, wrong_size};
 use crate::view::{Phase, View};
 
 /// Why the call must fail, if it must: `view` is the instance's, `me` its interface.
-pub fn forbidden(op: &Op3, view: &View, me: bool, m: &Description) -> Option<String> {
-    count_error(op, me, m).or_else(|| state_error(op, view, me, m))
+/// `event_mode`: a Co-Simulation instance with eventModeUsed.
+pub fn forbidden(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Description) -> Option<String> {
+    count_error(op, me, m).or_else(|| state_error(op, view, (me, event_mode), m))
 }
 
 /// Counts larger than the model allows, in any state (issue 25 item 1): value-reference lists
@@ -44,7 +45,7 @@ fn count_error(op: &Op3, me: bool, m: &Description) -> Option<String> {
 }
 
 /// What the state machines forbid in the instance's state (certain, else nothing).
-fn state_error(op: &Op3, view: &View, me: bool, m: &Description) -> Option<String> {
+fn state_error(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Description) -> Option<String> {
     use Phase::*;
     let phase = view.phase;
     let phase_name = match phase {
@@ -64,8 +65,9 @@ fn state_error(op: &Op3, view: &View, me: bool, m: &Description) -> Option<Strin
     match op {
         Op3::EnterInitializationMode(_) => state(phase == Instantiated),
         Op3::ExitInitializationMode => state(phase == Initialization),
-        // Co-Simulation enters Event Mode only with eventModeUsed, which no valid instance has.
-        Op3::EnterEventMode if !me => Some("fmi3EnterEventMode without eventModeUsed".into()),
+        // Co-Simulation enters Event Mode from Step Mode only with eventModeUsed (4.2.2).
+        Op3::EnterEventMode if !me && !event_mode => Some("fmi3EnterEventMode without eventModeUsed".into()),
+        Op3::EnterEventMode if !me => state(phase == StepComplete),
         Op3::EnterEventMode => state(!matches!(phase, Instantiated | Initialization | Terminated)),
         Op3::Terminate => state(matches!(phase, EventMode | ContinuousTime) || step),
         Op3::GetFloat64 { .. } | Op3::GetInt32 { .. } | Op3::GetBoolean { .. } | Op3::GetString { .. } => {
@@ -81,8 +83,9 @@ fn state_error(op: &Op3, view: &View, me: bool, m: &Description) -> Option<Strin
         Op3::Refused { .. } => Some("not provided by this FMU (modelDescription.xml)".into()),
         Op3::Derivative { adjoint: true, .. } if !m.adjoint => Some("providesAdjointDerivatives=\"false\"".into()),
         Op3::Derivative { .. } => state(phase != Instantiated),
-        Op3::EnterStepMode => cs_only(false),
+        Op3::EnterStepMode => cs_only(event_mode && phase == EventMode),
         Op3::DoStep { .. } => cs_only(step),
+        Op3::UpdateDiscreteStates { .. } if event_mode => state(phase == EventMode),
         Op3::UpdateDiscreteStates { .. } | Op3::EnterContinuousTimeMode => me_only(phase == EventMode),
         Op3::CompletedIntegratorStep { .. } => me_only(phase == ContinuousTime),
         Op3::SetTime { t } => me_only(true).or_else(|| view.set_time_refusal(*t)),

@@ -140,6 +140,8 @@ pub struct Description {
     pub fmi3: bool,
     /// `providesAdjointDerivatives` of the CoSimulation element (FMI 3.0).
     pub adjoint: bool,
+    /// `hasEventMode` of the CoSimulation element (FMI 3.0): eventModeUsed is accepted.
+    pub event_mode: bool,
     /// `providesDirectionalDerivative` (FMI 3.0: `providesDirectionalDerivatives`) of the
     /// CoSimulation element.
     pub directional: bool,
@@ -192,6 +194,7 @@ impl Description {
         let mut reader = quick_xml::Reader::from_str(xml);
         let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
         let (mut states, mut event_indicators, mut fmi3, mut adjoint, mut directional) = (0, 0, false, false, false);
+        let mut event_mode = false;
         let mut scalar: Option<Attributes> = None;
         // ModelStructure: (the section, the index or value reference) of every Unknown element.
         let (mut section, mut structure) = (String::new(), Vec::<(String, u32)>::new());
@@ -212,6 +215,7 @@ impl Description {
                         "CoSimulation" => {
                             identifier = a.get("modelIdentifier").cloned();
                             adjoint = a.get("providesAdjointDerivatives").is_some_and(|v| v == "true");
+                            event_mode = a.get("hasEventMode").is_some_and(|v| v == "true");
                             let key = if fmi3 { "providesDirectionalDerivatives" } else { "providesDirectionalDerivative" };
                             directional = a.get(key).is_some_and(|v| v == "true");
                         }
@@ -302,6 +306,7 @@ impl Description {
             guid: guid.ok_or("no guid or instantiationToken")?,
             fmi3,
             adjoint,
+            event_mode,
             directional,
             flexible,
             states,

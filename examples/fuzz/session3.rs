@@ -130,7 +130,7 @@ impl<'a> Session3<'a> {
 
     /// The state machine's and the logger's part of the oracle on a call to the main instance.
     fn check_status(&self, op: &Op3, status: Option<Status>, (errors, discards): (u64, u64)) -> Result<(), String> {
-        if let (Some(why), Some(s)) = (forbidden(op, &self.view, self.me, self.model), status) {
+        if let (Some(why), Some(s)) = (forbidden(op, &self.view, (self.me, self.event_mode), self.model), status) {
             if s != ERROR {
                 let call = op.describe();
                 let function = call.split([' ', '(']).next().unwrap_or_default();
@@ -307,9 +307,10 @@ impl<'a> Session3<'a> {
                     (e.start, e.start, e.stop_defined.then_some(e.stop), true, Phase::Initialization);
             }
             (Op3::ExitInitializationMode, _) => {
-                self.view.phase = if self.me { Phase::EventMode } else { Phase::StepComplete }
+                self.view.phase = if self.me || self.event_mode { Phase::EventMode } else { Phase::StepComplete }
             }
             (Op3::EnterEventMode, _) => self.view.phase = Phase::EventMode,
+            (Op3::EnterStepMode, _) => self.view.phase = Phase::StepComplete,
             (Op3::EnterContinuousTimeMode, _) => self.view.phase = Phase::ContinuousTime,
             (Op3::Terminate, _) => self.view.phase = Phase::Terminated,
             (Op3::Reset, _) => self.view = View::fresh(),
@@ -361,6 +362,8 @@ impl<'a> Session3<'a> {
         }
         if !self.opened {
             self.me = spec.interface == Interface3::ModelExchange;
+            let cs = !self.me;
+            (self.event_mode, self.early_return) = (cs && spec.event_mode_used, cs && spec.early_return_allowed);
             self.report.me = self.me;
             (self.logger, self.all_logged) = (spec.logger, spec.logging_on);
         }
@@ -393,11 +396,22 @@ impl<'a> Session3<'a> {
     fn stepped(&mut self, t: f64, h: f64, status: Option<Status>, [event, _, early]: [u8; 3], last: f64) -> Result<(), String> {
         let end = t + h;
         let near = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y.abs().max(1.0);
+        // FMI 3.0, 4.2.3: an early return only with earlyReturnAllowed, inside the step; an event
+        // only with eventModeUsed.
         match status {
-            Some(OK | WARNING) if event != 0 || early != 0 => {
-                return Err(format!("fmi3DoStep returned eventHandlingNeeded = {event}, earlyReturn = {early}; the FMU has no event mode and never returns early"));
+            Some(OK | WARNING) if (early != 0 && !self.early_return) || (event != 0 && !self.event_mode) => {
+                return Err(format!(
+                    "fmi3DoStep returned eventHandlingNeeded = {event}, earlyReturn = {early}, but the instance has \
+                     eventModeUsed = {}, earlyReturnAllowed = {}",
+                    self.event_mode, self.early_return
+                ));
             }
-            Some(OK | WARNING) if !near(last, end) => {
+            Some(OK | WARNING) if early != 0 && !(last > t && last < end) => {
+                return Err(format!(
+                    "fmi3DoStep returned earlyReturn with lastSuccessfulTime = {last}, outside ({t}, {end})"
+                ));
+            }
+            Some(OK | WARNING) if early == 0 && !near(last, end) => {
                 return Err(format!("fmi3DoStep returned fmi3OK with lastSuccessfulTime = {last}, not t + h = {end}"));
             }
             Some(DISCARD) if !(last >= t - 1e-9 * t.abs().max(1.0) && last <= end + 1e-9 * end.abs().max(1.0)) => {
@@ -406,6 +420,8 @@ impl<'a> Session3<'a> {
             _ => {}
         }
         let before = self.view;
+        // An early return ends the step at lastSuccessfulTime.
+        let h = if early != 0 && matches!(status, Some(OK | WARNING)) { last - t } else { h };
         self.simulated += self.view.stepped(t, h, status);
         if status == Some(DISCARD) {
             // FMI 3.0 2.2.4, 4.2.1 (issue 25 item 6): the instance stays as before the call,

@@ -149,7 +149,9 @@ pub fn valid_instantiation(spec: &Instantiation3, m: &Description) -> Option<boo
     }
     let name_ok =
         matches!(&spec.name, Text::Bytes(n) if !n.to_bytes().is_empty() && std::str::from_utf8(n.to_bytes()).is_ok());
-    let co_simulation_ok =
-        spec.interface == Interface3::ModelExchange || (!spec.event_mode_used && spec.required_intermediate.len() == 0);
+    // Event Mode where the model has it (hasEventMode); intermediate variables only with the
+    // intermediateUpdate callback, which the fuzzer never passes.
+    let co_simulation_ok = spec.interface == Interface3::ModelExchange
+        || ((!spec.event_mode_used || m.event_mode) && spec.required_intermediate.len() == 0);
     (name_ok && co_simulation_ok).then_some(true)
 }

@@ -144,3 +144,41 @@ fn models_without_events_refuse_event_mode() {
     assert!(e.iter().any(|m| m.contains("eventModeUsed") && m.contains("hasEventMode")), "{e:?}");
     assert!(Inst::<Pfc>::try_new(false, &token::<Pfc>(), (false, true)).is_ok(), "earlyReturnAllowed is accepted");
 }
+
+/// The bytes of an FMU state of `i` taken now (fmi3GetFMUState, fmi3SerializeFMUState).
+fn serialized(i: &Inst<Hb>) -> Vec<u8> {
+    let mut state = std::ptr::null_mut();
+    let mut size = 0;
+    unsafe {
+        assert_eq!(api::get_fmu_state::<Hb>(i.c, &mut state), OK);
+        assert_eq!(api::serialized_fmu_state_size::<Hb>(i.c, state, &mut size), OK);
+        let mut bytes = vec![0u8; size];
+        assert_eq!(api::serialize_fmu_state::<Hb>(i.c, state, bytes.as_mut_ptr(), size), OK);
+        assert_eq!(api::free_fmu_state::<Hb>(i.c, &mut state), OK);
+        bytes
+    }
+}
+
+/// fmi3DeserializeFMUState of a state fmi3SerializeFMUState gave (FMI 3.0, 2.2.4): a Co-Simulation
+/// instance with Event Mode restores one saved in Event Mode (found by the fuzzer: it was refused
+/// as a Model Exchange state), and one without Event Mode refuses it, naming why.
+#[test]
+fn fmu_states_saved_in_event_mode_restore_with_event_mode_only() {
+    let with = Inst::<Hb>::try_new(false, &token::<Hb>(), (true, true)).expect("instantiated");
+    unsafe {
+        assert_eq!(api::enter_initialization_mode::<Hb>(with.c, false, 0.0, 0.0, false, 0.0), OK);
+        assert_eq!(api::exit_initialization_mode::<Hb>(with.c), OK);
+    }
+    let bytes = serialized(&with);
+    let mut state = std::ptr::null_mut();
+    unsafe {
+        assert_eq!(api::deserialize_fmu_state::<Hb>(with.c, bytes.as_ptr(), bytes.len(), &mut state), OK);
+        assert_eq!(api::set_fmu_state::<Hb>(with.c, state), OK);
+        assert_eq!(api::free_fmu_state::<Hb>(with.c, &mut state), OK);
+        assert_eq!(update(&with), [false; 5], "restored in Event Mode");
+    }
+    let without = Inst::<Hb>::try_new(false, &token::<Hb>(), (false, false)).expect("instantiated");
+    let status = unsafe { api::deserialize_fmu_state::<Hb>(without.c, bytes.as_ptr(), bytes.len(), &mut state) };
+    assert_eq!(status, fmi3Status::Error);
+    assert!(without.last_error().contains("no Event Mode (eventModeUsed = false)"), "{}", without.last_error());
+}

@@ -23,6 +23,10 @@
  *                     ramp inputs at the step's end, its printed outputs read, fmi3UpdateDiscreteStates,
  *                     fmi3EnterStepMode): FMI 3.0, 2.2.8 and 2.3.5; its clocked outputs are printed
  *                     as read at the last activation
+ *     intermediate:I:VR  (--fmi3) FMU I is instantiated with an intermediateUpdate callback and VR as its
+ *                     requiredIntermediateVariables; VR's ramp op (ramp:I:VR=X,D) is then also set in the
+ *                     callback wherever it requests inputs, to X + D t at its intermediateUpdateTime t
+ *                     (FMI 3.0, 4.2.3: the input linear over a step, as FMI 2.0's input derivative)
  *
  * Exit status: 0 when every call returned OK (fmi2OK = fmi3OK = 0), 1 otherwise (the failing call
  * is printed), 2 for bad arguments. */
@@ -83,6 +87,9 @@ typedef struct {
     Status (*get_interval3)(Component, const VR *, size_t, double *, int *);
     int clocked; /* clock:I:VR given for this FMU */
     VR clock;
+    int intermediate; /* intermediate:I:VR given for this FMU: VR on the line X + D t */
+    VR intermediate_vr;
+    double line_x, line_d;
     /* both (the same signatures) */
     Status (*exit_init)(Component);
     Status (*terminate)(Component);
@@ -92,7 +99,7 @@ typedef struct {
 
 enum { MAX_OPS = 64 };
 typedef struct {
-    char kind; /* 'r' real, 'b' bool, 'l' link, 'm' ramp, 'p' print, 't' tolerance, 'c' clock */
+    char kind; /* 'r' real, 'b' bool, 'l' link, 'm' ramp, 'p' print, 't' tolerance, 'c' clock, 'i' intermediate */
     int fmu, src_fmu;
     VR vr, src_vr;
     double value, slope;
@@ -110,15 +117,29 @@ static void logger(void *env, const char *name, int status, const char *category
     fputc('\n', stderr);
 }
 
+/* The FMI 3.0 instance environment is the Fmu. */
 static void logger3(void *env, Status status, const char *category, const char *message) {
     if (status == 0) return;
-    fprintf(stderr, "[%s %d %s] %s\n", (const char *)env, status, category, message);
+    fprintf(stderr, "[%s %d %s] %s\n", ((Fmu *)env)->path, status, category, message);
 }
 
 static void check(Status s, const char *what) {
     if (s != 0) {
         fprintf(stderr, "fmu_host: %s returned status %d\n", what, s);
         exit(1);
+    }
+}
+
+/* fmi3IntermediateUpdateCallback: where inputs are requested, the required input on its line at t;
+ * never an early return. */
+static void intermediate_update(void *env, double t, bool set_requested, bool get_allowed, bool finished,
+                                bool can_return_early, bool *early_return_requested, double *early_return_time) {
+    Fmu *f = (Fmu *)env;
+    (void)get_allowed, (void)finished, (void)can_return_early, (void)early_return_time;
+    *early_return_requested = false;
+    if (set_requested) {
+        double x = f->line_x + f->line_d * t;
+        check(f->set_float64(f->c, &f->intermediate_vr, 1, &x, 1), "fmi3SetFloat64 in intermediate update");
     }
 }
 
@@ -161,9 +182,11 @@ static void load(Fmu *f, int fmi3, const char *path, const char *guid, const Cal
         NEED(set_clock3, "SetClock");
         NEED(update_discrete_states3, "UpdateDiscreteStates");
         NEED(get_interval3, "GetIntervalDecimal");
-        /* event mode only for an FMU with a Clock; no early return, no intermediate variables; the
-         * environment is the path */
-        f->c = f->instantiate3("host", guid, NULL, false, false, f->clocked, false, NULL, 0, (void *)path, logger3, NULL);
+        /* event mode only for an FMU with a Clock; no early return; the intermediate update for an
+         * FMU with intermediate:I:VR; the environment is the Fmu */
+        void *callback = f->intermediate ? (void *)intermediate_update : NULL;
+        f->c = f->instantiate3("host", guid, NULL, false, false, f->clocked, false, &f->intermediate_vr,
+                               (size_t)f->intermediate, f, logger3, callback);
     } else {
         NEED(instantiate, "Instantiate");
         NEED(setup, "SetupExperiment");
@@ -281,6 +304,7 @@ static Op parse(const char *s) {
     else if (sscanf(s, "print:%d:%u", &op.fmu, &vr) == 2) op.kind = 'p';
     else if (sscanf(s, "tol:%lf", &op.value) == 1) op.kind = 't';
     else if (sscanf(s, "clock:%d:%u", &op.fmu, &vr) == 2) op.kind = 'c';
+    else if (sscanf(s, "intermediate:%d:%u", &op.fmu, &vr) == 2) op.kind = 'i';
     else {
         fprintf(stderr, "fmu_host: cannot read \"%s\"\n", s);
         exit(2);
@@ -316,6 +340,18 @@ int main(int argc, char **argv) {
     for (k++; k < argc && n_ops < MAX_OPS; k++) ops[n_ops++] = parse(argv[k]);
     for (int j = 0; j < n_ops; j++) {
         if (ops[j].kind == 'c' && ops[j].fmu < n_fmus) fmus[ops[j].fmu].clocked = 1, fmus[ops[j].fmu].clock = ops[j].vr;
+        if (ops[j].kind == 'i' && ops[j].fmu < n_fmus) {
+            if (!fmi3) {
+                fprintf(stderr, "fmu_host: intermediate: needs --fmi3 (FMI 2.0 has input derivatives instead)\n");
+                return 2;
+            }
+            Fmu *f = &fmus[ops[j].fmu];
+            f->intermediate = 1, f->intermediate_vr = ops[j].vr;
+            for (int m = 0; m < n_ops; m++) {
+                if (ops[m].kind != 'm' || ops[m].fmu != ops[j].fmu || ops[m].vr != ops[j].vr) continue;
+                f->line_x = ops[m].value, f->line_d = ops[m].slope;
+            }
+        }
     }
     for (int i = 0; i < n_fmus; i++) load(&fmus[i], fmi3, argv[first_lib + 2 * i], argv[first_lib + 2 * i + 1], &cb);
 

@@ -8,7 +8,9 @@ reproduced through fmpy's FMI 3.0 calls (fmpy has no master for Clocks)."""
 
 import csv
 import io
+import os
 import pathlib
+import subprocess
 import zipfile
 
 import numpy as np
@@ -22,6 +24,7 @@ from boomsim import metrics, rig_loop
 from boomsim.clocked import runs_of, table
 from boomsim.regression import compare, load_tolerances
 from boomsim.scenarios import load_scenario
+from conftest import FMI_SIM
 
 CONTROLLER = "ClockedPressureFeedbackController"
 
@@ -96,6 +99,21 @@ def test_fmpy_simulate_which_never_activates_the_clock_gets_a_clear_error(how):
     with pytest.raises(Exception, match="fmi3GetFloat64 failed"):
         simulate_fmu(str(boomsim.fmu(CONTROLLER, fmi=3)), stop_time=0.1, output_interval=5e-3, logger=logger, **how)
     assert any('"u" is clocked by "sample", which is not active' in m for m in messages), messages
+
+
+def test_fmusim_which_never_activates_the_clock_gets_a_clear_error(tmp_path):
+    """fmi-sim 0.7.0 (rust-fmi's fmusim) has no Clock master either: with --event-mode-used it
+    leaves initialisation through Event Mode and reads `u` in Step Mode, and the FMU answers
+    fmi3Error naming the variable and its Clock (2.2.8.3); fmi-sim stops with an error, writing no
+    value."""
+    out = tmp_path / "clocked-fmusim.csv"
+    # RUST_LOG=error: fmi-sim logs the FMU's error messages (env_logger).
+    r = subprocess.run([FMI_SIM, "--model", boomsim.fmu(CONTROLLER, fmi=3), "-o", out, "co-simulation",
+                        "--event-mode-used", "-f", "0.1", "--output-interval", "0.005"],
+                       capture_output=True, text=True, timeout=120, env=dict(os.environ, RUST_LOG="error"))
+    assert r.returncode != 0
+    assert '"u" is clocked by "sample", which is not active' in r.stderr, r.stderr[-2000:]
+    assert not out.exists() or len(out.read_text().splitlines()) <= 1
 
 
 def test_the_reference_results_reproduce_through_fmpy():

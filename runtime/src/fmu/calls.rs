@@ -466,6 +466,11 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
                 core.mode, inst.interface
             ));
         }
+        if core.mode == Mode::EventMode && inst.interface == Interface::CoSimulation && !inst.event_mode_used {
+            return Err("the state was saved in Event Mode; this Co-Simulation instance has no Event Mode \
+                        (eventModeUsed = false)"
+                .into());
+        }
         *out = new_fmu_state(inst, core);
         Ok(Status::OK)
     })

@@ -28,13 +28,14 @@ impl Mode {
         1 << self as u16
     }
 
-    /// The interface whose state this is; `None` for the states both share.
+    /// The interface whose state this is; `None` for the states both share (Event Mode: Model
+    /// Exchange, and FMI 3.0 Co-Simulation with eventModeUsed).
     pub const fn interface(self) -> Option<Interface> {
         match self {
             Mode::StepComplete | Mode::StepFailed | Mode::StepCanceled | Mode::IntermediateUpdate => {
                 Some(Interface::CoSimulation)
             }
-            Mode::EventMode | Mode::ContinuousTimeMode => Some(Interface::ModelExchange),
+            Mode::ContinuousTimeMode => Some(Interface::ModelExchange),
             _ => None,
         }
     }
