@@ -23,6 +23,11 @@
  *                     ramp inputs at the step's end, its printed outputs read, fmi3UpdateDiscreteStates,
  *                     fmi3EnterStepMode): FMI 3.0, 2.2.8 and 2.3.5; its clocked outputs are printed
  *                     as read at the last activation
+ *     early:I         (--fmi3) FMU I is instantiated with eventModeUsed and earlyReturnAllowed: a step that
+ *                     returns early continues from lastSuccessfulTime to the step's end, after Event Mode
+ *                     (fmi3EnterEventMode, fmi3UpdateDiscreteStates, fmi3EnterStepMode) where the FMU asks
+ *                     for it (eventHandlingNeeded); each early return is written to stderr as
+ *                     "fmu_host: early return at T" (FMI 3.0, 4.2.3)
  *     intermediate:I:VR  (--fmi3) FMU I is instantiated with an intermediateUpdate callback and VR as its
  *                     requiredIntermediateVariables; VR's ramp op (ramp:I:VR=X,D) is then also set in the
  *                     callback wherever it requests inputs, to X + D t at its intermediateUpdateTime t
@@ -87,6 +92,7 @@ typedef struct {
     Status (*get_interval3)(Component, const VR *, size_t, double *, int *);
     int clocked; /* clock:I:VR given for this FMU */
     VR clock;
+    int early; /* early:I given for this FMU */
     int intermediate; /* intermediate:I:VR given for this FMU: VR on the line X + D t */
     VR intermediate_vr;
     double line_x, line_d;
@@ -99,7 +105,8 @@ typedef struct {
 
 enum { MAX_OPS = 64 };
 typedef struct {
-    char kind; /* 'r' real, 'b' bool, 'l' link, 'm' ramp, 'p' print, 't' tolerance, 'c' clock, 'i' intermediate */
+    char kind; /* 'r' real, 'b' bool, 'l' link, 'm' ramp, 'p' print, 't' tolerance, 'c' clock, 'e' early,
+                  'i' intermediate */
     int fmu, src_fmu;
     VR vr, src_vr;
     double value, slope;
@@ -182,10 +189,10 @@ static void load(Fmu *f, int fmi3, const char *path, const char *guid, const Cal
         NEED(set_clock3, "SetClock");
         NEED(update_discrete_states3, "UpdateDiscreteStates");
         NEED(get_interval3, "GetIntervalDecimal");
-        /* event mode only for an FMU with a Clock; no early return; the intermediate update for an
-         * FMU with intermediate:I:VR; the environment is the Fmu */
+        /* event mode for an FMU with a Clock or early:I, early return for the latter; the
+         * intermediate update for an FMU with intermediate:I:VR; the environment is the Fmu */
         void *callback = f->intermediate ? (void *)intermediate_update : NULL;
-        f->c = f->instantiate3("host", guid, NULL, false, false, f->clocked, false, &f->intermediate_vr,
+        f->c = f->instantiate3("host", guid, NULL, false, false, f->clocked || f->early, f->early, &f->intermediate_vr,
                                (size_t)f->intermediate, f, logger3, callback);
     } else {
         NEED(instantiate, "Instantiate");
@@ -234,27 +241,41 @@ static void fmu_set_boolean(Fmu *f, VR vr, int b) {
     else check(f->set_boolean(f->c, &vr, 1, &b), "fmi2SetBoolean");
 }
 
-static void fmu_do_step(Fmu *f, double t, double h) {
-    if (f->fmi3) {
-        bool event = false, terminate = false, early = false;
-        double last = 0.0;
-        check(f->do_step3(f->c, t, h, true, &event, &terminate, &early, &last), "fmi3DoStep");
-        if (event || terminate || early || last != t + h) {
-            fprintf(stderr, "fmu_host: fmi3DoStep at %g: event %d, terminate %d, early return %d, reached %g\n", t, event,
-                    terminate, early, last);
-            exit(1);
-        }
-        return;
-    }
-    check(f->do_step(f->c, t, h, 1), "fmi2DoStep");
-}
-
 static void fmu_update_discrete_states(Fmu *f) {
     bool need_update, terminate, nominals_changed, values_changed, next_defined;
     double next;
     check(f->update_discrete_states3(f->c, &need_update, &terminate, &nominals_changed, &values_changed,
                                      &next_defined, &next),
           "fmi3UpdateDiscreteStates");
+}
+
+/* A step from t to t + h; with early:I, through the early returns on the way. */
+static void fmu_do_step(Fmu *f, double t, double h) {
+    if (!f->fmi3) {
+        check(f->do_step(f->c, t, h, 1), "fmi2DoStep");
+        return;
+    }
+    double now = t, end = t + h;
+    for (;;) {
+        bool event = false, terminate = false, early = false;
+        double last = 0.0;
+        check(f->do_step3(f->c, now, end - now, true, &event, &terminate, &early, &last), "fmi3DoStep");
+        bool legal = !terminate && (f->early ? (!early || (last > now && last < end)) && (!event || f->early)
+                                             : !event && !early);
+        if (!legal || (!early && last != end)) {
+            fprintf(stderr, "fmu_host: fmi3DoStep at %g: event %d, terminate %d, early return %d, reached %g\n", now,
+                    event, terminate, early, last);
+            exit(1);
+        }
+        if (early) fprintf(stderr, "fmu_host: early return at %.17g\n", last);
+        if (event) {
+            check(f->enter_event_mode3(f->c), "fmi3EnterEventMode");
+            fmu_update_discrete_states(f);
+            check(f->enter_step_mode3(f->c), "fmi3EnterStepMode");
+        }
+        if (!early) return;
+        now = last;
+    }
 }
 
 /* In Initialization Mode: the Clock's interval must be the host's step. */
@@ -305,6 +326,7 @@ static Op parse(const char *s) {
     else if (sscanf(s, "tol:%lf", &op.value) == 1) op.kind = 't';
     else if (sscanf(s, "clock:%d:%u", &op.fmu, &vr) == 2) op.kind = 'c';
     else if (sscanf(s, "intermediate:%d:%u", &op.fmu, &vr) == 2) op.kind = 'i';
+    else if (sscanf(s, "early:%d", &op.fmu) == 1) op.kind = 'e';
     else {
         fprintf(stderr, "fmu_host: cannot read \"%s\"\n", s);
         exit(2);
@@ -340,6 +362,13 @@ int main(int argc, char **argv) {
     for (k++; k < argc && n_ops < MAX_OPS; k++) ops[n_ops++] = parse(argv[k]);
     for (int j = 0; j < n_ops; j++) {
         if (ops[j].kind == 'c' && ops[j].fmu < n_fmus) fmus[ops[j].fmu].clocked = 1, fmus[ops[j].fmu].clock = ops[j].vr;
+        if (ops[j].kind == 'e' && ops[j].fmu < n_fmus) {
+            if (!fmi3) {
+                fprintf(stderr, "fmu_host: early: needs --fmi3 (FMI 2.0 has no early return)\n");
+                return 2;
+            }
+            fmus[ops[j].fmu].early = 1;
+        }
         if (ops[j].kind == 'i' && ops[j].fmu < n_fmus) {
             if (!fmi3) {
                 fprintf(stderr, "fmu_host: intermediate: needs --fmi3 (FMI 2.0 has input derivatives instead)\n");
@@ -369,7 +398,7 @@ int main(int argc, char **argv) {
         }
         if (fmus[i].clocked) check_interval(&fmus[i], h);
         fmu_exit_init(&fmus[i]);
-        if (fmus[i].clocked) {
+        if (fmus[i].clocked || fmus[i].early) {
             fmu_update_discrete_states(&fmus[i]);
             check(fmus[i].enter_step_mode3(fmus[i].c), "fmi3EnterStepMode");
         }

@@ -87,9 +87,10 @@ def hosts(tmp_path_factory):
     return out
 
 
-def run(hosts, unpacked, platform, steps, fmus, ops, fmi=2, h="0.001"):
+def run(hosts, unpacked, platform, steps, fmus, ops, fmi=2, h="0.001", early=None):
     """fmu_host's printed rows (lists of floats, exact: printed with 17 digits) for the FMI `fmi`
-    FMUs `fmus` on `platform`, stepped by `h` seconds."""
+    FMUs `fmus` on `platform`, stepped by `h` seconds; with a list `early`, the times of the early
+    returns it reported are appended to it."""
     args = (["--fmi3"] if fmi == 3 else []) + [str(steps), h]
     for ident in fmus:
         _, token, libs = unpacked[fmi, ident]
@@ -97,6 +98,9 @@ def run(hosts, unpacked, platform, steps, fmus, ops, fmi=2, h="0.001"):
     env = dict(os.environ, WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
     r = subprocess.run(hosts[platform] + args + ["--"] + ops, capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, f"{platform}, FMI {fmi}: {r.stderr}"
+    if early is not None:
+        reported = [line for line in r.stderr.splitlines() if line.startswith("fmu_host: early return")]
+        early += [float(line.split()[-1]) for line in reported]
     return [[float(x) for x in line.split()] for line in r.stdout.splitlines()]
 
 
@@ -263,6 +267,24 @@ def test_intermediate_update_on_every_platform(hosts, unpacked, platform):
     for j in range(1, 5):
         scale = max(abs(r[j]) for r in reference)
         assert max(abs(a[j] - b[j]) for a, b in zip(rows, reference)) <= 1e-5 * scale, (platform, j)
+
+
+@pytest.mark.parametrize("platform", PLATFORMS)
+def test_early_return_on_every_platform(hosts, unpacked, platform):
+    """FMI 3.0 early return and Event Mode through the C host (`early:0`: eventModeUsed and
+    earlyReturnAllowed; after an early return it continues from lastSuccessfulTime, through Event
+    Mode where the FMU asks) on each platform: HydraulicBoom, rigid boom, valve.u_ref ramping from
+    0.3 through 0 to -0.3 in 0.4 s (held over each 10 ms step): the spool leaves the closed dead
+    band lifting, enters it and leaves it lowering: three early returns (FMI 3.0, 4.2.3), at the
+    times linux64 finds to 1e-9 s (the platforms' libm differ in the last bit), and the run ends
+    where linux64's does (1e-5 of p3, the bound of the plant scenarios above)."""
+    ops = ["early:0", "bool:0:31=0", "real:0:0=0.3", "ramp:0:0=0.3,-1.5", "print:0:3"]
+    times, reference = [], []
+    rows = run(hosts, unpacked, platform, 40, ["HydraulicBoom"], ops, fmi=3, h="0.01", early=times)
+    last = run(hosts, unpacked, "linux64", 40, ["HydraulicBoom"], ops, fmi=3, h="0.01", early=reference)
+    assert len(reference) == 3, reference
+    assert times == pytest.approx(reference, abs=1e-9), platform
+    assert rows[-1][1] == pytest.approx(last[-1][1], rel=1e-5)
 
 
 def test_tools_are_installed():

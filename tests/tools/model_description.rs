@@ -96,6 +96,11 @@ fn the_page_states_generated_facts() {
     assert!(page.contains("<th>Model Exchange tolerance</th><td>any</td>"), "controller: any tolerance");
     let page = boomsim_tools::pack::documentation::<boomsim::models::HydraulicBoom>(Version::Fmi2, platforms);
     assert!(page.contains("<th>Model Exchange tolerance</th><td>1e-6 or tighter"), "HydraulicBoom: 1e-6");
+    // FMI 3.0: the inputs a master ramps by intermediate update (the circuit's stroke follows the
+    // integral of v: not one of them), and the early return at the event indicators.
+    let page = boomsim_tools::pack::documentation::<boomsim::models::HydraulicCircuit>(Version::Fmi3, platforms);
+    assert!(page.contains("intermediate update") && page.contains("<td>valve.u_ref, cylinder.v, port.c_m</td>"));
+    assert!(page.contains("a step ends at an event indicator's root"), "early return");
 }
 
 /// The two halves of the cut carry the same coupling recipe (start.F, Z_c, step order, end stops).

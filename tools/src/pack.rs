@@ -151,7 +151,8 @@ pub fn model_description<M: Model>(version: Version) -> String {
 fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
     let i = &M::INFO;
     let name = |r: &u32| M::VARIABLES.iter().find(|v| v.vr == *r).map_or("?", |v| v.name);
-    let interpolated: Vec<&str> = i.interpolated_inputs.iter().map(name).collect();
+    let ramped = if version == Version::Fmi3 { M::INTERMEDIATE_INPUTS } else { i.interpolated_inputs };
+    let interpolated: Vec<&str> = ramped.iter().map(name).collect();
     let categories: Vec<&str> = GENERIC_CATEGORIES.iter().chain(i.log_categories).map(|c| c.0).collect();
     let platforms: Vec<&str> = platforms.iter().map(|p| p.folder(version)).collect();
     let states: Vec<&str> = M::STATES.iter().map(|s| name(&s.state)).collect();
@@ -167,7 +168,8 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
         Version::Fmi3 => (
             "FMI 3.0",
             ("Instantiation token", token::<M>()),
-            "Inputs linear over a step (FMI 2.0's fmi2SetRealInputDerivatives; FMI 3.0 holds inputs over a step)",
+            "Inputs linear over a step by intermediate update (set in the intermediateUpdate callback where it \
+             requests them; held over a step without one)",
             "Terminated after any fmi3Error (FMI 3.0, 2.3.1): getters, FMU states, fmi3Reset; fmi3SetFMUState of a \
              state saved before resumes. fmi3Discard of fmi3DoStep leaves the instance as before the step (2.2.4): \
              retry with a smaller step.",
@@ -178,9 +180,13 @@ fn facts<M: Model>(version: Version, platforms: &[Platform]) -> String {
     let rows = [
         (
             "Interfaces",
-            match clock_row::<M>() {
-                Some(_) => format!("{fmi} Model Exchange and Co-Simulation with Event Mode (a Clock)"),
-                None => format!("{fmi} Model Exchange and Co-Simulation"),
+            match (clock_row::<M>(), version, M::EVENT_INDICATORS.is_empty()) {
+                (Some(_), ..) => format!("{fmi} Model Exchange and Co-Simulation with Event Mode (a Clock)"),
+                (None, Version::Fmi3, false) => format!(
+                    "{fmi} Model Exchange and Co-Simulation (with earlyReturnAllowed a step ends at an event \
+                     indicator's root; Event Mode there with eventModeUsed)"
+                ),
+                _ => format!("{fmi} Model Exchange and Co-Simulation"),
             },
         ),
         (states_label.as_str(), format!("{}: {}", states.len(), states.join(", "))),
