@@ -77,11 +77,13 @@ impl OdeSystem for () {
 pub struct Driven<M> {
     model: M,
     solver: Option<Radau5>,
+    /// Work space of the event search: a state on the integrator's continuous output.
+    work: Vec<f64>,
 }
 
 impl<M: Model> Clone for Driven<M> {
     fn clone(&self) -> Self {
-        Driven { model: self.model.clone(), solver: self.solver().cloned() }
+        Driven { model: self.model.clone(), solver: self.solver().cloned(), work: self.work.clone() }
     }
 }
 
@@ -102,7 +104,7 @@ impl<M: Model> Driven<M> {
     /// `model` with a fresh integrator for its ODE state.
     pub fn new(model: M) -> Self {
         let n = model.state().len();
-        Driven { model, solver: (!M::CLOSED_FORM && n > 0).then(|| Radau5::new(n)) }
+        Driven { model, solver: (!M::CLOSED_FORM && n > 0).then(|| Radau5::new(n)), work: vec![0.0; n] }
     }
 
     /// The integrator; none for a closed-form model (known at compile time).
@@ -147,7 +149,7 @@ impl<M: Model> Driven<M> {
                 let before = *solver.stats();
                 let budget =
                     (values.integer(vr::SOLVER_MODE) == REALTIME).then(|| values.integer(vr::RHS_BUDGET) as u64);
-                let roots = early_return.then(|| Roots::<M>::new(ode, t, state));
+                let roots = early_return.then(|| Roots::<M>::new(ode, t, state, &mut self.work));
                 let mut watch = Watched::<M> { ode, roots, master, ended: None, requested: None };
                 let reached = solver.integrate_until(&mut watch, (t, t + h), state, budget);
                 let end = reached.map_err(|e| fail(e.t, e.to_string()))?;
@@ -200,7 +202,8 @@ impl<M: Model> Driven<M> {
             }
             None => None,
         };
-        Ok(Driven { model, solver })
+        let work = vec![0.0; state.len()];
+        Ok(Driven { model, solver, work })
     }
 }
 
@@ -233,7 +236,7 @@ pub struct Ended {
 /// master's intermediate update.
 struct Watched<'a, 'b, M: Model> {
     ode: &'a mut M::Ode,
-    roots: Option<Roots<M>>,
+    roots: Option<Roots<'a, M>>,
     master: Option<&'b mut dyn Intermediate>,
     ended: Option<Ended>,
     /// The time the master asked the step to end at.
@@ -281,31 +284,32 @@ impl<M: Model> Watch for Watched<'_, '_, M> {
 }
 
 /// The search for the first root of a model's event indicators within a step.
-struct Roots<M: Model> {
+struct Roots<'a, M: Model> {
     /// The indicators at the start of the integrator's current step.
     z: [f64; MAX_EVENT_INDICATORS],
-    /// Work space: a state on the continuous output.
-    x: Vec<f64>,
+    /// Work space: a state on the continuous output (the driver's, so that a step allocates
+    /// nothing).
+    x: &'a mut [f64],
     _model: std::marker::PhantomData<M>,
 }
 
-impl<M: Model> Roots<M> {
+impl<'a, M: Model> Roots<'a, M> {
     const N: usize = {
         assert!(M::EVENT_INDICATORS.len() <= MAX_EVENT_INDICATORS);
         M::EVENT_INDICATORS.len()
     };
 
-    /// The search over a step of `ode` from `t` with state `x`.
-    fn new(ode: &M::Ode, t: f64, x: &[f64]) -> Self {
+    /// The search over a step of `ode` from `t` with state `x`, in the work space `work`.
+    fn new(ode: &M::Ode, t: f64, x: &[f64], work: &'a mut [f64]) -> Self {
         let mut z = [0.0; MAX_EVENT_INDICATORS];
         M::step_event_indicators(ode, t, x, &mut z[..Self::N]);
-        Roots { z, x: x.to_vec(), _model: std::marker::PhantomData }
+        Roots { z, x: work, _model: std::marker::PhantomData }
     }
 
     /// The indicators at `t` on `dense`.
     fn at(&mut self, ode: &M::Ode, dense: &Dense<'_>, t: f64) -> [f64; MAX_EVENT_INDICATORS] {
         let mut z = [0.0; MAX_EVENT_INDICATORS];
-        dense.at(t, &mut self.x);
+        dense.at(t, self.x);
         M::step_event_indicators(ode, t, &self.x, &mut z[..Self::N]);
         z
     }
