@@ -546,7 +546,7 @@ pub unsafe fn do_step_with_master<M: Model>(c: Handle, f: Call, t: f64, h: f64) 
     let mut log = KeptLog::new(&inst.log, M::INFO.log_categories);
     let (values, input_derivatives) = (inst.core.values.clone(), inst.core.input_derivatives.clone());
     let can_return_early = inst.early_return_allowed;
-    let mut callback = Callback::<M> { c, f, values: values.clone(), master, can_return_early, model: PhantomData };
+    let mut callback = Callback::<M> { c, f, values: &values, master, can_return_early, model: PhantomData };
     // No borrow of the instance while the step runs: the callback's calls borrow it.
     let result = begun.run((&values, &input_derivatives), &mut log, Some(&mut callback));
     let inst = borrow::<M>(c, f)?;
@@ -561,17 +561,17 @@ pub unsafe fn do_step_with_master<M: Model>(c: Handle, f: Call, t: f64, h: f64) 
 /// false), after each accepted one it tells the time reached (`intermediateStepFinished`) and
 /// takes an early-return request (`canReturnEarly` with `earlyReturnAllowed`). Outputs are not
 /// offered (`intermediateVariableGetAllowed` false: no output has `intermediateUpdate="true"`).
-struct Callback<M: Model> {
+struct Callback<'a, M: Model> {
     c: Handle,
     f: Call,
     master: Master,
     /// The variable values at the step's start (the inputs the master did not require).
-    values: Values,
+    values: &'a Values,
     can_return_early: bool,
     model: PhantomData<M>,
 }
 
-impl<M: Model> Callback<M> {
+impl<M: Model> Callback<'_, M> {
     /// Calls the master in Intermediate Update Mode at `t`; returns its early-return request.
     fn call(&mut self, t: f64, set_requested: bool, finished: bool) -> Result<Option<f64>, String> {
         // SAFETY: each borrow ends before the callback runs, and the callback's own calls end
@@ -603,7 +603,7 @@ impl<M: Model> Callback<M> {
     }
 }
 
-impl<M: Model> Intermediate for Callback<M> {
+impl<M: Model> Intermediate for Callback<'_, M> {
     /// The master's values of the inputs it required, the step's start values of the others.
     fn inputs(&mut self, t: f64, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
         if !self.master.inputs.is_empty() {
@@ -611,7 +611,7 @@ impl<M: Model> Intermediate for Callback<M> {
         }
         let inst = unsafe { borrow::<M>(self.c, self.f) }?;
         for (&r, u) in vrs.iter().zip(out) {
-            let values = if self.master.inputs.contains(&r) { &inst.core.values } else { &self.values };
+            let values = if self.master.inputs.contains(&r) { &inst.core.values } else { self.values };
             *u = values.real(r);
         }
         Ok(())

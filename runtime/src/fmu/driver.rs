@@ -125,7 +125,7 @@ impl<M: Model> Driven<M> {
     /// within it ([`Model::step_event_indicators`], located on the integrator's continuous
     /// output): the state there has the indicators' new signs, so the next step starts past the
     /// event. With a `master` (FMI 3.0 intermediate update), the model's intermediate inputs
-    /// follow the values the master gives for the end of each attempted integrator step
+    /// take the values the master gives for the stage times of each attempted integrator step
     /// ([`Model::intermediate_inputs`]), and after each accepted step the master may ask the step
     /// to end at a time. Returns where the step ended, if not at `t + h`'s integration end: its
     /// time and whether it was at an event.

@@ -1010,26 +1010,24 @@ impl<M: Model> Begun<M> {
         master: Option<&mut dyn Intermediate>,
     ) -> Result<Option<Ended>, StepError> {
         let (_, h, start, end, tolerance) = self.span;
-        let slopes = self.bounded.as_deref().unwrap_or(input_derivatives);
-        match master {
-            // A model that steps in closed form takes each intermediate input linear over the
-            // step, to the master's value at its end: the slope the master would have passed to
-            // FMI 2.0 (over its communication step h).
-            Some(master) if M::CLOSED_FORM && !M::INTERMEDIATE_INPUTS.is_empty() => {
-                let vrs = M::INTERMEDIATE_INPUTS;
-                let mut at_end = vec![0.0; vrs.len()];
-                let mut slopes = slopes.to_vec();
-                if master.inputs(end, vrs, &mut at_end).is_ok() {
-                    for (&r, u) in vrs.iter().zip(at_end) {
-                        if let Some(i) = values.position(r) {
-                            slopes[i] = (u - values.real(r)) / h;
-                        }
+        let mut slopes = Cow::Borrowed(self.bounded.as_deref().unwrap_or(input_derivatives));
+        let mut master = master;
+        // A model that steps in closed form takes each intermediate input linear over the step,
+        // to the master's value at its end: the slope the master would have passed to FMI 2.0
+        // (over its communication step h).
+        let closed_form = M::CLOSED_FORM && !M::INTERMEDIATE_INPUTS.is_empty();
+        if let Some(m) = master.take_if(|_| closed_form) {
+            let vrs = M::INTERMEDIATE_INPUTS;
+            let mut at_end = vec![0.0; vrs.len()];
+            if m.inputs(end, vrs, &mut at_end).is_ok() {
+                for (&r, u) in vrs.iter().zip(at_end) {
+                    if let Some(i) = values.position(r) {
+                        slopes.to_mut()[i] = (u - values.real(r)) / h;
                     }
                 }
-                self.model.step(values, &slopes, (start, end - start, tolerance), log, self.early_return, None)
             }
-            master => self.model.step(values, slopes, (start, end - start, tolerance), log, self.early_return, master),
         }
+        self.model.step(values, &slopes, (start, end - start, tolerance), log, self.early_return, master)
     }
 }
 
