@@ -24,6 +24,19 @@
 //!   ([`STRUCTURAL_DAMPING`], not in the thesis) anchors beta instead at the arm's first bending
 //!   frequency omega_b ([`FlexibleBoom::bending_frequency`], 3.4 Hz for the rig), beta =
 //!   2 xi / omega_b: that mode gets xi whatever the sections, higher modes xi omega / omega_b.
+//!   `boom.damping` = 2 ([`MODAL_DAMPING`], not in the thesis) is modal damping: each mode of the
+//!   arm with the cylinder locked ([`FlexibleBoom::locked_modes`]) below the band of interest
+//!   ([`BAND`], 50 Hz: the first bending mode, 3.4 Hz) keeps the damping ratio the thesis' law
+//!   gives it, and every mode above it is damped at least critically ([`QUASI_STATIC`]): those
+//!   modes (70 Hz to 10 kHz at 4 + 5 sections) are the lumping's, their frequencies and the
+//!   thesis' damping of them move with n, and made non-oscillating they follow the slow motion
+//!   quasi-statically (with a lag of 2 / omega, under 5 ms), as a modal truncation with static
+//!   correction keeps them (Craig & Kurdila, Fundamentals of Structural Dynamics, 2nd ed., the
+//!   mode-acceleration method),
+//!   while the integrator no longer resolves their ringing after each stick of the cylinder.
+//!   The joints' dampers then form one symmetric matrix C (each joint's torque from every
+//!   joint's rate, [`FlexibleBoom::damper`]); the rigid turn about B has no deflection and no
+//!   damping, as under the thesis' law.
 //! - Masses: the arm is uniform (m_arm / l_arm per length), each section a slender rod. Its
 //!   inertia about its inner node, m l^2 / 3, is (2.39) and is what the equations use; part I adds
 //!   its mass and inertia to the first section; the payload is a point mass at (x2, h_pl) of
@@ -95,6 +108,19 @@ use crate::scalar::Scalar;
 /// `boom.damping` of the structural law: c = beta k with beta = 2 xi / omega_b (module doc).
 pub const STRUCTURAL_DAMPING: usize = 1;
 
+/// `boom.damping` of the modal law: the thesis' damping in the band of interest, the modes above
+/// it quasi-static (module doc).
+pub const MODAL_DAMPING: usize = 2;
+
+/// The modal law's band of interest (rad/s): 50 Hz, numerics issue 27's "the boom's dynamics of
+/// interest are below 50 Hz" (the rig's mode is 2.85 Hz, thesis 5.1.3; the feedback's filter
+/// corner is at most 168 rad/s = 27 Hz, section 6.1).
+pub const BAND: f64 = 50.0 * std::f64::consts::TAU;
+
+/// The modal law's least damping ratio above [`BAND`]: critical, the fastest decay without
+/// oscillation.
+pub const QUASI_STATIC: f64 = 1.0;
+
 /// Most sections the chain may have: max(n2, 1) + n3.
 pub const MAX_SECTIONS: usize = 32;
 
@@ -120,6 +146,10 @@ pub struct FlexibleBoom {
     /// Spring and damper of the joint between section i and i + 1.
     k: Column,
     c: Column,
+    /// The damping law (`boom.damping`) and, for the modal law, the joints' damping matrix
+    /// (rows of MAX_SECTIONS, the first n - 1 of each).
+    damping: usize,
+    modal: [f64; MAX_SECTIONS * MAX_SECTIONS],
     /// Upper cylinder pin, in the frame of the last section of part II.
     pin: Vector2<f64>,
     payload_section: usize,
@@ -220,6 +250,8 @@ impl FlexibleBoom {
             second: [0.0; MAX_SECTIONS],
             k: [0.0; MAX_SECTIONS],
             c: [0.0; MAX_SECTIONS],
+            damping: beam.damping,
+            modal: [0.0; MAX_SECTIONS * MAX_SECTIONS],
             pin: Vector2::zeros(),
             payload_section: 0,
             payload: Vector2::new(p.l_pl() - b7, p.h_pl),
@@ -271,6 +303,9 @@ impl FlexibleBoom {
                 boom.c[i] = beta * boom.k[i];
             }
         }
+        if beam.damping == MODAL_DAMPING {
+            boom.modal_damping()?;
+        }
         Ok(boom)
     }
 
@@ -312,13 +347,18 @@ impl FlexibleBoom {
         std::array::from_fn(|j| if j < self.n_ii { u.dot(&perp(self.lever(t, j))) } else { 0.0 })
     }
 
-    /// The arm's first bending frequency (rad/s): the lowest omega of K w = omega^2 M w,
-    /// undeformed and horizontal (q = 0), with the cylinder locked (g^T w = 0: the rotation
-    /// about B and the rod stand still), springs only: the gravity-loaded rest shape and
-    /// gravity's geometric stiffness are left out (together 0.03 % against the whole plant
-    /// linearised with a rigid oil column, `boomsim_tools`' test
+    /// The arm's first bending frequency (rad/s): the lowest of [`Self::locked_modes`]. The
+    /// gravity-loaded rest shape and gravity's geometric stiffness are left out (together 0.03 %
+    /// against the whole plant linearised with a rigid oil column, `boomsim_tools`' test
     /// `structural_damping_sits_at_the_arms_bending_mode`). `boom.damping` = 1 sets beta at it.
     pub fn bending_frequency(&self) -> Result<f64, MechanicsError> {
+        Ok(self.locked_modes()?.0.min().sqrt())
+    }
+
+    /// The arm's modes with the cylinder locked: omega^2 and the shapes w of K w = omega^2 M w,
+    /// undeformed and horizontal (q = 0), g^T w = 0 (the rotation about B and the rod stand
+    /// still), springs only; the shapes (columns, in q) normalised to w^T M w = 1.
+    fn locked_modes(&self) -> Result<(DVector<f64>, DMatrix<f64>), MechanicsError> {
         let n = self.n;
         let q = [0.0; MAX_SECTIONS];
         let g = DVector::from_column_slice(&self.cylinder_gradient(&self.trig(&q[..n]))[..n]);
@@ -337,8 +377,46 @@ impl FlexibleBoom {
         let (m, k) = (z.transpose() * self.mass_matrix(&q[..n]) * z, z.transpose() * k * z);
         let bad = MechanicsError::InvalidBeam("the arm's mass matrix is not positive definite");
         let l_inv = m.cholesky().ok_or(bad)?.l().try_inverse().ok_or(bad)?;
-        let lowest = (&l_inv * k * l_inv.transpose()).symmetric_eigen().eigenvalues.min();
-        Ok(lowest.sqrt())
+        let eigen = (&l_inv * k * l_inv.transpose()).symmetric_eigen();
+        Ok((eigen.eigenvalues, z * l_inv.transpose() * eigen.eigenvectors))
+    }
+
+    /// `boom.damping` = 2, the modal law (module doc): the joints' damping matrix C that gives
+    /// each locked mode j its own damping, psi_j^T C psi_j = 2 zeta_j omega_j and psi_i^T C psi_j
+    /// = 0, with psi_j the mode's joint deflections: the per-section law's own value below
+    /// [`BAND`], at least [`QUASI_STATIC`] above it. C = Psi^-T diag(2 zeta omega) Psi^-1 (Psi is
+    /// regular: the n - 1 deflections of a locked shape fix it, g^T w = 0 excluding the rigid
+    /// turn about B that has none).
+    fn modal_damping(&mut self) -> Result<(), MechanicsError> {
+        let m = self.n - 1;
+        let (omega2, shapes) = self.locked_modes()?;
+        let psi = DMatrix::from_fn(m, m, |i, j| shapes[(i + 1, j)] - shapes[(i, j)]);
+        let modal = DMatrix::from_fn(m, m, |i, j| {
+            let omega = omega2[j].sqrt();
+            let thesis = (0..m).map(|l| self.c[l] * psi[(l, j)].powi(2)).sum::<f64>();
+            match (i == j, omega < BAND) {
+                (false, _) => 0.0,
+                (true, true) => thesis,
+                (true, false) => thesis.max(2.0 * QUASI_STATIC * omega),
+            }
+        });
+        let inv = psi.try_inverse().ok_or(MechanicsError::InvalidBeam("the arm's locked modes are not independent"))?;
+        let c = inv.transpose() * modal * &inv;
+        for (i, row) in self.modal.chunks_exact_mut(MAX_SECTIONS).take(m).enumerate() {
+            row[..m].iter_mut().enumerate().for_each(|(j, c_ij)| *c_ij = c[(i, j)]);
+        }
+        Ok(())
+    }
+
+    /// Torque of the damper of joint i (between sections i and i + 1): its own rate's under the
+    /// per-section and structural laws (2.36-2.38), every joint's under the modal law.
+    fn damper<T: Scalar>(&self, qd: &[T], i: usize) -> T {
+        if self.damping == MODAL_DAMPING {
+            let row = &self.modal[i * MAX_SECTIONS..][..self.n - 1];
+            row.iter().enumerate().fold(T::from(0.0), |tau, (j, &c)| tau + (qd[j + 1] - qd[j]) * c)
+        } else {
+            (qd[i + 1] - qd[i]) * self.c[i]
+        }
     }
 
     /// The rigid boom of the same geometry (reference line of [`Self::tip_deflection`]).
@@ -402,7 +480,7 @@ impl FlexibleBoom {
             *o = -self.g * ((self.m_out[i] * self.len[i] + s.x) * t.c[i] - s.y * t.s[i]);
         }
         for i in 0..self.n - 1 {
-            let tau = self.k[i] * (q[i + 1] - q[i]) + self.c[i] * (qd[i + 1] - qd[i]);
+            let tau = self.k[i] * (q[i + 1] - q[i]) + self.damper(qd, i);
             out[i] += tau;
             out[i + 1] -= tau;
         }
@@ -549,7 +627,7 @@ impl<T: Scalar> Kinetics<T> for FlexibleBoom {
             let (sx, sy) = (c * f.x - s * f.y, s * f.x + c * f.y);
             let w2 = qd[j] * qd[j];
             let tau_in =
-                if j > 0 { (q[j] - q[j - 1]) * self.k[j - 1] + (qd[j] - qd[j - 1]) * self.c[j - 1] } else { zero };
+                if j > 0 { (q[j] - q[j - 1]) * self.k[j - 1] + self.damper(qd, j - 1) } else { zero };
             // K perp(r); d = J + perp(r)^T K perp(r) from the squares (off the K -> d path).
             let (kpx, kpy) = (kxy * x - kxx * y, kyy * x - kxy * y);
             let mut d = (y * y) * kxx + self.second[j] + ((x * x) * kyy - (x * 2.0 * y) * kxy);

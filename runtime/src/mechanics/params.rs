@@ -149,13 +149,16 @@ pub const BEAM_PARAMS: &[Param<BeamParams>] = &[
         "Sections of beam part II, joint B to the cylinder mount (0: rigid)", "section 3.1.2, experiment III"),
     param!(int "boom.n3", n3, 5.0, [1.0, 16.0],
         "Sections of beam part III, cylinder mount to the arm's end", "section 3.1.2, experiment II"),
-    param!(int "boom.damping", damping, 0.0, [0.0, 1.0],
+    param!(int "boom.damping", damping, 0.0, [0.0, 2.0],
         "Damping law of the arm's joints: 0 per section as the thesis (c = 2 xi sqrt(k J) of each section, its \
          modal damping falls with the number of sections), 1 structural (stiffness-proportional, c = beta k \
          with beta = 2 xi / omega_b: the damping ratio xi at the arm's first bending mode omega_b, whatever \
-         the sections)",
+         the sections), 2 modal (the arm's modes with the cylinder locked below 50 Hz keep the damping of \
+         law 0, those above it are damped critically: quasi-static)",
         "eq. 2.36-2.38; 1: not in the thesis, Rayleigh stiffness-proportional damping (Clough & Penzien, \
-         Dynamics of Structures, 3rd ed., sec. 12-5) anchored where [3, p. 97]'s 1-2 % for steel structures applies"),
+         Dynamics of Structures, 3rd ed., sec. 12-5) anchored where [3, p. 97]'s 1-2 % for steel structures \
+         applies; 2: not in the thesis, the damping matrix of modal damping ratios (ibid., same section) with \
+         the modes above the band quasi-static as in a modal truncation with static correction"),
 ];
 
 /// The cross-section and lumped-beam parameters as numbers (SI); names and ranges are in
