@@ -14,8 +14,8 @@ tolerance an ME user picks: HydraulicBoom alone (rigid, valve.u_ref = -0.3 from 
 through fmpy.simulate_fmu with CVode at rtol 1e-3 to 1e-7, against CS at rtol 1e-9; a fourth
 the same at rtol 1e-3 to 1e-5 with CVode's largest BDF order limited to 2 or 1, or its stability
 limit detection on (`--only orders`, 10 s), and a fifth with CVode on the boom's own states
-(7 rigid, 23 flexible) instead of the FMU's 69 padded slots (`--only layout`, 2 minutes). A
-benchmark: it prints, it asserts nothing. Run after `boomsim pack`; about 12 minutes on 2 cores
+(7 rigid, 23 flexible) instead of the FMU's 69 padded slots (`--only layout`, a second). A
+benchmark: it prints, it asserts nothing. Run after `boomsim pack`; under a minute on 2 cores
 (the flexible references take most of it).
 Usage: .venv/bin/python scripts/bench_interfaces.py [--rigid-only | --flexible-only] [--only TABLE]
        [--param NAME=VALUE ...]
@@ -222,7 +222,7 @@ def layout_rows() -> list:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     booms = ap.add_mutually_exclusive_group()
-    booms.add_argument("--rigid-only", action="store_true", help="skip the flexible boom (a minute instead of ten)")
+    booms.add_argument("--rigid-only", action="store_true", help="skip the flexible boom")
     booms.add_argument("--flexible-only", action="store_true", help="skip the rigid boom")
     ap.add_argument("--only", choices=("interfaces", "events", "tolerance", "orders", "layout"), help="one table")
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",

@@ -44,7 +44,7 @@ enum Cmd {
         duration: f64,
         /// Then Model Exchange (fmpy + CVode) against Co-Simulation on the same cases, with RHS
         /// counts and the error against an rtol 1e-9 reference (scripts/bench_interfaces.py
-        /// --only interfaces, 7 to 10 minutes; needs the venv of scripts/setup and `boomsim pack`).
+        /// --only interfaces, under a minute; needs the venv of scripts/setup and `boomsim pack`).
         #[arg(long)]
         model_exchange: bool,
         /// Instead: the distribution of one doStep's wall time, thread CPU time and RHS

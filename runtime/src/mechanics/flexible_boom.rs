@@ -24,7 +24,7 @@
 //!   ([`STRUCTURAL_DAMPING`], not in the thesis) anchors beta instead at the arm's first bending
 //!   frequency omega_b ([`FlexibleBoom::bending_frequency`], 3.4 Hz for the rig), beta =
 //!   2 xi / omega_b: that mode gets xi whatever the sections, higher modes xi omega / omega_b.
-//!   `boom.damping` = 2 ([`MODAL_DAMPING`], not in the thesis) is modal damping: each mode of the
+//!   `boom.damping` = 2 ([`MODAL_DAMPING`], not in the thesis; the default) is modal damping: each mode of the
 //!   arm with the cylinder locked ([`FlexibleBoom::locked_modes`]) below the band of interest
 //!   ([`BAND`], 50 Hz: the first bending mode, 3.4 Hz) keeps the damping ratio the thesis' law
 //!   gives it, and every mode above it is damped at least critically ([`QUASI_STATIC`]): those
@@ -759,7 +759,8 @@ mod tests {
     fn tip_load_matches_cantilever_formula() {
         let p = BoomParams { m_arm: 0.0, m_pl: 1.0, x_pl_inboard: 0.0, h_pl: 0.0, ..BoomParams::default() };
         for n in [1, 2, 5, 15] {
-            let beam = BeamParams { n2: 0, n3: n, ..BeamParams::default() };
+            // The thesis' damping law: the modal law's modes need the arm's mass (statics ignore damping).
+            let beam = BeamParams { n2: 0, n3: n, damping: 0, ..BeamParams::default() };
             let boom = build(&p, &beam);
             let l_cyl = horizontal(&boom);
             let q = boom.equilibrium_at(l_cyl).unwrap().q;
@@ -850,7 +851,8 @@ mod tests {
     #[test]
     fn energy_is_conserved_without_damping() {
         let p = BoomParams::default();
-        let boom = build(&p, &BeamParams { xi: 0.0, ..BeamParams::default() });
+        // xi = 0 under the thesis' law: no damper at all (the modal law damps the high modes whatever xi).
+        let boom = build(&p, &BeamParams { xi: 0.0, damping: 0, ..BeamParams::default() });
         let n = boom.sections();
         let f_rest = boom.equilibrium_at(0.93).unwrap().f_cyl;
         let force = |t: f64| f_rest + 3000.0 * (2.0 * std::f64::consts::PI * t / 0.02).sin();

@@ -223,6 +223,9 @@ mod tests {
         ("line.c_hose", Value::Real(0.0)),
     ];
 
+    /// The thesis' per-section damping law (eq. 2.36-2.38; the default is the modal law).
+    const THESIS_DAMPING: (&str, Value) = ("boom.damping", Value::Integer(0));
+
     /// The default arm with n2 + n3 sections (the stroke only has to be valid: the arm's
     /// matrices do not depend on it).
     fn arm(n2: usize, n3: usize) -> FlexibleBoom {
@@ -293,10 +296,8 @@ mod tests {
     #[test]
     fn per_section_damping_falls_with_the_lumping() {
         let second = |n2: i32, n3: i32| {
-            let (_, modes) =
-                hydraulic_boom_modes(true, None, &[("boom.n2", Value::Integer(n2)), ("boom.n3", Value::Integer(n3))])
-                    .unwrap();
-            modes[1]
+            let sections = [("boom.n2", Value::Integer(n2)), ("boom.n3", Value::Integer(n3)), THESIS_DAMPING];
+            hydraulic_boom_modes(true, None, &sections).unwrap().1[1]
         };
         // The law itself predicts the trend: for equal sections it is c = beta k with beta =
         // 2 xi / omega_sec, omega_sec ~ 1 / l^2, so a mode of fixed shape has zeta ~ l^2; making
