@@ -11,6 +11,10 @@ from .result import COLUMNS, PLANT_OUT, Result
 from .scenarios import controller_start, reference
 
 
+#: fmi2Discard, fmi3Discard.
+DISCARD = 2
+
+
 class Integrator:
     """fmpy's CVode (BDF, dense Newton with difference-quotient Jacobian, rtol `tolerance`, atol =
     rtol x the nominals) over an ODE given by its callbacks from t = 0, stepped to output points;
@@ -18,7 +22,21 @@ class Integrator:
 
     def __init__(self, nx: int, nz: int, tolerance: float, get_x, set_x, get_dx, get_z, get_nominals, set_time,
                  on_event):
+        from fmpy.fmi1 import FMICallException
         from fmpy.sundials import CVodeSolver
+
+        class Solver(CVodeSolver):
+            def f(self, t, y, ydot, user_data):
+                """fmpy's right-hand side, with an FMU's Discard (states outside its domain, FMI 2.0
+                2.1.3: retry with a smaller step) passed to CVode as a recoverable failure, which
+                it answers with a smaller step, instead of fmpy's default: the exception lost in
+                the callback and the derivatives left as they were."""
+                try:
+                    return super().f(t, y, ydot, user_data)
+                except FMICallException as e:
+                    if e.status != DISCARD:
+                        raise
+                    return 1
 
         class NoInput:
             def apply(self, t):
@@ -31,9 +49,9 @@ class Integrator:
             set_time(t)
 
         self.set_time, self.on_event = at, on_event
-        self.solver = CVodeSolver(nx=nx, nz=nz, get_x=get_x, set_x=set_x, get_dx=get_dx, get_z=get_z,
-                                  get_nominals=get_nominals, set_time=at, input=NoInput(), startTime=0.0,
-                                  relativeTolerance=tolerance, maxNumSteps=100000)
+        self.solver = Solver(nx=nx, nz=nz, get_x=get_x, set_x=set_x, get_dx=get_dx, get_z=get_z,
+                             get_nominals=get_nominals, set_time=at, input=NoInput(), startTime=0.0,
+                             relativeTolerance=tolerance, maxNumSteps=100000)
 
     def advance(self, t: float) -> None:
         """Integrates to `t` through the state events on the way."""

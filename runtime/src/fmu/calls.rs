@@ -684,10 +684,18 @@ pub unsafe fn set_time<M: Model>(c: Handle, f: Call, time: f64) -> Status {
     })
 }
 
+/// The continuous states; Discard, the states kept, where they are outside the model's domain
+/// ([`Model::outside_domain`]).
 pub unsafe fn set_continuous_states<M: Model>(c: Handle, f: Call, x: *const f64, nx: usize) -> Status {
     call::<M>(c, f, |inst| {
         Instance::<M>::check_states(nx)?;
-        inst.set_continuous_states(slice(x, nx, states::<M>(), "x")?)?;
+        let x = slice(x, nx, states::<M>(), "x")?;
+        if let Some(why) = x.iter().all(|v| v.is_finite()).then(|| M::outside_domain(x)).flatten() {
+            let said = format!("{}: {why}; the states are kept (retry with a smaller step)", f.function);
+            inst.log.status(Status::Discard, &said);
+            return Ok(Status::Discard);
+        }
+        inst.set_continuous_states(x)?;
         Ok(Status::OK)
     })
 }

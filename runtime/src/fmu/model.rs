@@ -156,6 +156,17 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// the model's domain, naming the state, its value and its valid range.
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
 
+    /// Why the equations do not hold at the continuous states `x` ([`Model::STATES`] order, all
+    /// finite), naming the state, its value and its bound, or None. fmi2SetContinuousStates and
+    /// fmi3SetContinuousStates then return Discard and keep the states they had: FMI 2.0, 2.1.3
+    /// (fmi2Discard in Model Exchange: "a function is outside of its domain", the integrator
+    /// retries with a smaller step), FMI 3.0, 3.2.1 (fmi3Discard "if the FMU rejects any of the
+    /// state values"). An integrator's trial states can leave the domain; accepted ones then do
+    /// not.
+    fn outside_domain(_x: &[f64]) -> Option<String> {
+        None
+    }
+
     /// Writes the states' time derivatives at the current states with the inputs of `values`.
     /// A non-finite value tells the importer to retry with a smaller step (fmi2Discard).
     fn derivatives(&self, values: &Values, dx: &mut [f64]);

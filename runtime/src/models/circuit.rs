@@ -3,9 +3,11 @@
 
 use super::table::param_value;
 use super::vr;
+use crate::fmu::log::num;
 use crate::fmu::Values;
 use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
 use crate::scalar::Scalar;
+use crate::units::P_ATM;
 
 /// The circuit from the parameter values at [`vr::hydraulic`]; refuses inconsistent combinations.
 pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
@@ -74,6 +76,23 @@ pub(crate) const LOG_CATEGORIES: &[(&str, &str)] = &[
 
 /// The circuit's event indicator variables, in the order of [`event_indicators`].
 pub(crate) const EVENT_INDICATORS: &[u32] = &[vr::EVENT_U_REF, vr::EVENT_DEAD_BAND_UPPER, vr::EVENT_DEAD_BAND_LOWER];
+
+/// The pressure states below absolute zero (`-P_ATM` gauge), which no oil or air can have (the
+/// bulk-modulus law holds the pressures above it, [`crate::hydraulics::line`]; only an
+/// integrator's trial state reaches below): the first, named with its value and bound, for
+/// [`crate::fmu::Model::outside_domain`]. `c` starts with the circuit's states p2, p3, p4.
+pub(crate) fn below_absolute_zero(c: &[f64]) -> Option<String> {
+    [("p2", circuit::P2), ("p3", circuit::P3), ("p4", circuit::P4)].iter().find(|&&(_, k)| c[k] < -P_ATM).map(
+        |&(name, k)| {
+            format!(
+                "{name} = {} Pa is below absolute zero, -{} Pa gauge (valid: {name} >= -{} Pa)",
+                num(c[k]),
+                P_ATM,
+                P_ATM
+            )
+        },
+    )
+}
 
 /// The circuit's event indicators at spool position `x_v` and reference `u_ref`: the places
 /// where its right-hand side jumps. `u_ref`: the spool demand jumps between -x_db and +x_db
