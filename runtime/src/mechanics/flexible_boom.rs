@@ -24,19 +24,18 @@
 //!   ([`STRUCTURAL_DAMPING`], not in the thesis) anchors beta instead at the arm's first bending
 //!   frequency omega_b ([`FlexibleBoom::bending_frequency`], 3.4 Hz for the rig), beta =
 //!   2 xi / omega_b: that mode gets xi whatever the sections, higher modes xi omega / omega_b.
-//!   `boom.damping` = 2 ([`MODAL_DAMPING`], not in the thesis; the default) is modal damping: each mode of the
-//!   arm with the cylinder locked ([`FlexibleBoom::locked_modes`]) below the band of interest
-//!   ([`BAND`], 50 Hz: the first bending mode, 3.4 Hz) keeps the damping ratio the thesis' law
-//!   gives it, and every mode above it is damped at least critically ([`QUASI_STATIC`]): those
-//!   modes (70 Hz to 10 kHz at 4 + 5 sections) are the lumping's, their frequencies and the
-//!   thesis' damping of them move with n, and made non-oscillating they follow the slow motion
-//!   quasi-statically (with a lag of 2 / omega, under 5 ms), as a modal truncation with static
-//!   correction keeps them (Craig & Kurdila, Fundamentals of Structural Dynamics, 2nd ed., the
-//!   mode-acceleration method),
-//!   while the integrator no longer resolves their ringing after each stick of the cylinder.
-//!   The joints' dampers then form one symmetric matrix C (each joint's torque from every
-//!   joint's rate, [`FlexibleBoom::damper`]); the rigid turn about B has no deflection and no
-//!   damping, as under the thesis' law.
+//!   `boom.damping` = 2 ([`MODAL_DAMPING`], not in the thesis; the default) is modal damping:
+//!   each mode of the arm with the cylinder locked ([`FlexibleBoom::locked_modes`]) below the
+//!   band of interest ([`BAND`], 50 Hz: the first bending mode, 3.4 Hz) keeps the damping ratio
+//!   the thesis' law gives it, and every mode above it is damped at least critically
+//!   ([`QUASI_STATIC`]). Those modes (70 Hz to 10 kHz at 4 + 5 sections) are the lumping's:
+//!   their frequencies and the thesis' damping of them move with n. Made non-oscillating, they
+//!   follow the slow motion quasi-statically (with a lag of 2 / omega, under 5 ms), as a modal
+//!   truncation with static correction keeps them (Craig & Kurdila, Fundamentals of Structural
+//!   Dynamics, 2nd ed., the mode-acceleration method), and the integrator no longer resolves
+//!   their ringing after each stick of the cylinder. The joints' dampers then form one
+//!   symmetric matrix C (each joint's torque from every joint's rate, [`FlexibleBoom::damper`]);
+//!   the rigid turn about B has no deflection and no damping, as under the thesis' law.
 //! - Masses: the arm is uniform (m_arm / l_arm per length), each section a slender rod. Its
 //!   inertia about its inner node, m l^2 / 3, is (2.39) and is what the equations use; part I adds
 //!   its mass and inertia to the first section; the payload is a point mass at (x2, h_pl) of
