@@ -203,7 +203,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
         mode: state,
         values,
         input_derivatives,
-        model,
+        model: model.map(Box::new),
         time,
         start_time,
         stop_time,
