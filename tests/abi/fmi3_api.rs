@@ -820,7 +820,7 @@ fn fmi3_states_below_absolute_zero_are_discarded() {
         assert_eq!(api::enter_continuous_time_mode::<HydraulicBoom>(i.c), OK);
         assert_eq!(api::get_continuous_states::<HydraulicBoom>(i.c, x.as_mut_ptr(), n), OK);
         let mut trial = x.clone();
-        trial[1] = -2e5; // p3
+        trial[boomsim::hydraulics::circuit::P3] = -2e5;
         assert_eq!(api::set_continuous_states::<HydraulicBoom>(i.c, trial.as_ptr(), n), fmi3Status::Discard);
         let said = i.messages.lock().unwrap().last().cloned().expect("a message");
         assert_eq!(said.0, fmi3Status::Discard);

@@ -7,7 +7,7 @@ use crate::common;
 use boomsim::fmi2::api;
 use boomsim::fmi2::types::*;
 use boomsim::fmu::Model;
-use boomsim::hydraulics::circuit::{N_STATES as C, X_V};
+use boomsim::hydraulics::circuit::{N_STATES as C, P4, X_V};
 use boomsim::models::pressure_feedback_controller::vr as pfc;
 use boomsim::models::{vr, BoomMechanics, HydraulicBoom, HydraulicCircuit, PressureFeedbackController as Pfc};
 use crate::common::Slave;
@@ -396,7 +396,7 @@ fn states_below_absolute_zero_are_discarded_and_the_old_ones_kept() {
             assert_eq!(api::get_continuous_states::<M>(s.c, x.as_mut_ptr(), n), OK);
             assert_eq!(api::get_derivatives::<M>(s.c, dx.as_mut_ptr(), n), OK);
             let mut trial = x.clone();
-            trial[2] = -101325.0 - 500.0; // p4, 5 mbar below absolute zero
+            trial[P4] = -101325.0 - 500.0; // 5 mbar below absolute zero
             let status = api::set_continuous_states::<M>(s.c, trial.as_ptr(), n);
             assert_eq!(status, fmi2Status::Discard, "{}", M::INFO.identifier);
             let said = s.messages.lock().unwrap().last().cloned().expect("a message");
@@ -409,7 +409,7 @@ fn states_below_absolute_zero_are_discarded_and_the_old_ones_kept() {
             assert_eq!(kept, x, "{}: the states it had", M::INFO.identifier);
             assert_eq!(api::get_derivatives::<M>(s.c, again.as_mut_ptr(), n), OK);
             assert_eq!(again, dx);
-            trial[2] = -101325.0;
+            trial[P4] = -101325.0;
             assert_eq!(api::set_continuous_states::<M>(s.c, trial.as_ptr(), n), OK, "{}", s.last_error());
         }
     }

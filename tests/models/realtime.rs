@@ -43,8 +43,8 @@ fn rhs_per_step(p: &mut InProcess<HydraulicBoom>, n: usize) -> Vec<u64> {
 /// budget binds (closing steps with an accuracy loss), so the bound is tested where it matters.
 #[test]
 fn a_real_time_do_step_never_exceeds_its_budget() {
-    let (damping, _) = boomsim_tools::analysis::modes::parameter_change("boom.damping=0").unwrap();
-    let thesis = [(damping.vr, Value::Integer(0))];
+    let (damping, law) = boomsim_tools::analysis::modes::parameter_change("boom.damping=0").unwrap();
+    let thesis = [(damping.vr, law)];
     let adaptive = rhs_per_step(&mut plant_with(true, 0, 400, &thesis), 3000);
     assert!(adaptive.iter().any(|&r| r > 400), "adaptive U needs more than the budget somewhere");
     for budget in [100, 400] {

@@ -390,15 +390,12 @@ impl FlexibleBoom {
         let m = self.n - 1;
         let (omega2, shapes) = self.locked_modes()?;
         let psi = DMatrix::from_fn(m, m, |i, j| shapes[(i + 1, j)] - shapes[(i, j)]);
-        let modal = DMatrix::from_fn(m, m, |i, j| {
+        let modal = DVector::from_fn(m, |j, _| {
             let omega = omega2[j].sqrt();
             let thesis = (0..m).map(|l| self.c[l] * psi[(l, j)].powi(2)).sum::<f64>();
-            match (i == j, omega < BAND) {
-                (false, _) => 0.0,
-                (true, true) => thesis,
-                (true, false) => thesis.max(2.0 * QUASI_STATIC * omega),
-            }
+            if omega < BAND { thesis } else { thesis.max(2.0 * QUASI_STATIC * omega) }
         });
+        let modal = DMatrix::from_diagonal(&modal);
         let inv = psi.try_inverse().ok_or(MechanicsError::InvalidBeam("the arm's locked modes are not independent"))?;
         let c = inv.transpose() * modal * &inv;
         for (i, row) in self.modal.chunks_exact_mut(MAX_SECTIONS).take(m).enumerate() {

@@ -223,6 +223,13 @@ mod tests {
         ("line.c_hose", Value::Real(0.0)),
     ];
 
+    /// The modes of the plant with [`STIFF_OIL`] under the damping law `law` (`boom.damping`).
+    fn stiff_modes(law: i32) -> Vec<Mode> {
+        let mut changes = STIFF_OIL.to_vec();
+        changes.push(("boom.damping", Value::Integer(law)));
+        hydraulic_boom_modes(true, None, &changes).unwrap().1
+    }
+
     /// The thesis' per-section damping law (eq. 2.36-2.38; the default is the modal law).
     const THESIS_DAMPING: (&str, Value) = ("boom.damping", Value::Integer(0));
 
@@ -248,10 +255,7 @@ mod tests {
         let note = model_note("- **Flexible arm");
         assert!(note.contains(&format!("cylinder locked ({f_b:.1} Hz,")), "docs/models.md's note states {f_b:.1} Hz");
         for damping in [0, 1] {
-            let mut changes = STIFF_OIL.to_vec();
-            changes.push(("boom.damping", Value::Integer(damping)));
-            let (_, modes) = hydraulic_boom_modes(true, None, &changes).unwrap();
-            let lowest = modes[0];
+            let lowest = stiff_modes(damping)[0];
             assert!((lowest.frequency_hz / f_b - 1.0).abs() < 5e-3, "damping {damping}: {lowest:?} against {f_b} Hz");
             if damping == 0 {
                 assert!(lowest.damping_ratio.abs() < 0.02 / 100.0, "{lowest:?}");
@@ -271,12 +275,7 @@ mod tests {
     /// arm; 0.95 covers the plant's gravity-loaded rest shape and the oil's remaining compliance).
     #[test]
     fn modal_damping_keeps_the_band_and_settles_the_rest() {
-        let modes_of = |law: i32| {
-            let mut changes = STIFF_OIL.to_vec();
-            changes.push(("boom.damping", Value::Integer(law)));
-            hydraulic_boom_modes(true, None, &changes).unwrap().1
-        };
-        let (thesis, modal) = (modes_of(0), modes_of(2));
+        let (thesis, modal) = (stiff_modes(0), stiff_modes(2));
         let band = boomsim::mechanics::flexible_boom::BAND / std::f64::consts::TAU;
         assert!(thesis[0].frequency_hz < band && thesis[1].frequency_hz > band, "{thesis:?}");
         assert!((modal[0].frequency_hz / thesis[0].frequency_hz - 1.0).abs() < 1e-6, "{modal:?}");
