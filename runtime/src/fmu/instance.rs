@@ -560,7 +560,20 @@ impl<M: Model> Instance<M> {
             if clock_active::<M>(&c.values) {
                 model.evaluate_partition(&c.values);
             }
+            // Every Real the importer can read is finite after a good step, or the instance
+            // is in error.
+            c.values.take_non_finite();
             write_outputs(model, &mut c.values);
+            if let Some(i) = c.values.take_non_finite() {
+                c.mode = Mode::Error;
+                let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
+                return Err(format!(
+                    "{} = {} at t = {}: the model left its valid range",
+                    M::VARIABLES[i].name,
+                    num(x),
+                    num(c.time)
+                ));
+            }
         }
         c.outputs_current = true;
         c.derivatives_current = false;
@@ -970,22 +983,9 @@ impl<M: Model> Instance<M> {
             let why = if event { "an event indicator changed sign" } else { "the master asked" };
             self.log.info("logEvents", &format!("{why}: the step ended at t = {}", num(t)));
         }
-        // Every Real the importer can read is finite after a good step, or the step is an error.
-        c.values.take_non_finite();
-        write_outputs(&model, &mut c.values);
+        // The outputs are written when the master first reads one (refresh_outputs): a master
+        // that reads few of them, or none, between steps pays for none.
         c.model = Some(model);
-        c.outputs_current = true;
-        c.derivatives_current = false;
-        if let Some(i) = c.values.take_non_finite() {
-            c.mode = Mode::Error;
-            let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
-            return Err(format!(
-                "{} = {} at t = {}: the model left its valid range",
-                M::VARIABLES[i].name,
-                num(x),
-                num(end)
-            ));
-        }
         Ok(Step::Done(warning))
     }
 }
