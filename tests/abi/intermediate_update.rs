@@ -19,9 +19,12 @@ const ERR: fmi3Status = fmi3Status::Error;
 /// The communication step.
 const H: f64 = 0.01;
 
-/// The operator's command: from 0 to -0.3 over 0.2 s, then held (a kink on the grid).
+/// The operator's command: from 0 to -0.3 over 0.2 s, then more slowly on to -0.5 at 0.5 s (a
+/// kink on the grid). Never held: under a held input the FMI 2.0 instance integrates past its
+/// communication points (`Model::LOOKAHEAD`), which an FMI 3.0 master's callback rules out, and
+/// the two runs would differ by the integration error.
 fn command(t: f64) -> f64 {
-    -0.3 * (t / 0.2).min(1.0)
+    -0.3 * (t / 0.2).min(1.0) - 0.2 * ((t - 0.2) / 0.3).max(0.0)
 }
 
 /// What the master's callback does besides passing the ramp of its step.

@@ -10,5 +10,6 @@ mod fmi2_api;
 mod fmi3_api;
 mod hardening;
 mod intermediate_update;
+mod lookahead;
 mod misuse;
 mod model_exchange;

@@ -58,9 +58,9 @@ fn a_real_time_do_step_never_exceeds_its_budget() {
 
 /// The load held at rest by the closed CBV (spool closed) is an equilibrium of the model, so the
 /// real-time mode must leave it there: 2 s later the stroke is start.x (480 mm, to 1 nm) and
-/// p3 its start value (to 1 Pa), with no closing step beyond the tolerance, for both booms; and
-/// with the default budget, which suffices for every doStep at rest, it is the adaptive result
-/// bit for bit (the steps are the adaptive ones).
+/// p3 its start value (to 1 Pa), with no closing step beyond the tolerance, for both booms, as
+/// the adaptive mode does (which at rest steps past the communication points,
+/// `Model::LOOKAHEAD`; the real-time mode ends each doStep's integration at its end).
 #[test]
 fn real_time_holds_the_load_at_rest() {
     for flexible in [false, true] {
@@ -70,13 +70,12 @@ fn real_time_holds_the_load_at_rest() {
             rt.step(k as f64 * STEP, STEP).unwrap();
             ad.step(k as f64 * STEP, STEP).unwrap();
         }
-        let (x, p3_end) = (rt.get(hb::X).unwrap(), rt.get(hb::P3).unwrap());
-        assert!((x - 0.48).abs() < 1e-9, "flexible {flexible}: stroke {x}");
-        assert!((p3_end - p3).abs() < 1.0, "flexible {flexible}: p3 {p3} -> {p3_end} Pa");
-        assert_eq!(rt.get(hb::INACCURATE_STEPS).unwrap(), 0.0);
-        for r in [hb::X, hb::P1, hb::P3, hb::P4, hb::SOLVER_RHS] {
-            assert_eq!(rt.get(r).unwrap().to_bits(), ad.get(r).unwrap().to_bits(), "vr {r}, flexible {flexible}");
+        for p in [&mut rt, &mut ad] {
+            let (x, p3_end) = (p.get(hb::X).unwrap(), p.get(hb::P3).unwrap());
+            assert!((x - 0.48).abs() < 1e-9, "flexible {flexible}: stroke {x}");
+            assert!((p3_end - p3).abs() < 1.0, "flexible {flexible}: p3 {p3} -> {p3_end} Pa");
         }
+        assert_eq!(rt.get(hb::INACCURATE_STEPS).unwrap(), 0.0);
     }
 }
 

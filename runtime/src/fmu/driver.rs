@@ -1,6 +1,8 @@
 //! The Co-Simulation driver: one for every model. A model states its ODE and state
 //! ([`Model::begin_step`]); the driver integrates it over the communication step with the stiff
-//! Radau IIA of [`crate::solver`] (adaptive, or real-time with a bounded cost per step), then
+//! Radau IIA of [`crate::solver`] (adaptive, or real-time with a bounded cost per step; for a
+//! model whose ODE depends on nothing but its inputs, [`Model::LOOKAHEAD`], the adaptive
+//! integrator's last step may pass the communication point while no input changes), then
 //! lets the model act at the communication point ([`Model::communication_point`]: the TLM wave),
 //! writes the integrator's counters as outputs, and saves and restores the integrator with the
 //! model in FMU states. No model owns a solver.
@@ -136,7 +138,7 @@ impl<M: Model> Driven<M> {
         input_derivatives: &[f64],
         (t, h, tolerance): (f64, f64, f64),
         log: &mut dyn Log,
-        early_return: bool,
+        (early_return, reach): (bool, Option<f64>),
         master: Option<&mut dyn Intermediate>,
     ) -> Result<Option<Ended>, StepError> {
         let fail = |time, message: String| StepError { time, message };
@@ -151,7 +153,8 @@ impl<M: Model> Driven<M> {
                     (values.integer(vr::SOLVER_MODE) == REALTIME).then(|| values.integer(vr::RHS_BUDGET) as u64);
                 let roots = early_return.then(|| Roots::<M>::new(ode, t, state, &mut self.work));
                 let mut watch = Watched::<M> { ode, roots, master, ended: None, requested: None };
-                let reached = solver.integrate_until(&mut watch, (t, t + h), state, budget);
+                let reach = reach.filter(|_| M::LOOKAHEAD && budget.is_none());
+                let reached = solver.integrate_until(&mut watch, (t, t + h), state, budget, reach);
                 let end = reached.map_err(|e| fail(e.t, e.to_string()))?;
                 log_step(log, end, &before, solver.stats());
                 (end, watch.ended)
@@ -160,6 +163,14 @@ impl<M: Model> Driven<M> {
         };
         self.model.communication_point(end);
         Ok(ended)
+    }
+
+    /// An input or parameter changed between steps: the next step starts from the state at its
+    /// start (not from a step of the integrator's that passed it).
+    pub fn inputs_changed(&mut self) {
+        if let Some(solver) = self.solver.as_mut() {
+            solver.inputs_changed();
+        }
     }
 
     /// Writes the model's outputs and locals, and the integrator's counters.

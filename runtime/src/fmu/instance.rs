@@ -134,6 +134,14 @@ fn next_activation<M: Model>(start: f64, t: f64) -> Option<f64> {
     Some(first + i * interval)
 }
 
+/// Whether two values are the same bit for bit (0.0 and -0.0 differ: a model may tell them apart).
+fn same(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Real(x), Value::Real(y)) => x.to_bits() == y.to_bits(),
+        _ => a == b,
+    }
+}
+
 /// Whether the model's Clock is active.
 fn clock_active<M: Model>(values: &Values) -> bool {
     clock_row::<M>().is_some_and(|i| *values.at(i) == Value::Clock(true))
@@ -695,7 +703,9 @@ impl<M: Model> Instance<M> {
         let tunes = matches!(self.core.mode, Mode::StepComplete | Mode::EventMode)
             && checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
         let before = tunes.then(|| self.core.values.clone());
+        let mut changed = false;
         for (i, value) in checked {
+            changed |= !same(self.core.values.at(i), &value);
             self.core.values.put(i, value);
         }
         if let Some(before) = before {
@@ -705,8 +715,13 @@ impl<M: Model> Instance<M> {
                 return Err(e);
             }
         }
-        if let (Mode::StepComplete, Some(model)) = (self.core.mode, self.core.model.as_mut()) {
-            model.inputs_set(vrs);
+        if let Some(model) = self.core.model.as_mut() {
+            if self.core.mode == Mode::StepComplete {
+                model.inputs_set(vrs);
+            }
+            if changed {
+                model.inputs_changed();
+            }
         }
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
@@ -921,6 +936,7 @@ impl<M: Model> Instance<M> {
             warning,
             span: (t, h, start, end, tolerance),
             early_return: self.early_return_allowed && !M::EVENT_INDICATORS.is_empty(),
+            reach: c.stop_time.unwrap_or(f64::INFINITY),
         })
     }
 
@@ -1000,6 +1016,8 @@ pub struct Begun<M: Model> {
     /// The master's t and h, the instance's start and end time, the tolerance.
     span: (f64, f64, f64, f64, f64),
     early_return: bool,
+    /// How far the integrator may step past the step's end (the stop time).
+    reach: f64,
 }
 
 impl<M: Model> Begun<M> {
@@ -1029,7 +1047,11 @@ impl<M: Model> Begun<M> {
                 }
             }
         }
-        self.model.step(values, &slopes, (start, end - start, tolerance), log, self.early_return, master)
+        // Past the step's end only where nothing within the step asks for its time: no event
+        // search, no master's intermediate inputs, no input ramp (a ramp's next slope is the
+        // master's).
+        let reach = (!self.early_return && master.is_none() && slopes.iter().all(|&d| d == 0.0)).then_some(self.reach);
+        self.model.step(values, &slopes, (start, end - start, tolerance), log, (self.early_return, reach), master)
     }
 }
 

@@ -201,6 +201,13 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// at the current time. Default: nothing to do.
     fn inputs_set(&mut self, _vrs: &[u32]) {}
 
+    /// Whether the ODE of a step depends on nothing but the values at its start (no action at
+    /// the communication point, no Clock). The driver may then integrate past the step's end,
+    /// give the state there from the integrator's collocation polynomial, and continue from the
+    /// step that passed it in the next doStep while no input changes: steps as long as the
+    /// tolerance allows, not cut at each communication point. Default: no.
+    const LOOKAHEAD: bool = false;
+
     /// The loosest relative tolerance a BDF integrator (CVode, DASSL) needs for the model in Model
     /// Exchange, as measured; an importer that sets a looser one gets a warning naming this one.
     /// Default: none (any tolerance).

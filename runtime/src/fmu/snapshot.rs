@@ -19,7 +19,7 @@ use super::variables::{Causality, Value, Values, Variable};
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 /// Serialises a core into the checked byte format.
 pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {

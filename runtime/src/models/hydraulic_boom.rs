@@ -298,6 +298,8 @@ impl Model for HydraulicBoom {
 
     const INTERMEDIATE_INPUTS: &'static [u32] = &[vr::U_REF];
 
+    const LOOKAHEAD: bool = true;
+
     fn intermediate_inputs(plant: &mut Plant, t: f64, samples: &[(f64, &[f64]); 3]) {
         plant.u_ref = plant.u_ref.through(t, samples.map(|(ts, u)| (ts, u[0])));
     }

@@ -38,21 +38,28 @@
 //! whose size equals theirs up to rounding (`|h - h_lu| ≤ 1e-9·h_lu`), e.g. the step cut to land
 //! on `t_end` or the first step of the next call when both are one communication step long.
 //!
-//! **Communication points.** Steps never pass `t_end`; if the wanted step reaches `t_end` it is
-//! cut to land exactly, if it covers more than half the rest, the rest is split into two equal
-//! steps. Each `integrate` call starts with the carried step-size hint and, as between steps, the
-//! Jacobian of the previous call unless the last Newton contraction asked for a new one: it is
-//! only the iteration matrix, so a stale one (inputs changed) costs iterations, never accuracy,
-//! and a Newton failure recomputes it; its LU factors are kept too if the first step has their
-//! step size. A call *continues* the previous integration if it starts at the time and (bit for
-//! bit) at the state where the last accepted step ended, as an FMU's successive doStep calls do:
-//! then its first step is an ordinary step (starting values extrapolated from the last
-//! collocation polynomial, a rejection reduces `h` by the controller). A changed input only
-//! makes that starting value less accurate, which costs Newton iterations, never accuracy.
-//! Hint, contraction, Jacobian, the step size of the LU factors and the last step (size, end
-//! time, collocation polynomial, end state) are the persistent state ([`Radau5::save_state`]);
-//! the LU factors are recomputed from them on loading, so a restored integrator continues
-//! bit-identically.
+//! **Communication points.** Steps never pass `t_end`; if the wanted step reaches `t_end` it is cut
+//! to land exactly, if it covers more than half the rest, the rest is split into two equal steps.
+//! Unless the call has a *reach* beyond `t_end` ([`Radau5::integrate_until`]): then steps are
+//! planned towards the reach, the first accepted step that passes `t_end` ends the call, and the
+//! state at `t_end` comes from that step's collocation polynomial (the continuous output of order
+//! 3, Hairer & Wanner IV.8, eq. 8.12, the one the event search uses). A later call with a reach
+//! that starts on that polynomial (bit for bit: the state this call returned) continues from the
+//! step's end, or, if the step covers its end too, only evaluates the polynomial there; any other
+//! call starts from its own state. After [`Radau5::inputs_changed`] the next call has no reach: the
+//! step past `t_end` was taken with the old inputs. Each `integrate` call starts with the carried
+//! step-size hint and, as between steps, the Jacobian of the previous call unless the last Newton
+//! contraction asked for a new one: it is only the iteration matrix, so a stale one (inputs
+//! changed) costs iterations, never accuracy, and a Newton failure recomputes it; its LU factors
+//! are kept too if the first step has their step size. A call *continues* the previous integration
+//! if it starts at the time and (bit for bit) at the state where the last accepted step ended, as
+//! an FMU's successive doStep calls do: then its first step is an ordinary step (starting values
+//! extrapolated from the last collocation polynomial, a rejection reduces `h` by the controller). A
+//! changed input only makes that starting value less accurate, which costs Newton iterations, never
+//! accuracy. Hint, contraction, Jacobian, the step size of the LU factors, the last step (size, end
+//! time, collocation polynomial, end state, `f` there) and whether the inputs changed are the
+//! persistent state ([`Radau5::save_state`]); the LU factors are recomputed from them on loading,
+//! so a restored integrator continues bit-identically.
 
 // The tableau constants are kept with all digits as published in radau5.f.
 #![allow(clippy::excessive_precision)]
@@ -181,6 +188,8 @@ pub struct Radau5 {
     /// Accuracy-loss indicator of the last [`integrate_bounded`](Self::integrate_bounded) call
     /// (0 when it needed no closing step, and after [`integrate`](Self::integrate)).
     accuracy_loss: f64,
+    /// The system's inputs changed since the last call ([`Radau5::inputs_changed`]).
+    changed: bool,
     /// Current state, `f(t, y)`, error weights.
     y: Vec<f64>,
     y0: Vec<f64>,
@@ -289,6 +298,7 @@ impl Radau5 {
             beta,
             faccon: 1.0,
             accuracy_loss: 0.0,
+            changed: false,
             y: v(),
             y0: v(),
             scal: v(),
@@ -391,9 +401,15 @@ impl Radau5 {
         self.faccon = 1.0;
     }
 
+    /// The system's inputs changed where the last call ended: the next call neither continues a
+    /// step that passed that point nor passes its own end (the inputs may change again).
+    pub fn inputs_changed(&mut self) {
+        self.changed = true;
+    }
+
     /// Number of `f64` that [`save_state`](Self::save_state) writes for dimension `n`.
     pub fn saved_len(n: usize) -> usize {
-        SAVED_HEAD + n * n + 4 * n
+        SAVED_HEAD + n * n + 5 * n
     }
 
     /// Number of `f64` in [`save_state`](Self::save_state): `16 + n² + 4n`.
@@ -406,8 +422,9 @@ impl Radau5 {
     /// and end time of the last accepted step (size 0 = none), the Newton convergence factor
     /// carried between steps (`θ/(1-θ)` of the last iteration), the number of solves the LU
     /// factors have served (`iteration.rs`: when they are inverted), the accuracy-loss indicator
-    /// of the last call, the seven work counters of [`SolverStats`] (exact as f64 below 2^53), the Jacobian (column-major), the
-    /// collocation polynomial of the last step (3n) and its end state (n). The LU factors are
+    /// of the last call, the seven work counters of [`SolverStats`] (exact as f64 below 2^53),
+    /// whether the inputs changed (0/1), the Jacobian (column-major), the collocation
+    /// polynomial of the last step (3n), its end state (n) and `f` there (n). The LU factors are
     /// not saved: they are a deterministic function of the Jacobian and their step size, and
     /// [`load_state`](Self::load_state) recomputes them bit-identically.
     pub fn save_state(&self) -> Vec<f64> {
@@ -423,8 +440,9 @@ impl Radau5 {
             self.accuracy_loss,
         ];
         s.extend(stats_array(&self.stats).map(|c| c as f64));
+        s.push(self.changed as u8 as f64);
         s.extend_from_slice(self.jac.as_slice());
-        for v in self.cont.iter().chain([&self.y]) {
+        for v in self.cont.iter().chain([&self.y, &self.y0]) {
             s.extend_from_slice(v);
         }
         s
@@ -440,14 +458,15 @@ impl Radau5 {
         let ok = s[0] >= 0.0 && s[1] >= 0.0 && (s[2] == 0.0 || jac_valid) && s[3] >= 0.0 && s[4] >= 0.0;
         let count = |x: f64, max: f64| (0.0..=max).contains(&x) && x.fract() == 0.0;
         let uses_ok = count(s[7], u32::MAX as f64);
-        let counters = &s[9..SAVED_HEAD];
+        let counters = &s[9..SAVED_HEAD - 1];
         if !counters.iter().all(|&c| count(c, (1u64 << 53) as f64)) {
             return Err(invalid(format!("work counters {counters:?} are not counts")));
         }
-        if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0 && uses_ok && s[8] >= 0.0) {
+        let changed = s[SAVED_HEAD - 1];
+        if !(ok && (jac_valid || s[3] == 0.0) && s[6] >= 0.0 && uses_ok && s[8] >= 0.0 && count(changed, 1.0)) {
             return Err(invalid(format!(
                 "step-size hint {}, contraction {}, flag {}, LU step size {}, last step {}, convergence factor {}, \
-                 LU uses {}, accuracy loss {} are invalid",
+                 LU uses {}, accuracy loss {}, inputs changed {changed} are invalid",
                 s[0], s[1], s[2], s[3], s[4], s[6], s[7], s[8]
             )));
         }
@@ -456,9 +475,10 @@ impl Radau5 {
         self.theta = s[1];
         self.jac_valid = jac_valid;
         (self.h_cont, self.t_cont, self.faccon, self.accuracy_loss) = (s[4], s[5], s[6], s[8]);
+        self.changed = changed == 1.0;
         let (jac, rest) = s[SAVED_HEAD..].split_at(n * n);
         self.jac.as_mut_slice().copy_from_slice(jac);
-        for (v, saved) in self.cont.iter_mut().chain([&mut self.y]).zip(rest.chunks_exact(n)) {
+        for (v, saved) in self.cont.iter_mut().chain([&mut self.y, &mut self.y0]).zip(rest.chunks_exact(n)) {
             v.copy_from_slice(saved);
         }
         self.h_lu = 0.0;
@@ -495,7 +515,7 @@ impl Radau5 {
         x: &mut [f64],
         t_end: f64,
     ) -> Result<(), SolveError> {
-        self.integrate_until(&mut Plain(sys), (t0, t_end), x, None).map(|_| ())
+        self.integrate_until(&mut Plain(sys), (t0, t_end), x, None, None).map(|_| ())
     }
 
     /// The real-time mode: [`integrate`](Self::integrate) with at most `rhs_budget` RHS
@@ -516,7 +536,7 @@ impl Radau5 {
         t_end: f64,
         rhs_budget: u64,
     ) -> Result<(), SolveError> {
-        self.integrate_until(&mut Plain(sys), (t0, t_end), x, Some(rhs_budget)).map(|_| ())
+        self.integrate_until(&mut Plain(sys), (t0, t_end), x, Some(rhs_budget), None).map(|_| ())
     }
 
     /// [`integrate`](Self::integrate), or [`integrate_bounded`](Self::integrate_bounded) with
@@ -526,25 +546,32 @@ impl Radau5 {
     /// the integration there (the state there from the polynomial: continuous output of order 3,
     /// Hairer & Wanner IV.8, eq. 8.12). Returns the time reached: `t_end`, or where the watch
     /// ended it. A call that starts where one ended inside a step restarts the integration (its
-    /// first step extrapolates nothing), as after any change of the state.
+    /// first step extrapolates nothing), as after any change of the state, unless it has a
+    /// `reach`: a time at or after `t_end` up to which its steps may go (see the module's
+    /// "Communication points"; for a watch that neither changes inputs nor ends steps).
     pub fn integrate_until<W: Watch + ?Sized>(
         &mut self,
         watch: &mut W,
         (t0, t_end): (f64, f64),
         x: &mut [f64],
         budget: Option<u64>,
+        reach: Option<f64>,
     ) -> Result<f64, SolveError> {
         if budget.is_some() {
             self.accuracy_loss = 0.0;
         }
         let (n, rhs0) = (self.n as u64, self.stats.rhs_evals);
-        let Some(continues) = self.begin(watch.ode(), t0, x, t_end)? else {
-            return Ok(t_end);
+        // With a reach, steps are planned towards it and the call returns at the first step
+        // that passes t_end, with the polynomial's state there.
+        let changed = std::mem::take(&mut self.changed);
+        let reach = reach.filter(|_| !changed);
+        let (t_out, t_end) = (t_end, reach.map_or(t_end, |r| r.max(t_end)));
+        let Some((mut t, continues)) = self.begin(watch.ode(), t0, x, t_out, reach.is_some())? else {
+            return Ok(t_out);
         };
-        let mut t = t0;
 
         let fnewt = (10.0 * UROUND / self.rtol).max(KAPPA);
-        let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_end.abs());
+        let h_min = 10.0 * f64::EPSILON * t0.abs().max(t_out.abs());
         let cfac = SAFE * (1 + 2 * NIT) as f64;
 
         let mut h_nat = if self.h_hint > 0.0 { self.h_hint } else { H_INITIAL }.min(self.max_step);
@@ -652,9 +679,10 @@ impl Radau5 {
             // Candidate new state and f there, which starts the next step; a non-finite f
             // rejects the step. The last step of a call skips it: the next call evaluates f
             // there itself (with its own inputs), and the Newton iteration's last evaluation
-            // of the final stage lies within its tolerance of this state.
+            // of the final stage lies within its tolerance of this state. A step past the
+            // call's end does not: the next call may continue it.
             self.stage_end();
-            if !last {
+            if !last || tph > t_out {
                 watch.ode().rhs(tph, &self.tmp, &mut self.ftmp);
                 self.stats.rhs_evals += 1;
                 if !all_finite(&self.ftmp) {
@@ -679,19 +707,19 @@ impl Radau5 {
             erracc = err.max(1e-2);
             hold = h;
             t = tph;
-            if !last {
+            if !last || tph > t_out {
                 self.y0.copy_from_slice(&self.ftmp);
             }
             self.accept(h, t);
 
             let stopped = watch.accepted(&self.dense());
-            if last || stopped.is_some() {
+            if last || stopped.is_some() || t >= t_out {
                 // Carry the step the controller wanted, not the one cut to land on t_end.
                 let hint = if hnew < h { hnew } else { hnew.max(h_nat) };
                 self.h_hint = hint.min(self.max_step);
                 self.theta = theta;
                 x.copy_from_slice(&self.y);
-                return Ok(self.stop_at(stopped, x));
+                return Ok(self.stop_at(stopped.or((t > t_out).then_some(t_out)), x));
             }
             hnew = hnew.min(self.max_step);
             if reject {
@@ -835,9 +863,10 @@ impl Radau5 {
         &mut self,
         sys: &S,
         t0: f64,
-        x: &[f64],
+        x: &mut [f64],
         t_end: f64,
-    ) -> Result<Option<bool>, SolveError> {
+        ahead: bool,
+    ) -> Result<Option<(f64, bool)>, SolveError> {
         let n = self.n;
         if sys.dim() != n || x.len() != n {
             return Err(invalid_at(t0, format!("system dimension {} / state length {} != {n}", sys.dim(), x.len())));
@@ -868,6 +897,21 @@ impl Radau5 {
                 }
             }
         }
+        // A call that may continue a step that passed its start, and starts on that step's
+        // polynomial (bit for bit), continues from the step's end; if that is at or past
+        // t_end too, the polynomial gives the state there.
+        if ahead && self.h_cont > 0.0 && self.t_cont > t0 && t0 >= self.t_cont - self.h_cont {
+            Dense { t: self.t_cont, h: self.h_cont, y: &self.y, cont: &self.cont }.at(t0, &mut self.tmp);
+            if bit_equal(x, &self.tmp) {
+                if t_end <= self.t_cont {
+                    self.dense().at(t_end, x);
+                    return Ok(None);
+                }
+                // The error weights at the step's end (not saved in a state: loaded, they are 0).
+                self.update_scal();
+                return Ok(Some((self.t_cont, true)));
+            }
+        }
         // A call that starts where the last accepted step ended continues that integration: its
         // first step extrapolates the last collocation polynomial like any other step.
         let continues = self.h_cont > 0.0 && t0 == self.t_cont && bit_equal(x, &self.y);
@@ -881,7 +925,7 @@ impl Radau5 {
             return Err(SolveError { kind: SolveErrorKind::NonFiniteInitialRhs, t: t0, h: 0.0 });
         }
         self.update_scal();
-        Ok(Some(continues))
+        Ok(Some((t0, continues)))
     }
 
     fn update_scal(&mut self) {
@@ -1164,7 +1208,7 @@ fn all_finite(v: &[f64]) -> bool {
 }
 
 /// Leading numbers of a saved state: nine of the integration, seven work counters.
-const SAVED_HEAD: usize = 16;
+const SAVED_HEAD: usize = 17;
 
 /// The work counters in the order [`Radau5::save_state`] writes them.
 fn stats_array(s: &SolverStats) -> [u64; 7] {

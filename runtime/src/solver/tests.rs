@@ -455,7 +455,7 @@ fn dense_output_has_order_four_between_grid_points() {
             worst = worst.max(max_abs_diff(&mid, &Linear::exact(0.5 * (a + b))));
             None
         });
-        let reached = s.integrate_until(&mut watch, (0.0, 1.0), &mut x, None).unwrap();
+        let reached = s.integrate_until(&mut watch, (0.0, 1.0), &mut x, None, None).unwrap();
         assert_eq!(reached, 1.0);
         errs.push(worst);
     }
@@ -483,7 +483,7 @@ fn an_integration_stops_where_asked() {
             stops += 1;
             (stops == 3).then_some(if stop_inside { 0.5 * (a + b) } else { b })
         });
-        let t = s.integrate_until(&mut watch, (0.0, 2.0), &mut x, None).unwrap();
+        let t = s.integrate_until(&mut watch, (0.0, 2.0), &mut x, None, None).unwrap();
         assert!(t > 0.0 && t < 2.0, "stopped at {t}");
         assert!(max_abs_diff(&x, &Linear::exact(t)) < 1e-7, "state at {t}: {x:?}");
         s.integrate(&Linear, t, &mut x, 2.0).unwrap();
@@ -497,4 +497,72 @@ fn an_integration_stops_where_asked() {
     assert_eq!(run(false), whole, "a stop at a step's end changes nothing");
     let inside = run(true);
     assert!(max_abs_diff(&inside, &Linear::exact(2.0)) < 1e-7, "{inside:?}");
+}
+
+/// A watch of [`Linear`] that only holds it (what the FMU's driver passes with a reach).
+struct Held;
+
+impl Watch for Held {
+    type Ode = Linear;
+    fn ode(&self) -> &Linear {
+        &Linear
+    }
+}
+
+/// Calls of 1 ms over 2 s of [`Linear`] at rtol 1e-8 from `s` at t = `k0` ms, with a reach
+/// (unbounded) or without; returns the largest error against the exact solution at the calls'
+/// ends.
+fn calls_of_a_millisecond(s: &mut Radau5, x: &mut [f64; 3], k0: usize, reach: bool) -> f64 {
+    let mut worst = 0.0_f64;
+    for k in k0..2000 {
+        let (t0, t1) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);
+        let t = s.integrate_until(&mut Held, (t0, t1), x, None, reach.then_some(f64::INFINITY)).unwrap();
+        assert_eq!(t, t1);
+        worst = worst.max(max_abs_diff(x, &Linear::exact(t1)));
+    }
+    worst
+}
+
+/// With a reach, steps pass the communication points and the state there comes from the
+/// collocation polynomial: over 2 s of 1 ms calls, fewer accepted steps than calls (the problem's
+/// steps at rtol 1e-8 are several ms), and every state within 1e-7 of the exact solution, the bound
+/// of `an_integration_stops_where_asked` for the same tolerance. Saved while a step is ahead of
+/// the last call (mid-run) and loaded into a fresh integrator, the run continues bit for bit as
+/// the original. After `inputs_changed` the next call has no reach: its last step ends at its end.
+#[test]
+fn a_reach_steps_past_the_communication_points() {
+    let fresh = || {
+        let mut s = Radau5::new(3);
+        s.set_rtol(1e-8).unwrap();
+        s.set_atol(&[1e-8; 3]).unwrap();
+        s
+    };
+    let (mut cut, mut x_cut) = (fresh(), Linear::exact(0.0));
+    assert!(calls_of_a_millisecond(&mut cut, &mut x_cut, 0, false) < 1e-7);
+    let (mut a, mut xa) = (fresh(), Linear::exact(0.0));
+    for k in 0..1000 {
+        let (t0, t1) = (k as f64 * 1e-3, (k + 1) as f64 * 1e-3);
+        a.integrate_until(&mut Held, (t0, t1), &mut xa, None, Some(f64::INFINITY)).unwrap();
+    }
+    let (saved, x_saved) = (a.save_state(), xa);
+    assert!(saved[5] > 1.0, "a step passed the call's end (t = 1 s): it ended at {}", saved[5]);
+    let worst = calls_of_a_millisecond(&mut a, &mut xa, 1000, true);
+    assert!(worst < 1e-7, "worst error {worst}");
+    let steps = a.stats().accepted_steps;
+    assert!(steps < 2000 / 2, "{steps} steps for 2000 calls ({} without the reach)", cut.stats().accepted_steps);
+
+    let mut b = fresh();
+    b.load_state(&saved).unwrap();
+    let mut xb = x_saved;
+    calls_of_a_millisecond(&mut b, &mut xb, 1000, true);
+    assert_eq!(xa.map(f64::to_bits), xb.map(f64::to_bits));
+    assert_eq!(a.save_state(), b.save_state());
+
+    let mut c = fresh();
+    c.load_state(&saved).unwrap();
+    c.inputs_changed();
+    let mut xc = x_saved;
+    c.integrate_until(&mut Held, (1.0, 1.001), &mut xc, None, Some(f64::INFINITY)).unwrap();
+    assert_eq!(c.save_state()[5], 1.001, "the last step ends at the call's end");
+    assert!(max_abs_diff(&xc, &Linear::exact(1.001)) < 1e-7);
 }
