@@ -11,5 +11,6 @@ mod fmi3_api;
 mod hardening;
 mod intermediate_update;
 mod lookahead;
+mod outputs;
 mod misuse;
 mod model_exchange;

@@ -647,6 +647,9 @@ impl<M: Model> Instance<M> {
         wanted: BaseType,
         read: impl Fn(&Value) -> T,
     ) -> Result<(), String> {
+        if self.held(vrs, out, wanted, &read) {
+            return Ok(());
+        }
         self.refresh_outputs()?;
         for (k, &vr) in vrs.iter().enumerate() {
             if self.version == Version::Fmi3 && vr == INDEPENDENT_VR && wanted == BaseType::Real {
@@ -673,6 +676,24 @@ impl<M: Model> Instance<M> {
             out[k] = read(value);
         }
         Ok(())
+    }
+
+    /// Reads Reals that the model holds ([`Model::held_output`]) while the outputs are not
+    /// written: `true` if every one of `vrs` is such and finite (and read into `out`), else
+    /// `false` with nothing read.
+    fn held<T>(&self, vrs: &[u32], out: &mut [T], wanted: BaseType, read: &impl Fn(&Value) -> T) -> bool {
+        let c = &self.core;
+        let Some(model) = c.model.as_deref().filter(|_| !c.outputs_current && wanted == BaseType::Real) else {
+            return false;
+        };
+        let held = |r| model.held_output(r).filter(|x| x.is_finite());
+        if c.mode == Mode::InitializationMode || !vrs.iter().all(|&r| held(r).is_some()) {
+            return false;
+        }
+        for (o, &r) in out.iter_mut().zip(vrs) {
+            *o = read(&Value::Real(held(r).unwrap_or(f64::NAN)));
+        }
+        true
     }
 
     /// Writes values, all or nothing: every value is checked (type, settability, range) before

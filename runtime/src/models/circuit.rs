@@ -37,24 +37,39 @@ pub(crate) const ME_TOLERANCE: f64 = 1e-6;
 /// 1 mm of spool travel, full valve opening.
 pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e-3, 1.0];
 
+/// The outputs and locals that are circuit states: (value reference, index in the state).
+pub(crate) const STATE_ROWS: [(u32, usize); N_CIRCUIT] = [
+    (vr::P2, circuit::P2),
+    (vr::P3, circuit::P3),
+    (vr::P4, circuit::P4),
+    (vr::X_V, circuit::X_V),
+    (vr::U_CBV, circuit::U_CBV),
+];
+
+/// The output or local `r` if it is a circuit state, from the state `c` (no evaluation).
+pub(crate) fn state_row(c: &[f64], r: u32) -> Option<f64> {
+    STATE_ROWS.iter().find(|&&(v, _)| v == r).map(|&(_, i)| c[i])
+}
+
 /// The circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
 /// load-sensing pressure) for state `c` and its evaluation `e`, as (value reference, value).
 pub(crate) fn circuit_rows<T: Scalar>(c: &[T; N_CIRCUIT], e: &Eval<T>) -> [(u32, T); 16] {
+    let [s0, s1, s2, s3, s4] = STATE_ROWS.map(|(r, i)| (r, c[i]));
     [
         (vr::P1, e.p1),
-        (vr::P2, c[circuit::P2]),
-        (vr::P3, c[circuit::P3]),
-        (vr::P4, c[circuit::P4]),
+        s0,
+        s1,
+        s2,
         (vr::U, e.u),
         (vr::U_CV, e.u_cv),
-        (vr::U_CBV, c[circuit::U_CBV]),
+        s4,
         (vr::Q1, e.q[0]),
         (vr::Q2, e.q[1]),
         (vr::Q3, e.q[2]),
         (vr::Q4, e.q[3]),
         (vr::F, e.force),
         (vr::F_FR, e.f_friction),
-        (vr::X_V, c[circuit::X_V]),
+        s3,
         (vr::U_PCV, e.u_pcv),
         (vr::P_X, e.p_x),
     ]
