@@ -35,6 +35,8 @@ enum Behaviour {
     SetUnrequested,
     /// Reads an output (no output has intermediateUpdate="true").
     GetOutput,
+    /// Reads an output once, then ramps (a single failed call).
+    GetOutputOnce,
     /// Asks to return early at this time where it may.
     ReturnEarlyAt(f64),
 }
@@ -78,6 +80,11 @@ unsafe extern "C" fn update<M: Model>(
     let u = u0 + slope * (t - t0);
     let status = match m.behaviour.get() {
         Behaviour::SetUnrequested if !set_requested => api::set_float64::<M>(c, &m.input, 1, &u, 1),
+        Behaviour::GetOutputOnce if finished => {
+            m.behaviour.set(Behaviour::Ramp);
+            let mut p3 = f64::NAN;
+            api::get_float64::<M>(c, &vr::P3, 1, &mut p3, 1)
+        }
         Behaviour::GetOutput if finished => {
             let mut p3 = f64::NAN;
             api::get_float64::<M>(c, &vr::P3, 1, &mut p3, 1)
@@ -264,12 +271,14 @@ fn instantiation_checks_the_required_intermediate_variables() {
 /// 4.2.3, Intermediate Update Mode: inputs are set only where the callback requests them
 /// (intermediateVariableSetRequested), outputs read only where allowed (intermediateVariableGetAllowed,
 /// never here): such a call is an error naming why, and the step fails with it (2.3.1: the
-/// instance is then Terminated).
+/// instance is then Terminated, and the next doStep is an error), also when the master's later
+/// calls from the callback succeed.
 #[test]
 fn intermediate_update_mode_refuses_what_the_callback_did_not_offer() {
     for (behaviour, why) in [
         (Behaviour::SetUnrequested, "intermediateVariableSetRequested = false"),
         (Behaviour::GetOutput, "illegal call in state IntermediateUpdate"),
+        (Behaviour::GetOutputOnce, "illegal call in state IntermediateUpdate"),
     ] {
         let m = Master::<Hb>::new(behaviour);
         m.instantiate(true, &[vr::U_REF], false).unwrap();
@@ -278,6 +287,11 @@ fn intermediate_update_mode_refuses_what_the_callback_did_not_offer() {
         let messages = m.messages.borrow();
         assert!(messages.iter().any(|t| t.contains(why)), "{messages:?}");
         assert!(messages.last().unwrap().contains("a call in intermediate update failed"), "{messages:?}");
+        drop(messages);
+        let (mut event, mut term, mut early, mut last) = (true, true, true, f64::NAN);
+        let next =
+            unsafe { api::do_step::<Hb>(m.instance.get(), H, H, true, (&mut event, &mut term, &mut early), &mut last) };
+        assert_eq!(next, ERR, "Terminated: no further step");
     }
 }
 

@@ -577,6 +577,11 @@ impl<M: Model> Callback<'_, M> {
         // SAFETY: each borrow ends before the callback runs, and the callback's own calls end
         // before the next borrow.
         let inst = unsafe { borrow::<M>(self.c, self.f) }?;
+        // After a failed call of the master's the instance is Terminated (FMI 3.0, 2.3.1) and
+        // stays so: no further callback, whose success would otherwise hide the failure.
+        if inst.core.mode != Mode::StepComplete {
+            return Err("a call in intermediate update failed".into());
+        }
         inst.core.mode = Mode::IntermediateUpdate;
         inst.set_requested = set_requested;
         let can_return_early = self.can_return_early && finished;
