@@ -30,13 +30,13 @@ class Integrator:
                 """fmpy's right-hand side, with an FMU's Discard (states outside its domain, FMI 2.0
                 2.1.3: retry with a smaller step) passed to CVode as a recoverable failure, which
                 it answers with a smaller step, instead of fmpy's default: the exception lost in
-                the callback and the derivatives left as they were."""
+                the callback and the derivatives left as they were. Any other failure is
+                unrecoverable (-1: CVode stops with an error), not an exception, which ctypes
+                would print and answer with 0, the stale derivatives taken as good."""
                 try:
                     return super().f(t, y, ydot, user_data)
                 except FMICallException as e:
-                    if e.status != DISCARD:
-                        raise
-                    return 1
+                    return 1 if e.status == DISCARD else -1
 
         class NoInput:
             def apply(self, t):

@@ -409,6 +409,14 @@ fn states_below_absolute_zero_are_discarded_and_the_old_ones_kept() {
             assert_eq!(kept, x, "{}: the states it had", M::INFO.identifier);
             assert_eq!(api::get_derivatives::<M>(s.c, again.as_mut_ptr(), n), OK);
             assert_eq!(again, dx);
+            // The same state set by its value reference (FMI 2.0, 3.2.3 rule 5: a new state, as
+            // fmi2SetContinuousStates sets it): the same Discard, nothing set.
+            let p4 = (M::STATES[P4].state, -101325.0 - 500.0);
+            assert_eq!(api::set_real::<M>(s.c, &p4.0, 1, &p4.1), fmi2Status::Discard, "{}", M::INFO.identifier);
+            let said = s.messages.lock().unwrap().last().cloned().expect("a message");
+            assert!(said.2.contains("fmi2SetReal") && said.2.contains("p4 = -101825 Pa"), "{}", said.2);
+            assert_eq!(api::get_continuous_states::<M>(s.c, kept.as_mut_ptr(), n), OK);
+            assert_eq!(kept, x, "{}: the states it had", M::INFO.identifier);
             trial[P4] = -101325.0;
             assert_eq!(api::set_continuous_states::<M>(s.c, trial.as_ptr(), n), OK, "{}", s.last_error());
         }

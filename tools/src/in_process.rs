@@ -90,7 +90,10 @@ impl<M: Model> InProcess<M> {
 
 impl<M: Model> Slave for InProcess<M> {
     fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
-        self.0.set(&[vr], vec![Value::Real(x)])
+        match self.0.set(&[vr], vec![Value::Real(x)])? {
+            Some(why) => Err(why),
+            None => Ok(()),
+        }
     }
     fn get(&mut self, vr: u32) -> Result<f64, String> {
         let mut x = [0.0];

@@ -168,8 +168,9 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// fmi3SetContinuousStates then return Discard and keep the states they had: FMI 2.0, 2.1.3
     /// (fmi2Discard in Model Exchange: "a function is outside of its domain", the integrator
     /// retries with a smaller step), FMI 3.0, 3.2.1 (fmi3Discard "if the FMU rejects any of the
-    /// state values"). An integrator's trial states can leave the domain; accepted ones then do
-    /// not.
+    /// state values"). An integrator's trial states can leave the domain; it then retries with a
+    /// smaller step. fmi2SetReal / fmi3SetFloat64 of a state by its value reference is refused
+    /// the same way.
     fn outside_domain(_x: &[f64]) -> Option<String> {
         None
     }
