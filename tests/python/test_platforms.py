@@ -10,7 +10,8 @@ Needs `boomsim pack --platforms all` (scripts/test does it) and scripts/setup-cr
 What agrees how well, and why:
 - the controller's outputs to 1e-12 relative: a closed-form filter (exp, arithmetic), identical
   code; only libm's exp may differ, by an ulp;
-- the plants' outputs, at rtol 1e-6, to 1e-5 of each output's largest magnitude over the run, or
+- the plants' outputs, at rtol 1e-6, to 1e-5 of each output's largest magnitude over the run (U:
+  5e-5, below), or
   to twice linux64's own global error in that output where it is larger: the same code, but the
   platforms' libm (glibc on x86-64 and aarch64, msvcrt on Windows) differs in the last bit of exp,
   pow, tanh, sin/cos/acos, and the adaptive Radau IIA integrator turns such differences into
@@ -18,7 +19,10 @@ What agrees how well, and why:
   converged solution, so they may differ by that much. The global error is measured against the
   same run at rtol 1e-10 on linux64; it is a few rtol except where the controller's high-pass
   filter differentiates the integrator's error (B with the flexible arm: 1e-4 of Q4's range as
-  the spool opens). A real defect (a wrong ABI, a mis-linked math function, a truncated constant)
+  the spool opens); in U, where no input changes, the integrator's steps pass the communication
+  points and the outputs there come from the steps' collocation polynomials (continuous output of
+  order 3): measured at rtol 1e-6, each platform's outputs within 2.7e-5 of their range of the
+  converged run (aarch64, p2; linux64 7.4e-6), so U's floor is 5e-5. A real defect (a wrong ABI, a mis-linked math function, a truncated constant)
   is far larger. The largest differences are printed (pytest -s) and quoted in the README."""
 
 import math
@@ -129,7 +133,7 @@ SCENARIOS = [
     ("controller, pressure ramp", ["PressureFeedbackController"], 500,
      ["real:0:1=4e6", "ramp:0:1=4e6,2e7", "real:0:0=-0.05", "print:0:2", "print:0:3", "print:0:10"], 1e-12),
     ("HydraulicBoom U, flexible, 2 s", ["HydraulicBoom"], 2000,
-     ["real:0:0=-0.05", "tol:1e-6"] + PLANT_OUT + ["print:0:16", "print:0:40"], 1e-5),
+     ["real:0:0=-0.05", "tol:1e-6"] + PLANT_OUT + ["print:0:16", "print:0:40"], 5e-5),
     ("HydraulicBoom B with the controller, flexible, 2 s", ["HydraulicBoom", "PressureFeedbackController"], 2000,
      ["real:1:0=-0.05", "link:0:0=1:2", "link:1:1=0:4", "tol:1e-6"] + PLANT_OUT + ["print:1:2", "print:1:3"], 1e-5),
     ("HydraulicCircuit, plain port, lowering at 10 mm/s", ["HydraulicCircuit"], 1000,

@@ -34,7 +34,10 @@
 //!   truncation with static correction keeps them (Craig & Kurdila, Fundamentals of Structural
 //!   Dynamics, 2nd ed., the mode-acceleration method), and the integrator no longer resolves
 //!   their ringing after each stick of the cylinder. The joints' dampers then form one
-//!   symmetric matrix C (each joint's torque from every joint's rate, [`FlexibleBoom::damper`]);
+//!   symmetric matrix C (each joint's torque from every joint's rate, [`FlexibleBoom::damper`]).
+//!   The band is decided on the locked modes: coupled to the oil column, the second locked mode
+//!   (70 Hz) is a plant mode at 47.5 Hz (0.2 % under the thesis' law) that this law moves to
+//!   55.5 Hz at 12 % (`boomsim eigen`), damped but not quasi-static;
 //!   the rigid turn about B has no deflection and no damping, as under the thesis' law.
 //! - Masses: the arm is uniform (m_arm / l_arm per length), each section a slender rod. Its
 //!   inertia about its inner node, m l^2 / 3, is (2.39) and is what the equations use; part I adds

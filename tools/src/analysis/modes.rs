@@ -268,8 +268,9 @@ mod tests {
     /// `boom.damping` = 2 (the modal law) against the plant linearised by differences with the
     /// cylinder made a rigid link (as above): its lowest mode, the arm's first bending mode
     /// (3.4 Hz, in the band), keeps the frequency and the damping the thesis' per-section law
-    /// gives it (the same frequency to 1e-6; the damping within 1e-5, the differences' noise:
-    /// the law itself makes them equal); above the 50 Hz band no mode of the arm (the thesis'
+    /// gives it (the frequency to 1e-6, the damping ratio to 1e-4 relative: the law makes them equal,
+    /// and the linearisation by differences reproduces them to about 1e-5 relative, measured
+    /// 5e-9 absolute on the ratio of 1.5e-4); above the 50 Hz band no mode of the arm (the thesis'
     /// law: 70 Hz to 10.4 kHz; the stiffened oil column's own mode, 187 kHz, is not one) oscillates
     /// with less than critical damping (the law sets it exactly for the undeformed horizontal
     /// arm; 0.95 covers the plant's gravity-loaded rest shape and the oil's remaining compliance).
@@ -279,7 +280,7 @@ mod tests {
         let band = boomsim::mechanics::flexible_boom::BAND / std::f64::consts::TAU;
         assert!(thesis[0].frequency_hz < band && thesis[1].frequency_hz > band, "{thesis:?}");
         assert!((modal[0].frequency_hz / thesis[0].frequency_hz - 1.0).abs() < 1e-6, "{modal:?}");
-        assert!((modal[0].damping_ratio - thesis[0].damping_ratio).abs() < 1e-5, "{modal:?}");
+        assert!((modal[0].damping_ratio / thesis[0].damping_ratio - 1.0).abs() < 1e-4, "{modal:?}");
         let arm = modal[1..].iter().filter(|m| m.frequency_hz < 20e3);
         assert!(arm.clone().count() >= 1 && arm.clone().all(|m| m.damping_ratio > 0.95), "{modal:?}");
     }
