@@ -682,19 +682,19 @@ impl<M: Model> Instance<M> {
     }
 
     /// Reads Reals that the model holds ([`Model::held_output`]) while the outputs are not
-    /// written: `true` if every one of `vrs` is such and finite (and read into `out`), else
-    /// `false` with nothing read.
+    /// written: `true` if every one of `vrs` is such and finite (read into `out`), else `false`
+    /// (`out` is then written by the full read).
     fn held<T>(&self, vrs: &[u32], out: &mut [T], wanted: BaseType, read: &impl Fn(&Value) -> T) -> bool {
         let c = &self.core;
-        let Some(model) = c.model.as_deref().filter(|_| !c.outputs_current && wanted == BaseType::Real) else {
+        let held = !c.outputs_current && wanted == BaseType::Real && c.mode != Mode::InitializationMode;
+        let Some(model) = c.model.as_deref().filter(|_| held) else {
             return false;
         };
-        let held = |r| model.held_output(r).filter(|x| x.is_finite());
-        if c.mode == Mode::InitializationMode || !vrs.iter().all(|&r| held(r).is_some()) {
-            return false;
-        }
         for (o, &r) in out.iter_mut().zip(vrs) {
-            *o = read(&Value::Real(held(r).unwrap_or(f64::NAN)));
+            match model.held_output(r).filter(|x| x.is_finite()) {
+                Some(x) => *o = read(&Value::Real(x)),
+                None => return false,
+            }
         }
         true
     }

@@ -412,7 +412,7 @@ impl Radau5 {
         SAVED_HEAD + n * n + 5 * n
     }
 
-    /// Number of `f64` in [`save_state`](Self::save_state): `16 + n² + 4n`.
+    /// Number of `f64` in [`save_state`](Self::save_state): `17 + n² + 5n`.
     pub fn state_len(&self) -> usize {
         Self::saved_len(self.n)
     }
