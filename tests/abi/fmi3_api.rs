@@ -539,7 +539,7 @@ fn serialised_states_round_trip_and_corruption_is_refused() {
     let at = flipped.len() / 2;
     flipped[at] ^= 1;
     let mut forged = bytes.clone();
-    let time_at = common::payload_offset(&forged) + 1;
+    let time_at = common::time_offset(&forged);
     common::forge(&mut forged, time_at, f64::NAN);
     let fmi2_state = {
         let messages = Box::new(common::Messages::default());

@@ -19,7 +19,7 @@ use boomsim::fmu::guid::guid;
 use boomsim::fmi2::types::*;
 use boomsim::models::pressure_feedback_controller::vr;
 use boomsim::models::{HydraulicBoom, PressureFeedbackController as Pfc};
-use crate::common::{forge, forge_value, payload_offset, Slave};
+use crate::common::{forge, forge_bytes, forge_value, payload_offset, time_offset, Slave};
 use std::ffi::CString;
 use std::ptr::{null, null_mut};
 
@@ -256,7 +256,14 @@ const ROWS: &[Row] = &[
     Row { at: At::Stepping, what: "deserialise a forged K_f = NaN", call: |s| deserialise(s, &serialised(s, |b| forge_value::<Pfc>(b, 4, f64::NAN))), status: ERR, says: &["K_f = NaN"] },
     Row { at: At::Stepping, what: "deserialise a forged u_max = NaN", call: |s| deserialise(s, &serialised(s, |b| forge_value::<Pfc>(b, 9, f64::NAN))), status: ERR, says: &["u_max = NaN"] },
     Row { at: At::Stepping, what: "deserialise a forged p = 1e308", call: |s| deserialise(s, &serialised(s, |b| forge_value::<Pfc>(b, 1, 1e308))), status: ERR, says: &["p = 1e308", "outside its valid range"] },
-    Row { at: At::Stepping, what: "deserialise a forged time NaN", call: |s| deserialise(s, &serialised(s, |b| { let at = payload_offset(b) + 1; forge(b, at, f64::NAN) })), status: ERR, says: &["inconsistent times", "time NaN"] },
+    // An FMU state records the FMI version and interface of the instance that took it, and is
+    // taken only in the states that version and interface have (issue 46: a state re-checksummed
+    // into FMI 3.0's Intermediate Update Mode left an FMI 2.0 instance refusing every call,
+    // fmi2FreeInstance included).
+    Row { at: At::Stepping, what: "deserialise a state forged into Intermediate Update Mode", call: |s| deserialise(s, &serialised(s, |b| { let at = payload_offset(b) + 2; forge_bytes(b, at, &[9]) })), status: ERR, says: &["IntermediateUpdate", "FMI 2.0 CoSimulation"] },
+    Row { at: At::Stepping, what: "deserialise a state forged as an FMI 3.0 instance's", call: |s| deserialise(s, &serialised(s, |b| { let at = payload_offset(b); forge_bytes(b, at, &[1]) })), status: ERR, says: &["taken by an FMI 3.0 CoSimulation instance", "this instance is an FMI 2.0 CoSimulation instance"] },
+    Row { at: At::Stepping, what: "deserialise a state forged as a Model Exchange instance's", call: |s| deserialise(s, &serialised(s, |b| { let at = payload_offset(b) + 1; forge_bytes(b, at, &[0]) })), status: ERR, says: &["taken by an FMI 2.0 ModelExchange instance"] },
+    Row { at: At::Stepping, what: "deserialise a forged time NaN", call: |s| deserialise(s, &serialised(s, |b| { let at = time_offset(b); forge(b, at, f64::NAN) })), status: ERR, says: &["inconsistent times", "time NaN"] },
 ];
 
 #[test]

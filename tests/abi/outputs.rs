@@ -34,3 +34,72 @@ fn held_outputs_equal_the_computed_ones() {
     }
     assert!(computed[2] > 0.0 && computed[5] != 0.0, "{computed:?}");
 }
+
+/// Issue 46, defect 3 (found by an independent host's fuzzer): BoomMechanics in FMI 2.0 with
+/// cylinder.F's derivative at -DBL_MAX. The step bounds the ramp to the input's range
+/// (fmi2Warning "stops at the bound") and reaches a state with a non-finite output; that step
+/// is the one that fails (fmi2Error naming the variable, the Error state: FMI 2.0, 4.3.1),
+/// not the next read. A read of a variable that is finite is not refused because of another
+/// (here the Integer solver.mode, which the fuzzer read).
+#[test]
+fn a_step_to_a_non_finite_output_fails_in_fmi2() {
+    use boomsim::models::boom_mechanics::vr as bm;
+    use boomsim::models::BoomMechanics as Bm;
+    let s = Slave::<Bm>::initialized("bm2", &[]);
+    assert_eq!(s.set_slope(bm::F, -f64::MAX), fmi2Status::OK);
+    assert_eq!(s.step(0.0, 0.01), fmi2Status::Error);
+    let e = s.last_error();
+    assert!(e.contains("fmi2DoStep") && e.contains("the model left its valid range") && e.contains("Error state"), "{e}");
+    let mut mode = -1;
+    assert_eq!(unsafe { api::get_integer::<Bm>(s.c, &bm::SOLVER_MODE, 1, &mut mode) }, fmi2Status::OK, "{}", s.last_error());
+    assert_eq!(mode, 0);
+}
+
+/// Issue 46, defect 2 (fuzzer sequence 14679269399127648895): BoomMechanics in FMI 3.0 pushed by
+/// the largest rod forces its input allows (FORCE_RANGE, +-1e8 N, alternating every step of
+/// 7.8 ms). A step whose state has a non-finite output is fmi3Discard, and the instance is as
+/// before the call (FMI 3.0, 2.2.4); after every step that answers OK every output is finite and
+/// the directional derivative is given (4.2.1: a step that returns fmi3OK completed it).
+#[test]
+fn a_step_to_a_non_finite_output_is_discarded_in_fmi3() {
+    use crate::fmi3_api::Inst;
+    use boomsim::fmi3::types::fmi3Status;
+    use boomsim::models::boom_mechanics::vr as bm;
+    use boomsim::models::BoomMechanics as Bm;
+    let i = Inst::<Bm>::initialized(false, &[]);
+    let outputs = [bm::X, bm::V, bm::THETA, bm::OMEGA, bm::PAYLOAD_X, bm::PAYLOAD_Y];
+    let (h, mut t, mut discarded) = (0.0078, 0.0, 0);
+    for k in 0..12 {
+        assert_eq!(i.set(bm::F, if k % 2 == 0 { -1e8 } else { 1e8 }), fmi3Status::OK);
+        match i.step(t, h) {
+            fmi3Status::OK => {
+                t += h;
+                for r in outputs {
+                    assert!(i.get(r).is_finite(), "vr {r} at t = {t}");
+                }
+                let (mut dx, seed) = (f64::NAN, 1.0);
+                let status = unsafe {
+                    boomsim::fmi3::api::get_directional_derivative::<Bm>(
+                        i.c,
+                        boomsim::fmi3::api::Derivative {
+                            unknown: (&bm::V, 1),
+                            known: (&bm::F, 1),
+                            seed: (&seed, 1),
+                            sensitivity: (&mut dx, 1),
+                        },
+                    )
+                };
+                assert_eq!(status, fmi3Status::OK, "after an OK step at t = {t}: {}", i.last_error());
+            }
+            fmi3Status::Discard => {
+                discarded += 1;
+                // The same step again from the same time: the instance is where it was.
+                assert_eq!(i.set(bm::F, 0.0), fmi3Status::OK);
+                assert_eq!(i.step(t, h), fmi3Status::OK, "{}", i.last_error());
+                t += h;
+            }
+            s => panic!("step {k}: {s:?} {}", i.last_error()),
+        }
+    }
+    assert!(discarded > 0, "the forces of the fuzzer's sequence drove the boom out of its valid range");
+}

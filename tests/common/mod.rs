@@ -145,7 +145,12 @@ impl<M: Model> Drop for Slave<M> {
 /// Overwrites the f64 at byte `at` of a serialised FMU state and recomputes its trailing CRC-32:
 /// a forged state that passes every integrity check.
 pub fn forge(b: &mut [u8], at: usize, x: f64) {
-    b[at..at + 8].copy_from_slice(&x.to_le_bytes());
+    forge_bytes(b, at, &x.to_le_bytes());
+}
+
+/// Overwrites the bytes at `at` of a serialised FMU state and recomputes its trailing CRC-32.
+pub fn forge_bytes(b: &mut [u8], at: usize, bytes: &[u8]) {
+    b[at..at + bytes.len()].copy_from_slice(bytes);
     let n = b.len() - 4;
     let crc = crc32(&b[..n]);
     b[n..].copy_from_slice(&crc.to_le_bytes());
@@ -171,12 +176,21 @@ pub fn payload_offset(b: &[u8]) -> usize {
     16 + n + 8
 }
 
+/// The payload's first three bytes: the codes of the FMI version (0: 2.0, 1: 3.0), the interface
+/// (0: Model Exchange, 1: Co-Simulation) and the state machine state (its position in `Mode::ALL`).
+pub const CODES: usize = 3;
+
+/// Byte offset of the instance time in a serialised FMU state, after the codes.
+pub fn time_offset(b: &[u8]) -> usize {
+    payload_offset(b) + CODES
+}
+
 /// Byte offset of the value of the variable at table index `i` in a serialised state of `M`:
-/// after the payload's state code 1, three times 24, two optional times 2 x 9, outputs flag 1 and
+/// after the payload's codes 3, three times 24, two optional times 2 x 9, outputs flag 1 and
 /// the value count 8, each value is a type tag (0 Real: 8 bytes, 1 Integer: 4, 2 Boolean: 1,
 /// 3 String: length 8 + bytes).
 pub fn value_offset<M: Model>(b: &[u8], i: usize) -> usize {
-    let mut at = payload_offset(b) + 1 + 24 + 18 + 1 + 8;
+    let mut at = time_offset(b) + 24 + 18 + 1 + 8;
     for _ in 0..i {
         at += 1 + match b[at] {
             0 => 8,

@@ -14,6 +14,9 @@ pub mod allowed {
     use super::*;
     const ANY: Mask = INST | INIT | DONE | FAIL | CANC | EVENT | CONT | TERM | ERR;
     pub const SET_DEBUG_LOGGING: Rule = both(ANY);
+    /// Every state but Intermediate Update Mode, where the master's callback runs inside
+    /// fmi3DoStep: 4.2.3 does not list fmi3FreeInstance among its calls, and the step would go on
+    /// in freed memory.
     pub const FREE_INSTANCE: Rule = both(ANY);
     pub const ENTER_INITIALIZATION_MODE: Rule = both(INST);
     pub const EXIT_INITIALIZATION_MODE: Rule = both(INIT);

@@ -413,7 +413,7 @@ pub unsafe fn free_fmu_state<M: Model>(c: Handle, f: Call, state: *mut FmuState)
 pub unsafe fn serialized_fmu_state_size<M: Model>(c: Handle, f: Call, state: FmuState, size: *mut usize) -> Status {
     call::<M>(c, f, |inst| {
         let out = size.as_mut().ok_or("size is NULL")?;
-        *out = snapshot::serialize(own_fmu_state(inst, state)?, &inst.guid).len();
+        *out = snapshot::serialize(own_fmu_state(inst, state)?, &inst.guid, (inst.version, inst.interface)).len();
         Ok(Status::OK)
     })
 }
@@ -426,7 +426,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     size: usize,
 ) -> Status {
     call::<M>(c, f, |inst| {
-        let data = snapshot::serialize(own_fmu_state(inst, state)?, &inst.guid);
+        let data = snapshot::serialize(own_fmu_state(inst, state)?, &inst.guid, (inst.version, inst.interface));
         if data.len() != size {
             return Err(format!(
                 "size = {size} bytes, but the state needs {} ({})",
@@ -458,13 +458,7 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
             None => prefix,
         };
         let out = state.as_mut().ok_or("FMUstate is NULL")?;
-        let core = snapshot::deserialize::<M>(data, &inst.guid)?;
-        if let Some(other) = core.mode.interface().filter(|&i| i != inst.interface) {
-            return Err(format!(
-                "the state was saved by a {other:?} instance (state {:?}); this instance is {:?}",
-                core.mode, inst.interface
-            ));
-        }
+        let core = snapshot::deserialize::<M>(data, &inst.guid, (inst.version, inst.interface))?;
         if core.mode == Mode::EventMode && inst.interface == Interface::CoSimulation && !inst.event_mode_used {
             return Err("the state was saved in Event Mode; this Co-Simulation instance has no Event Mode \
                         (eventModeUsed = false)"

@@ -558,12 +558,21 @@ impl<M: Model> Instance<M> {
         self.name(M::STATES[k].state).unwrap_or("?")
     }
 
-    /// Brings outputs up to date before a get.
+    /// Brings outputs up to date before a get. A value that is not finite is refused by the get
+    /// that asks for it, not by the read of another variable: a step never ends on one
+    /// ([`Instance::end_step`]), but a value set since may lead to one.
     fn refresh_outputs(&mut self) -> Result<(), String> {
+        self.write_current_outputs().map(drop)
+    }
+
+    /// Writes the outputs unless they are current: the table index of the first Real written
+    /// that is not a finite number.
+    fn write_current_outputs(&mut self) -> Result<Option<usize>, String> {
         let c = &mut self.core;
         if c.outputs_current {
-            return Ok(());
+            return Ok(None);
         }
+        c.values.take_non_finite();
         if c.mode == Mode::InitializationMode {
             // Initial outputs follow from the values set so far.
             write_outputs(&Driven::new(M::initialize(&c.values)?), &mut c.values);
@@ -571,24 +580,23 @@ impl<M: Model> Instance<M> {
             if clock_active::<M>(&c.values) {
                 model.evaluate_partition(&c.values);
             }
-            // Every Real the importer can read is finite after a good step, or the instance
-            // is in error.
-            c.values.take_non_finite();
             write_outputs(model, &mut c.values);
-            if let Some(i) = c.values.take_non_finite() {
-                c.mode = Mode::Error;
-                let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
-                return Err(format!(
-                    "{} = {} at t = {}: the model left its valid range",
-                    M::VARIABLES[i].name,
-                    num(x),
-                    num(c.time)
-                ));
-            }
         }
         c.outputs_current = true;
         c.derivatives_current = false;
-        Ok(())
+        Ok(c.values.take_non_finite())
+    }
+
+    /// Writes the outputs of the state a step reached; `Err` names the first Real that is not a
+    /// finite number (the model left its valid range): such a step is not done.
+    fn outputs_at_step_end(&mut self) -> Result<(), String> {
+        let Some(i) = self.write_current_outputs()? else {
+            return Ok(());
+        };
+        let c = &mut self.core;
+        c.outputs_current = false;
+        let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
+        Err(format!("{} = {} at t = {}: the model left its valid range", M::VARIABLES[i].name, num(x), num(c.time)))
     }
 
     /// Writes the `der()` variables from the current states and inputs (in Initialization Mode,
@@ -1011,25 +1019,41 @@ impl<M: Model> Instance<M> {
         // Inputs with a derivative follow their ramp to the new communication point (only
         // interpolated inputs accept derivatives).
         let slopes = bounded.as_deref().unwrap_or(&c.input_derivatives);
+        let mut ramped = Vec::new();
         for &r in M::INFO.interpolated_inputs {
             let Some(i) = c.values.position(r) else { continue };
             if let (Value::Real(x), Kind::Real { min, max, .. }, true) =
                 (c.values.at(i), M::VARIABLES[i].kind, slopes[i] != 0.0)
             {
                 // A slope bounded to reach a bound ends there, not a rounding error outside.
-                c.values.put(i, Value::Real((x + slopes[i] * (end - start)).clamp(min, max)));
+                let x_end = (x + slopes[i] * (end - start)).clamp(min, max);
+                ramped.push((i, *x));
+                c.values.put(i, Value::Real(x_end));
             }
         }
-        c.time = end;
-        c.last_successful_time = end;
+        let times_before = (c.time, c.last_successful_time);
+        (c.time, c.last_successful_time) = (end, end);
+        c.model = Some(model);
+        // A step whose state has an output that is not a finite number is not done, whether or
+        // not the master reads one (issue 46): FMI 3.0 discards it (2.2.4: the instance is as
+        // before the call), FMI 2.0, which keeps no state from before the step, ends in Error.
+        if let Err(e) = self.outputs_at_step_end() {
+            let why = format!("the step from t = {} with h = {} reached {e}", num(t), num(h));
+            let c = &mut self.core;
+            let Some(before) = before else {
+                c.mode = Mode::Error;
+                return Err(why);
+            };
+            c.model = Some(before);
+            ramped.into_iter().for_each(|(i, x)| c.values.put(i, Value::Real(x)));
+            (c.time, c.last_successful_time) = times_before;
+            return Ok(Step::Discarded(format!("{why}; the instance is back at t = {}", num(start))));
+        }
         self.ended = ended;
         if let Some(Ended { t, event }) = ended {
             let why = if event { "an event indicator changed sign" } else { "the master asked" };
             self.log.info("logEvents", &format!("{why}: the step ended at t = {}", num(t)));
         }
-        // The outputs are written when the master first reads one (refresh_outputs): a master
-        // that reads few of them, or none, between steps pays for none.
-        c.model = Some(model);
         Ok(Step::Done(warning))
     }
 }

@@ -4,8 +4,11 @@
 //!
 //! Byte format, little endian: magic `BOOMSIM\0`, format version (u32), GUID (u32 length +
 //! UTF-8), payload length (u64), payload, CRC-32 of everything before it (u32). The payload holds
-//! the state machine state, times, every variable value, the input derivatives and the model's
-//! own state. Any mismatch (size, GUID, version, checksum, value types) is refused with a reason,
+//! the FMI version and interface of the instance that took the state, the state machine state,
+//! times, every variable value, the input derivatives and the model's own state. Any mismatch
+//! (size, GUID, format version, checksum, FMI version, interface, value types) is refused with a
+//! reason, and so is a state machine state that no instance of that FMI version and interface
+//! can save (FMI 2.0 has no Intermediate Update Mode, and no state is taken inside one),
 //! and so is a well-formed state whose values fmi2SetReal would refuse (a non-finite number, a
 //! parameter or input outside its range, inconsistent times): a checksum only proves the bytes
 //! were not damaged, not that they were written by this FMU.
@@ -13,17 +16,23 @@
 use super::driver::Driven;
 use super::instance::{in_range, Core, TOLERANCE_RANGE};
 use super::log::num;
-use super::machine::Mode;
+use super::machine::{Interface, Mode};
 use super::model::Model;
 use super::variables::{Causality, Value, Values, Variable};
+use super::version::Version;
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 
-/// Serialises a core into the checked byte format.
-pub fn serialize<M: Model>(core: &Core<M>, guid: &str) -> Vec<u8> {
+/// Who took a state: the FMI version and interface of the instance.
+pub type Origin = (Version, Interface);
+
+/// Serialises a core that an instance of `origin` took into the checked byte format.
+pub fn serialize<M: Model>(core: &Core<M>, guid: &str, (version, interface): Origin) -> Vec<u8> {
     let mut p = Vec::new();
+    p.push(version as u8);
+    p.push(interface as u8);
     p.push(mode_code(core.mode));
     for x in [core.time, core.start_time, core.last_successful_time] {
         put_f64(&mut p, x);
@@ -100,8 +109,8 @@ pub fn announced_len(head: &[u8]) -> Option<usize> {
     (payload_at + 8).checked_add(payload)?.checked_add(4)
 }
 
-/// Parses bytes written by [`serialize`] for this model and GUID.
-pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String> {
+/// Parses bytes written by [`serialize`] for this model and GUID, by an instance of `origin`.
+pub fn deserialize<M: Model>(bytes: &[u8], guid: &str, origin: Origin) -> Result<Core<M>, String> {
     if bytes.len() < MAGIC.len() + 4 + 4 + 8 + 4 {
         return Err(format!("{} bytes are too few for a serialised FMU state", bytes.len()));
     }
@@ -127,7 +136,18 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str) -> Result<Core<M>, String
     if len != body.len() - r.at {
         return Err(format!("payload length {len} does not match the {} bytes present", body.len() - r.at));
     }
+    let taken = decode_origin(r.take(1)?[0], r.take(1)?[0])?;
+    if taken != origin {
+        return Err(format!(
+            "the state was taken by {}, and this instance is {}",
+            origin_name(taken),
+            origin_name(origin)
+        ));
+    }
     let state = decode_mode(r.take(1)?[0])?;
+    if !can_save(state, origin) {
+        return Err(format!("state {state:?}, which {} never saves", origin_name(origin)));
+    }
     let (time, start_time, last_successful_time) = (r.f64()?, r.f64()?, r.f64()?);
     let mut opt = || -> Result<Option<f64>, String> {
         let some = r.take(1)?[0] != 0;
@@ -242,6 +262,35 @@ fn put_f64(out: &mut Vec<u8>, x: f64) {
 }
 fn put_u64(out: &mut Vec<u8>, x: u64) {
     out.extend_from_slice(&x.to_le_bytes());
+}
+
+/// Whether an instance of `origin` can take an FMU state in `state`: never inside doStep's
+/// Intermediate Update Mode (FMI 3.0, 4.2.3: the FMU state functions are not among its calls;
+/// FMI 2.0 has no such mode), never in StepCanceled (no step is asynchronous), and only in the
+/// states of its interface (Event Mode: both).
+fn can_save(state: Mode, (_, interface): Origin) -> bool {
+    !matches!(state, Mode::IntermediateUpdate | Mode::StepCanceled)
+        && state.interface().is_none_or(|i| i == interface)
+}
+
+/// An instance's FMI version and interface for people.
+fn origin_name((version, interface): Origin) -> String {
+    let v = if version == Version::Fmi2 { "2.0" } else { "3.0" };
+    format!("an FMI {v} {interface:?} instance")
+}
+
+fn decode_origin(version: u8, interface: u8) -> Result<Origin, String> {
+    let version = match version {
+        0 => Version::Fmi2,
+        1 => Version::Fmi3,
+        _ => return Err(format!("invalid FMI version code {version}")),
+    };
+    let interface = match interface {
+        0 => Interface::ModelExchange,
+        1 => Interface::CoSimulation,
+        _ => return Err(format!("invalid interface code {interface}")),
+    };
+    Ok((version, interface))
 }
 
 fn mode_code(s: Mode) -> u8 {
