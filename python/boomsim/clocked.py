@@ -93,7 +93,13 @@ def run_clocked(scenario: dict, boom: str = "rigid", stop_time: float | None = N
             ctrl.enterStepMode()
 
         def activate(t: float):
-            """The Clock's activation at t, the controller already in Event Mode: its command."""
+            """The Clock's activation at t, the controller already in Event Mode: its command.
+            Activation k (from 0) is due at shift + k interval: one at another time would skip
+            or repeat one (FMI 3.0, 2.2.8.2), and the master stops."""
+            due = shift + counts["ticks"] * interval
+            if abs(t - due) > 1e-9 * interval:
+                raise RuntimeError(f"activation {counts['ticks'] + 1} of the Clock is due at t = {due:.9g} s, "
+                                   f"not t = {t:.9g} s: the master would {'skip' if t > due else 'repeat'} one")
             counts["ticks"] += 1
             ctrl.setClock([sample], [True])
             ctrl.setReal([vc["p"], vc["u_ref"]], [plant.getReal([vp["p4"]])[0], reference(table, t)])
@@ -129,6 +135,9 @@ def run_clocked(scenario: dict, boom: str = "rigid", stop_time: float | None = N
                 plant.setReal([vp["valve.u_ref"]], [u])
             rows.append([t, reference(table, t), u_comp, u, *plant.getReal(out_p)])
         data = np.array(rows)
+        due = int(np.floor((t_end - shift) / interval + 1e-9)) + 1
+        if counts["ticks"] != due:
+            raise RuntimeError(f"{counts['ticks']} activations of the Clock in {t_end} s; its times give {due}")
         if not me:
             counts["rhs"] = int(plant.getReal([vp["solver.rhs_evals"]])[0])
     finally:

@@ -37,13 +37,15 @@ MODELS = {"lag": {}, "PVES loop": {"valve.omega_loop": LOOP_GAIN}}
 CATALOGUE = ["A", "B", "C1.1", "C1.2", "C1.3", "C2.1", "C2.2", "C2.3", "C3.1", "C3.2", "C3.3"]
 
 
-def run(scenario: dict, model: str, step: float = RIG_STEP, boom: str = "rigid", p4: float | None = None):
+def run(scenario: dict, model: str, step: float = RIG_STEP, boom: str = "rigid", p4: float | None = None,
+        tolerance: float | None = None):
     """One run at `step` with the valve model `model`, the feedback from the step (t0), the
-    rod side pre-charged to `p4` bar if given."""
+    rod side pre-charged to `p4` bar if given, the plant's integrator at `tolerance` (default:
+    the scenario's)."""
     params = dict(MODELS[model])
     if p4 is not None:
         params["start.p4"] = p4 * metrics.BAR
-    return cosim.run(scenario, boom, step=step, feedback_start="t0", params=params)
+    return cosim.run(scenario, boom, step=step, feedback_start="t0", params=params, tolerance=tolerance)
 
 
 def row(scenario: dict, model: str, step: float, boom: str, p4: float | None) -> dict:

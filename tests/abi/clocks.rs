@@ -167,7 +167,7 @@ fn the_clock_is_activated_at_its_times_and_its_instant_ends_with_update_discrete
         assert!(i.last_error().contains("which is none of its times 0.005 + i 0.005 s"), "{}", i.last_error());
     }
     let i = running(50e5, -0.05);
-    activate(&i, 3.0 * T, 51e5);
+    activate(&i, T, 51e5);
     assert_eq!(unsafe { api::enter_continuous_time_mode::<Cpfc>(i.c) }, ERR);
     assert!(i.last_error().contains("end the instant with fmi3UpdateDiscreteStates"), "{}", i.last_error());
 }
@@ -308,4 +308,89 @@ fn co_simulation_with_event_mode_gives_the_commands_of_model_exchange() {
         assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), ERR, "the instant has not ended");
     }
     assert!(cs.last_error().contains("end the instant with fmi3UpdateDiscreteStates"), "{}", cs.last_error());
+}
+
+/// A Co-Simulation instance with Event Mode in Step Mode at t = 0, p = 50 bar, u_ref = -0.05.
+fn stepping() -> Inst<Cpfc> {
+    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), (true, false)).expect("Co-Simulation with Event Mode");
+    unsafe {
+        assert_eq!(api::enter_initialization_mode::<Cpfc>(cs.c, false, 0.0, 0.0, false, 0.0), OK);
+        assert_eq!((cs.set(vr::P, 50e5), cs.set(vr::U_REF, -0.05)), (OK, OK));
+        assert_eq!(api::exit_initialization_mode::<Cpfc>(cs.c), OK);
+        assert_eq!(update(&cs), OK);
+        assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), OK);
+    }
+    cs
+}
+
+/// Issue 46, rule 4: a skipped activation is refused. FMI 3.0, 2.2.8.2: the importer activates
+/// a periodic Clock at each of its times t_i = t_start + shift + i interval (here 5 ms, 10 ms,
+/// ...). In Co-Simulation a doStep to 5 ms is fine, a further doStep from there without the
+/// activation is fmi3Error naming it; in Model Exchange fmi3SetTime past 5 ms is; a state that
+/// claims a time past an activation not made (forged) cannot activate the next one. (Before the
+/// rule the next activation advanced the filter by 5 ms although 10 ms had passed: u_comp 9 %
+/// off.) fmi3Error leaves the instance Terminated (2.3.1).
+#[test]
+fn a_skipped_activation_is_refused() {
+    let cs = stepping();
+    assert_eq!(cs.step(0.0, T), OK, "to the first activation");
+    assert_eq!(cs.step(T, T), ERR, "on without activating the Clock");
+    let e = cs.last_error();
+    assert!(e.contains("skip activation 1 of Clock \"sample\" at t = 0.005") && e.contains("2.2.8.2"), "{e}");
+
+    let me = running(50e5, -0.05);
+    unsafe {
+        assert_eq!(api::set_time::<Cpfc>(me.c, 0.004), OK, "before the activation");
+        assert_eq!(api::set_time::<Cpfc>(me.c, T), OK, "on it");
+        assert_eq!(api::set_time::<Cpfc>(me.c, 0.007), ERR, "past it");
+    }
+    assert!(me.last_error().contains("time = 0.007 would skip activation 1"), "{}", me.last_error());
+
+    let me = running(50e5, -0.05);
+    let mut forged = crate::fmi3_api::serialize(&me);
+    let at = crate::common::time_offset(&forged);
+    crate::common::forge(&mut forged, at, 2.0 * T);
+    unsafe {
+        let mut s = std::ptr::null_mut();
+        assert_eq!(api::deserialize_fmu_state::<Cpfc>(me.c, forged.as_ptr(), forged.len(), &mut s), OK);
+        assert_eq!(api::set_fmu_state::<Cpfc>(me.c, s), OK, "{}", me.last_error());
+        assert_eq!(api::free_fmu_state::<Cpfc>(me.c, &mut s), OK);
+    }
+    unsafe { assert_eq!(api::enter_event_mode::<Cpfc>(me.c), OK) };
+    assert_eq!(set_clock(&me, true), ERR, "activation 2 before activation 1");
+    assert!(me.last_error().contains("skip activation 1"), "{}", me.last_error());
+}
+
+/// Issue 46, rule 5: a double activation is refused. FMI 3.0, 2.2.8.2: a periodic Clock is
+/// activated once at each of its times. A second fmi3SetClock after fmi3UpdateDiscreteStates
+/// ended the instant, in the same Event Mode or in a second Event Mode at the same time, would
+/// advance the filter again (u_comp 0.0829 instead of 0.0896 at 10 ms): fmi3Error naming the
+/// rule. Set again while still active, in the same instant, it is the same activation: the
+/// command is that of one activation, bit for bit.
+#[test]
+fn a_double_activation_is_refused() {
+    for second_event_mode in [false, true] {
+        let me = running(50e5, -0.05);
+        if second_event_mode {
+            tick(&me, T, 50.5e5);
+            unsafe { assert_eq!(api::enter_event_mode::<Cpfc>(me.c), OK) };
+        } else {
+            activate(&me, T, 50.5e5);
+            assert_eq!(update(&me), OK);
+        }
+        assert_eq!(set_clock(&me, true), ERR, "a second activation at 5 ms");
+        let e = me.last_error();
+        assert!(e.contains("was activated at t = 0.005 already") && e.contains("2.2.8.2"), "{e}");
+    }
+    let (once, twice) = (running(50e5, -0.05), running(50e5, -0.05));
+    activate(&once, T, 50.5e5);
+    activate(&twice, T, 50.5e5);
+    assert_eq!(set_clock(&twice, true), OK, "set again in the same instant");
+    assert_eq!(twice.get(vr::U_COMP).to_bits(), once.get(vr::U_COMP).to_bits());
+    assert_eq!((update(&once), update(&twice)), (OK, OK));
+    unsafe {
+        assert_eq!(api::enter_continuous_time_mode::<Cpfc>(once.c), OK);
+        assert_eq!(api::enter_continuous_time_mode::<Cpfc>(twice.c), OK);
+    }
+    assert_eq!(tick(&twice, 2.0 * T, 51e5), tick(&once, 2.0 * T, 51e5), "the next activation alike");
 }

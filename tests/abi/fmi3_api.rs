@@ -501,7 +501,8 @@ fn misuse_answers_with_error_and_a_message_and_changes_nothing() {
     assert_eq!(i.get(boomsim::fmu::instance::INDEPENDENT_VR), 2e-3 + 1e-3);
 }
 
-fn serialize<M: Model>(i: &Inst<M>) -> Vec<u8> {
+/// The instance's current state, serialised (fmi3GetFMUState, size, serialise, free).
+pub(crate) fn serialize<M: Model>(i: &Inst<M>) -> Vec<u8> {
     unsafe {
         let (mut s, mut n) = (null_mut(), 0);
         assert_eq!(api::get_fmu_state::<M>(i.c, &mut s), OK);

@@ -186,11 +186,11 @@ pub fn time_offset(b: &[u8]) -> usize {
 }
 
 /// Byte offset of the value of the variable at table index `i` in a serialised state of `M`:
-/// after the payload's codes 3, three times 24, two optional times 2 x 9, outputs flag 1 and
+/// after the payload's codes 3, three times 24, the Clock's activations 8, two optional times 2 x 9, outputs flag 1 and
 /// the value count 8, each value is a type tag (0 Real: 8 bytes, 1 Integer: 4, 2 Boolean: 1,
 /// 3 String: length 8 + bytes).
 pub fn value_offset<M: Model>(b: &[u8], i: usize) -> usize {
-    let mut at = time_offset(b) + 24 + 18 + 1 + 8;
+    let mut at = time_offset(b) + 24 + 8 + 18 + 1 + 8;
     for _ in 0..i {
         at += 1 + match b[at] {
             0 => 8,

@@ -20,7 +20,9 @@ fn committed_model_descriptions_are_current() {
 }
 
 /// FMI 2.0 section 2.2.7: unique value references, declared units, start within range, and
-/// output dependencies on inputs only.
+/// output dependencies on inputs only; FMI 3.0, 2.4.8: a clocked output's also on the
+/// discrete-time states (the clocked variables with a previous value), and on its Clock (an
+/// input), which must be listed.
 fn check_table(id: &str, vars: &[Variable]) {
     for (i, v) in vars.iter().enumerate() {
         assert!(vars[i + 1..].iter().all(|w| w.vr != v.vr && w.name != v.name), "{id}: {} is not unique", v.name);
@@ -34,7 +36,12 @@ fn check_table(id: &str, vars: &[Variable]) {
         }
         for dep in v.depends_on {
             let d = vars.iter().find(|w| w.vr == *dep).expect("dependency exists");
-            assert_eq!(d.causality, Causality::Input, "{id}: {} depends on non-input {}", v.name, d.name);
+            let discrete_state = v.clocked && d.clocked && d.previous.is_some();
+            assert!(d.causality == Causality::Input || discrete_state, "{id}: {} depends on non-input {}", v.name, d.name);
+        }
+        if v.clocked && !v.depends_on.is_empty() {
+            let clock = vars.iter().find(|w| matches!(w.kind, Kind::Clock { .. })).expect("a clocked variable's Clock");
+            assert!(v.depends_on.contains(&clock.vr), "{id}: {} does not list its Clock {}", v.name, clock.name);
         }
     }
 }

@@ -94,6 +94,9 @@ pub struct Core<M: Model> {
     pub stop_time: Option<f64>,
     pub tolerance: Option<f64>,
     pub last_successful_time: f64,
+    /// The activations of the model's Clock made since initialisation: the index of the one due
+    /// next (FMI 3.0, 2.2.8.2: a periodic Clock is activated once at each of its times).
+    pub activations: u64,
     /// Whether outputs reflect the current state and inputs.
     pub outputs_current: bool,
     /// Whether the `der()` variables do too (computed when one is read: a Co-Simulation step
@@ -114,6 +117,7 @@ impl<M: Model> Core<M> {
             stop_time: None,
             tolerance: None,
             last_successful_time: 0.0,
+            activations: 0,
             outputs_current: false,
             derivatives_current: false,
         }
@@ -126,12 +130,24 @@ impl<M: Model> Default for Core<M> {
     }
 }
 
-/// The first activation of the model's Clock after `t` (None without a Clock), a time within
-/// [`ACTIVATION_TOLERANCE`] of an activation counting as on it.
-fn next_activation<M: Model>(start: f64, t: f64) -> Option<f64> {
+/// The time of activation `k` (from 0) of the model's Clock in an experiment from `start`, and
+/// how far a time may lie from it and still be on it ([`ACTIVATION_TOLERANCE`] of the interval);
+/// `None` without a Clock.
+pub(crate) fn activation<M: Model>(start: f64, k: u64) -> Option<(f64, f64)> {
     let (first, interval) = activations::<M>(start)?;
-    let i = ((t - first) / interval + ACTIVATION_TOLERANCE).floor().max(-1.0) + 1.0;
-    Some(first + i * interval)
+    Some((first + k as f64 * interval, ACTIVATION_TOLERANCE * interval))
+}
+
+/// Why the Clock's activation `k`, due at `due`, cannot be passed: the importer has not made it.
+fn skipped<M: Model>(k: u64, due: f64, what: &str) -> String {
+    let clock = clock_row::<M>().map_or("", |i| M::VARIABLES[i].name);
+    format!(
+        "{what} would skip activation {} of Clock \"{clock}\" at t = {}, which was not made: at each of its times the \
+         importer enters Event Mode, activates it (fmi3SetClock) and ends the instant (fmi3UpdateDiscreteStates) \
+         (FMI 3.0, 2.2.8.2: a periodic Clock is activated at every one of its times)",
+        k + 1,
+        num(due)
+    )
 }
 
 /// Whether two values are the same bit for bit (0.0 and -0.0 differ: a model may tell them apart).
@@ -347,6 +363,11 @@ impl<M: Model> Instance<M> {
                 num(t),
                 num(self.core.start_time)
             ));
+        }
+        if let Some((due, near)) = activation::<M>(self.core.start_time, self.core.activations) {
+            if t > due + near {
+                return Err(skipped::<M>(self.core.activations, due, &format!("time = {}", num(t))));
+            }
         }
         self.core.time = t;
         self.core.outputs_current = false;
@@ -821,6 +842,9 @@ impl<M: Model> Instance<M> {
                     v.name
                 ));
             }
+            if *self.core.values.at(i) == Value::Clock(true) {
+                continue; // set again in the same instant: the same activation
+            }
             let (t, (first, interval)) = (self.core.time, activations::<M>(self.core.start_time).ok_or("no Clock")?);
             let k = (t - first) / interval;
             if !(k > -ACTIVATION_TOLERANCE && (k - k.round()).abs() <= ACTIVATION_TOLERANCE) {
@@ -833,10 +857,27 @@ impl<M: Model> Instance<M> {
                     num(interval)
                 ));
             }
-            rows.push(i);
+            let (k, made) = (k.round() as u64, self.core.activations);
+            if k < made {
+                return Err(format!(
+                    "Clock \"{}\" was activated at t = {} already (activation {}); a periodic Clock is activated once \
+                     at each of its times (FMI 3.0, 2.2.8.2), so this would advance its model partition twice",
+                    v.name,
+                    num(t),
+                    k + 1
+                ));
+            }
+            if k > made {
+                let due = first + made as f64 * interval;
+                return Err(skipped::<M>(made, due, &format!("activating Clock \"{}\" at t = {}", v.name, num(t))));
+            }
+            if !rows.contains(&i) {
+                rows.push(i);
+            }
         }
         for i in rows {
             self.core.values.put(i, Value::Clock(true));
+            self.core.activations += 1;
         }
         self.core.outputs_current = false;
         Ok(())
@@ -938,13 +979,16 @@ impl<M: Model> Instance<M> {
                 ));
             }
         }
-        if let Some(next) = next_activation::<M>(c.start_time, c.time) {
-            if t + h > next + TIME_MATCH_RTOL * next.abs().max(1.0) {
+        if let Some((due, near)) = activation::<M>(c.start_time, c.activations) {
+            if c.time >= due - near {
+                return Err(skipped::<M>(c.activations, due, &format!("a step from t = {}", num(t))));
+            }
+            if t + h > due + TIME_MATCH_RTOL * due.abs().max(1.0) {
                 return Err(format!(
                     "a step to t = {} would pass the Clock's activation at t = {}: step to it and activate the \
                      Clock in Event Mode (FMI 3.0, 2.2.8.2: the importer activates a time-based Clock at its times)",
                     num(t + h),
-                    num(next)
+                    num(due)
                 ));
             }
         }

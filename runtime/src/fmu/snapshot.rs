@@ -5,7 +5,7 @@
 //! Byte format, little endian: magic `BOOMSIM\0`, format version (u32), GUID (u32 length +
 //! UTF-8), payload length (u64), payload, CRC-32 of everything before it (u32). The payload holds
 //! the FMI version and interface of the instance that took the state, the state machine state,
-//! times, every variable value, the input derivatives and the model's own state. Any mismatch
+//! times, the Clock's activations made, every variable value, the input derivatives and the model's own state. Any mismatch
 //! (size, GUID, format version, checksum, FMI version, interface, value types) is refused with a
 //! reason, and so is a state machine state that no instance of that FMI version and interface
 //! can save (FMI 2.0 has no Intermediate Update Mode, and no state is taken inside one),
@@ -14,7 +14,7 @@
 //! were not damaged, not that they were written by this FMU.
 
 use super::driver::Driven;
-use super::instance::{in_range, Core, TOLERANCE_RANGE};
+use super::instance::{activation, in_range, Core, TOLERANCE_RANGE};
 use super::log::num;
 use super::machine::{Interface, Mode};
 use super::model::Model;
@@ -37,6 +37,7 @@ pub fn serialize<M: Model>(core: &Core<M>, guid: &str, (version, interface): Ori
     for x in [core.time, core.start_time, core.last_successful_time] {
         put_f64(&mut p, x);
     }
+    put_u64(&mut p, core.activations);
     for opt in [core.stop_time, core.tolerance] {
         p.push(opt.is_some() as u8);
         put_f64(&mut p, opt.unwrap_or(0.0));
@@ -149,6 +150,10 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str, origin: Origin) -> Result
         return Err(format!("state {state:?}, which {} never saves", origin_name(origin)));
     }
     let (time, start_time, last_successful_time) = (r.f64()?, r.f64()?, r.f64()?);
+    let activations = r.u64()?;
+    if activation::<M>(start_time, activations).is_some_and(|(t, _)| !t.is_finite()) {
+        return Err(format!("the serialised FMU state counts {activations} activations of the Clock"));
+    }
     let mut opt = || -> Result<Option<f64>, String> {
         let some = r.take(1)?[0] != 0;
         let x = r.f64()?;
@@ -229,6 +234,7 @@ pub fn deserialize<M: Model>(bytes: &[u8], guid: &str, origin: Origin) -> Result
         stop_time,
         tolerance,
         last_successful_time,
+        activations,
         outputs_current: false,
         derivatives_current: false,
     })

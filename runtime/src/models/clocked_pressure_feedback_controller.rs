@@ -32,8 +32,10 @@ pub const INTERVAL: f64 = 5e-3;
 const VARIABLES: &[Variable] = &[
     row::U_REF.clocked(),
     row::P.clocked(),
-    row::U.clocked().depends(&[vr::U_REF, vr::P]).initial_depends(&[vr::U_REF]),
-    row::U_COMP.clocked().depends(&[vr::P]).initial_depends(&[]),
+    // FMI 3.0, 2.4.8: the dependencies of a clocked variable list its Clock too, and the
+    // discrete-time states its partition starts from (the filter's x and p sample).
+    row::U.clocked().depends(&[vr::U_REF, vr::P, vr::SAMPLE, vr::P_LP, vr::P_SAMPLE]).initial_depends(&[vr::U_REF]),
+    row::U_COMP.clocked().depends(&[vr::P, vr::SAMPLE, vr::P_LP, vr::P_SAMPLE]).initial_depends(&[]),
     row::K_F,
     row::OMEGA_F,
     row::Q_RATED,
@@ -85,7 +87,8 @@ next activation: the command the continuous PressureFeedbackController gives whe
 Event Mode, activate <code>sample</code>, set <i>p</i> = p4 and <i>u</i><sub>ref</sub>, read <i>u</i>, call
 fmi3UpdateDiscreteStates and pass <i>u</i> to the plant. In Co-Simulation (instantiated with eventModeUsed, which a
 Clock requires) step to each activation and activate the Clock in Event Mode (fmi3EnterEventMode, fmi3SetClock, the
-inputs, the outputs, fmi3UpdateDiscreteStates, fmi3EnterStepMode); a step past an activation is refused. Clocked
+inputs, the outputs, fmi3UpdateDiscreteStates, fmi3EnterStepMode); a step past an activation is refused. Each
+activation is made once: a skipped or repeated one is refused with fmi3Error (FMI 3.0, 2.2.8.2). Clocked
 variables can be set and read only while the Clock is active (and in Initialization Mode). FMI 3.0 only.</p>"#;
 
 /// The sampled controller: its parameters and its clocked states (this activation's and the
