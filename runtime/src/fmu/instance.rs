@@ -679,9 +679,6 @@ impl<M: Model> Instance<M> {
         wanted: BaseType,
         read: impl Fn(&Value) -> T,
     ) -> Result<(), String> {
-        if self.held(vrs, out, wanted, &read) {
-            return Ok(());
-        }
         self.refresh_outputs()?;
         for (k, &vr) in vrs.iter().enumerate() {
             if self.version == Version::Fmi3 && vr == INDEPENDENT_VR && wanted == BaseType::Real {
@@ -708,24 +705,6 @@ impl<M: Model> Instance<M> {
             out[k] = read(value);
         }
         Ok(())
-    }
-
-    /// Reads Reals that the model holds ([`Model::held_output`]) while the outputs are not
-    /// written: `true` if every one of `vrs` is such and finite (read into `out`), else `false`
-    /// (`out` is then written by the full read).
-    fn held<T>(&self, vrs: &[u32], out: &mut [T], wanted: BaseType, read: &impl Fn(&Value) -> T) -> bool {
-        let c = &self.core;
-        let held = !c.outputs_current && wanted == BaseType::Real && c.mode != Mode::InitializationMode;
-        let Some(model) = c.model.as_deref().filter(|_| held) else {
-            return false;
-        };
-        for (o, &r) in out.iter_mut().zip(vrs) {
-            match model.held_output(r).filter(|x| x.is_finite()) {
-                Some(x) => *o = read(&Value::Real(x)),
-                None => return false,
-            }
-        }
-        true
     }
 
     /// Writes values, all or nothing: every value is checked (type, settability, range) before

@@ -149,13 +149,6 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Writes outputs and locals from the current state and inputs.
     fn outputs(&self, values: &mut Values);
 
-    /// The output or local `vr` if the model holds it without computing the others (a
-    /// continuous state): a master that reads only such between steps, as the controller reads
-    /// p4, pays for no [`Model::outputs`]. Default: none.
-    fn held_output(&self, _vr: u32) -> Option<f64> {
-        None
-    }
-
     /// Writes the continuous states ([`Model::STATES`] order).
     fn continuous_states(&self, x: &mut [f64]);
 

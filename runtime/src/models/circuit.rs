@@ -38,18 +38,13 @@ pub(crate) const ME_TOLERANCE: f64 = 1e-6;
 pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e-3, 1.0];
 
 /// The outputs and locals that are circuit states: (value reference, index in the state).
-pub(crate) const STATE_ROWS: [(u32, usize); N_CIRCUIT] = [
+const STATE_ROWS: [(u32, usize); N_CIRCUIT] = [
     (vr::P2, circuit::P2),
     (vr::P3, circuit::P3),
     (vr::P4, circuit::P4),
     (vr::X_V, circuit::X_V),
     (vr::U_CBV, circuit::U_CBV),
 ];
-
-/// The output or local `r` if it is a circuit state, from the state `c` (no evaluation).
-pub(crate) fn state_row(c: &[f64], r: u32) -> Option<f64> {
-    STATE_ROWS.iter().find(|&&(v, _)| v == r).map(|&(_, i)| c[i])
-}
 
 /// The circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
 /// load-sensing pressure) for state `c` and its evaluation `e`, as (value reference, value).

@@ -294,10 +294,6 @@ impl Model for HydraulicBoom {
         }
     }
 
-    fn held_output(&self, r: u32) -> Option<f64> {
-        super::circuit::state_row(&self.state, r)
-    }
-
     type Ode = Plant;
 
     const INTERMEDIATE_INPUTS: &'static [u32] = &[vr::U_REF];
