@@ -394,3 +394,33 @@ fn a_double_activation_is_refused() {
     }
     assert_eq!(tick(&twice, 2.0 * T, 51e5), tick(&once, 2.0 * T, 51e5), "the next activation alike");
 }
+
+/// Found by the fuzzer (examples/fuzz/regressions.txt): far from t = 0 the Clock's times are as
+/// strict. With startTime 1e6 s (or 1e9 s) a step past the first activation at start + 5 ms was
+/// accepted (the step-time tolerance, relative to the time, was 1 ms there, 1 s at 1e9); an
+/// activation is now matched within 1e-6 of the interval or four ulps of its time, whichever is
+/// more, and an activation at its time is accepted there too.
+#[test]
+fn the_clock_is_as_strict_far_from_time_zero() {
+    for start in [1e6, 1e9] {
+        let cs = stepping_from(start);
+        assert_eq!(cs.step(start, 0.0058), ERR, "start {start}: past the activation at start + 5 ms");
+        assert!(cs.last_error().contains("would pass the Clock's activation"), "{}", cs.last_error());
+        let cs = stepping_from(start);
+        assert_eq!(cs.step(start, T), OK, "start {start}: to the activation");
+        unsafe { assert_eq!(api::enter_event_mode::<Cpfc>(cs.c), OK) };
+        assert_eq!(set_clock(&cs, true), OK, "start {start}: {}", cs.last_error());
+    }
+}
+
+/// [`stepping`] from `start`.
+fn stepping_from(start: f64) -> Inst<Cpfc> {
+    let cs = Inst::<Cpfc>::try_new(false, &token::<Cpfc>(), (true, false)).unwrap();
+    unsafe {
+        assert_eq!(api::enter_initialization_mode::<Cpfc>(cs.c, false, 0.0, start, false, 0.0), OK);
+        assert_eq!(api::exit_initialization_mode::<Cpfc>(cs.c), OK);
+        assert_eq!(update(&cs), OK);
+        assert_eq!(api::enter_step_mode::<Cpfc>(cs.c), OK);
+    }
+    cs
+}
