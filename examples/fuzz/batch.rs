@@ -36,17 +36,47 @@ const EXIT_VIOLATION: c_int = 1;
 /// Exit status of a child in which the fuzzer itself panicked.
 const EXIT_FUZZER_PANIC: c_int = 3;
 
-/// Fuzzes one library through one FMI version for `budget`, batch after batch, printing the first
-/// failure of each kind.
-pub fn fuzz_library(library: &dyn Subject, master: u64, budget: Duration) -> Result<Tally, String> {
+/// Which sequences a library runs: those of a master seed (`rng::sequence_seed`) for a time
+/// budget or a fixed number of them, or the seeds listed (the regressions).
+pub enum Sequences<'a> {
+    Timed { master: u64, budget: Duration },
+    Counted { master: u64, count: u64 },
+    Listed(&'a [u64]),
+}
+
+impl Sequences<'_> {
+    /// The seed of sequence `k` of `library`, if it runs that many.
+    fn seed(&self, library: &dyn Subject, k: u64) -> Option<u64> {
+        let seed = |master| sequence_seed(master, library.identifier(), library.fmi(), k);
+        match *self {
+            Sequences::Timed { master, .. } => Some(seed(master)),
+            Sequences::Counted { master, count } => (k < count).then(|| seed(master)),
+            Sequences::Listed(seeds) => seeds.get(k as usize).copied(),
+        }
+    }
+
+    /// Whether sequences drawn from a master seed run (not listed ones): a failure is new.
+    pub fn drawn(&self) -> bool {
+        !matches!(self, Sequences::Listed(_))
+    }
+}
+
+/// Fuzzes one library through one FMI version with `sequences`, batch after batch, printing
+/// the first failure of each kind. Only a time budget makes the run depend on the clock.
+pub fn fuzz_library(library: &dyn Subject, sequences: &Sequences) -> Result<Tally, String> {
     let mut report = SharedReport::new()?;
     let started = Instant::now();
-    let deadline = started + budget;
+    let deadline = match sequences {
+        Sequences::Timed { budget, .. } => Some(started + *budget),
+        _ => None,
+    };
     let mut tally = Tally::default();
     let mut next = 0;
-    while Instant::now() < deadline {
-        let seeds: Vec<u64> =
-            (next..next + BATCH).map(|k| sequence_seed(master, library.identifier(), library.fmi(), k)).collect();
+    while deadline.is_none_or(|d| Instant::now() < d) {
+        let seeds: Vec<u64> = (next..next + BATCH).map_while(|k| sequences.seed(library, k)).collect();
+        if seeds.is_empty() {
+            break;
+        }
         report.clear();
         let ending = run_batch(library, &seeds, &mut report, deadline)?;
         let r = report.get();
@@ -58,7 +88,7 @@ pub fn fuzz_library(library: &dyn Subject, master: u64, budget: Duration) -> Res
         if let Some(ending) = ending {
             let name = format!("{} (FMI {})", library.identifier(), library.fmi());
             if tally.kinds.insert(r.signature(&name, &ending)) {
-                r.print_failure(library, seeds[r.running as usize], &ending);
+                r.print_failure(library, seeds[r.running as usize], &ending, sequences.drawn());
             }
             tally.failures += 1;
             tally.counts.sequences += 1;
@@ -75,7 +105,7 @@ fn run_batch(
     library: &dyn Subject,
     seeds: &[u64],
     report: &mut SharedReport,
-    deadline: Instant,
+    deadline: Option<Instant>,
 ) -> Result<Option<String>, String> {
     let mut fds = [0; 2];
     // SAFETY: pipe fills two descriptors.
@@ -106,9 +136,15 @@ fn run_batch(
 }
 
 /// The child: runs the sequences, a heartbeat byte before each; the exit status.
-fn run_child(library: &dyn Subject, seeds: &[u64], report: &mut Report, heartbeat: c_int, deadline: Instant) -> c_int {
+fn run_child(
+    library: &dyn Subject,
+    seeds: &[u64],
+    report: &mut Report,
+    heartbeat: c_int,
+    deadline: Option<Instant>,
+) -> c_int {
     for (i, &seed) in seeds.iter().enumerate() {
-        if i > 0 && Instant::now() >= deadline {
+        if i > 0 && deadline.is_some_and(|d| Instant::now() >= d) {
             break;
         }
         report.running = i as u64;

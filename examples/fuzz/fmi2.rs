@@ -52,9 +52,8 @@ impl Binding for Fmi2 {
             fmi2GetNominalsOfContinuousStates)
     }
 
-    /// A Co-Simulation instance with logger and memory callbacks.
-    /// Co-Simulation, with logger and memory callbacks.
-    unsafe fn instantiates(&self, guid: &CStr) -> bool {
+    /// Co-Simulation, with logger and memory callbacks (FMI 2.0 has no Event Mode to ask for).
+    unsafe fn instantiates(&self, guid: &CStr, _: bool) -> bool {
         let callbacks = Callbacks { logger: true, memory: true }.functions();
         let c = self.fmi2Instantiate(
             c"fuzz".as_ptr(),

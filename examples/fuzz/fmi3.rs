@@ -47,8 +47,9 @@ impl Binding for Fmi3 {
     }
 
     /// Co-Simulation, without a logger.
-    unsafe fn instantiates(&self, token: &CStr) -> bool {
-        let c = instantiate(self, &Instantiation3::quiet(Text::Bytes(token.to_owned())));
+    unsafe fn instantiates(&self, token: &CStr, event_mode_used: bool) -> bool {
+        let quiet = Instantiation3::quiet(Text::Bytes(token.to_owned()));
+        let c = instantiate(self, &Instantiation3 { event_mode_used, ..quiet });
         if !c.is_null() {
             self.fmi3FreeInstance(c);
         }

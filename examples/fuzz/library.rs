@@ -29,8 +29,9 @@ pub trait Binding: Sized {
     unsafe fn open(path: &Path) -> Result<Self, String>;
     /// The first function of the version that the library does not export.
     fn first_missing(&self) -> Option<&'static str>;
-    /// Whether a Co-Simulation instantiation named "fuzz" with `token` returns an instance (then freed).
-    unsafe fn instantiates(&self, token: &CStr) -> bool;
+    /// Whether a Co-Simulation instantiation named "fuzz" with `token` returns an instance (then
+    /// freed); `event_mode_used` for an FMI 3.0 model with a Clock, which requires it.
+    unsafe fn instantiates(&self, token: &CStr, event_mode_used: bool) -> bool;
     fn session<'a>(library: &'a Library<Self>, report: &'a mut Report) -> Self::Session<'a>;
 }
 
@@ -52,7 +53,7 @@ impl<F: Binding> Library<F> {
         }
         let token = CString::new(model.guid.as_str()).map_err(|e| e.to_string())?;
         // SAFETY: a valid string; the instance is freed once.
-        if !unsafe { fmi.instantiates(&token) } {
+        if !unsafe { fmi.instantiates(&token, model.clock.is_some()) } {
             return Err(format!(
                 "{} refuses the {} {} of {xml}: a stale build? (cargo build --release)",
                 path.display(),

@@ -6,7 +6,8 @@
 //! A call forbidden here must return fmi3Error. Where the text leaves room, nothing is claimed.
 //! Issue 25 adds: counts larger than the model allows (`oversized`, in any state), fmi3SetTime
 //! in Continuous-Time Mode only and not before the startTime (`View::set_time_refusal`), and
-//! continuous-time states settable in Continuous-Time Mode (FMI 3.0.2, 3.2.4).
+//! continuous-time states settable in Continuous-Time Mode (FMI 3.0.2, 3.2.4). The rules of a
+//! Clock are `clock_rules`'.
 
 use crate::model_description::{Description, Type};
 use crate::ops::Arr;
@@ -17,7 +18,9 @@ use crate::view::{Phase, View};
 /// Why the call must fail, if it must: `view` is the instance's, `me` its interface.
 /// `event_mode`: a Co-Simulation instance with eventModeUsed.
 pub fn forbidden(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Description) -> Option<String> {
-    count_error(op, me, m).or_else(|| state_error(op, view, (me, event_mode), m))
+    count_error(op, me, m)
+        .or_else(|| state_error(op, view, (me, event_mode), m))
+        .or_else(|| crate::clock_rules::forbidden(op, view, m))
 }
 
 /// Counts larger than the model allows, in any state (issue 25 item 1): value-reference lists
@@ -81,6 +84,7 @@ fn state_error(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Descri
             known.then(|| format!("no variable is a {}", crate::ops3::OTHER_TYPES[*ty]))
         }
         Op3::Refused { .. } => Some("not provided by this FMU (modelDescription.xml)".into()),
+        Op3::SetClock { .. } => state(phase != Terminated),
         Op3::Derivative { adjoint: true, .. } if !m.adjoint => Some("providesAdjointDerivatives=\"false\"".into()),
         Op3::Derivative { .. } => state(phase != Instantiated),
         Op3::EnterStepMode => cs_only(event_mode && phase == EventMode),

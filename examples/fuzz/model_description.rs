@@ -6,7 +6,7 @@
 use crate::rng::Rng;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::XmlVersion;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::os::raw::c_int;
 use std::path::Path;
 
@@ -35,9 +35,23 @@ pub struct Variable {
     pub min: f64,
     pub max: f64,
     start: Option<f64>,
+    /// FMI 3.0: the variable has a `clocks` attribute (set and read only while its Clock is
+    /// active or in Initialization Mode).
+    pub clocked: bool,
 }
 
-type Attributes = HashMap<String, String>;
+/// An FMI 3.0 input Clock with a constant interval: active at start + shift + k interval.
+#[derive(Debug, Clone)]
+pub struct Clock {
+    pub name: String,
+    pub vr: u32,
+    pub interval: f64,
+    pub shift: f64,
+}
+
+/// An element's attributes. Not a HashMap: its random order of drops would make the heap's
+/// layout, and so the FMU state pointers an allocator reuses, differ from run to run.
+type Attributes = BTreeMap<String, String>;
 
 impl Variable {
     /// From the attributes of a ScalarVariable and of its type element (`Real`, `Integer`, ...);
@@ -68,6 +82,7 @@ impl Variable {
             derivative: typed.get("derivative").and_then(|s| s.parse().ok()),
             min: number("min").unwrap_or(lo),
             max: number("max").unwrap_or(hi),
+            clocked: scalar.contains_key("clocks"),
             name,
             vr,
             ty,
@@ -131,6 +146,20 @@ impl Variable {
     }
 }
 
+impl Clock {
+    /// From the attributes of a `Clock` element with `intervalDecimal` (and `shiftDecimal`, else 0).
+    fn new(a: &Attributes) -> Result<Self, String> {
+        let number = |key: &str| a.get(key).map(|s| s.parse::<f64>().map_err(|e| format!("Clock {key}: {e}")));
+        Ok(Clock {
+            name: a.get("name").cloned().ok_or("a Clock without name")?,
+            vr: a.get("valueReference").and_then(|s| s.parse().ok()).ok_or("a Clock without valueReference")?,
+            interval: number("intervalDecimal")
+                .ok_or("a Clock without intervalDecimal: the fuzzer knows constant ones")??,
+            shift: number("shiftDecimal").unwrap_or(Ok(0.0))?,
+        })
+    }
+}
+
 /// The model description, with the lists the generators draw from.
 pub struct Description {
     pub identifier: String,
@@ -142,6 +171,8 @@ pub struct Description {
     pub adjoint: bool,
     /// `hasEventMode` of the CoSimulation element (FMI 3.0): eventModeUsed is accepted.
     pub event_mode: bool,
+    /// The input Clock (FMI 3.0; one at most), not among `variables`.
+    pub clock: Option<Clock>,
     /// `providesDirectionalDerivative` (FMI 3.0: `providesDirectionalDerivatives`) of the
     /// CoSimulation element.
     pub directional: bool,
@@ -151,12 +182,16 @@ pub struct Description {
     by_type: [Vec<u32>; 4],
     /// Value references of the Real outputs.
     pub outputs: Vec<u32>,
+    /// Value references of the Reals read after every step that succeeded (`step_outputs`):
+    /// the outputs and locals that are not clocked.
+    pub after_step: Vec<u32>,
     /// Indices of the variables that may be set before initialisation ends (FMI 2.0, 2.2.7:
     /// inputs and non-calculated parameters), but `boom.flexible`, which the planner sets itself.
     pub init_settable: Vec<usize>,
-    /// Indices of the variables that may be set between steps: inputs and tunable parameters.
+    /// Indices of the variables that may be set between steps: inputs that are not clocked and
+    /// tunable parameters.
     pub step_settable: Vec<usize>,
-    /// Indices of the Real inputs (for input derivatives).
+    /// Indices of the Real inputs that are not clocked (for input derivatives).
     pub real_inputs: Vec<usize>,
     /// `boom.flexible`, when the model has it.
     pub flexible: Option<u32>,
@@ -194,7 +229,7 @@ impl Description {
         let mut reader = quick_xml::Reader::from_str(xml);
         let (mut identifier, mut guid, mut categories, mut variables) = (None, None, Vec::new(), Vec::new());
         let (mut states, mut event_indicators, mut fmi3, mut adjoint, mut directional) = (0, 0, false, false, false);
-        let mut event_mode = false;
+        let (mut event_mode, mut clock) = (false, None);
         let mut scalar: Option<Attributes> = None;
         // ModelStructure: (the section, the index or value reference) of every Unknown element.
         let (mut section, mut structure) = (String::new(), Vec::<(String, u32)>::new());
@@ -235,11 +270,12 @@ impl Description {
                             states += usize::from(tag == "Float64" && a.contains_key("derivative"));
                             variables.push(Variable::new(&a, tag, &a)?);
                         }
+                        "Clock" if fmi3 && clock.is_none() => clock = Some(Clock::new(&a)?),
                         tag @ ("Float32" | "Int8" | "UInt8" | "Int16" | "UInt16" | "UInt32" | "Int64" | "UInt64"
                         | "Enumeration" | "Binary" | "Clock")
                             if fmi3 =>
                         {
-                            return Err(format!("a {tag} variable: the fuzzer knows Float64, Int32, Boolean and String"));
+                            return Err(format!("a {tag} variable: the fuzzer knows Float64, Int32, Boolean, String, a Clock"));
                         }
                         tag @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration") => {
                             states += usize::from(tag == "Real" && a.contains_key("derivative"));
@@ -260,7 +296,7 @@ impl Description {
         let indices = |keep: &dyn Fn(&Variable) -> bool| -> Vec<usize> {
             variables.iter().enumerate().filter(|(_, v)| keep(v)).map(|(i, _)| i).collect()
         };
-        let input = |v: &Variable| v.causality == "input";
+        let input = |v: &Variable| v.causality == "input" && !v.clocked;
         let parameter = |v: &Variable| v.causality == "parameter";
         // FMI 2.0 refers to variables by their index (from 1), FMI 3.0 by value reference.
         let vr_of = |reference: u32| match fmi3 {
@@ -283,9 +319,14 @@ impl Description {
         Ok(Description {
             by_type: TYPES.map(|t| variables.iter().filter(|v| v.ty == t).map(|v| v.vr).collect()),
             outputs: variables.iter().filter(|v| v.ty == Type::Real && v.causality == "output").map(|v| v.vr).collect(),
+            after_step: variables
+                .iter()
+                .filter(|v| v.ty == Type::Real && !v.clocked && matches!(v.causality.as_str(), "output" | "local"))
+                .map(|v| v.vr)
+                .collect(),
             init_settable: indices(&|v| {
                 v.variability != "constant"
-                    && (input(v) || (parameter(v) && v.initial.as_deref() != Some("calculated")))
+                    && (v.causality == "input" || (parameter(v) && v.initial.as_deref() != Some("calculated")))
                     && Some(v.vr) != flexible
             }),
             step_settable: indices(&|v| input(v) || (parameter(v) && v.variability == "tunable")),
@@ -293,7 +334,7 @@ impl Description {
             initial_unknowns: listed("InitialUnknowns"),
             initial_knowns: variables
                 .iter()
-                .filter(|v| v.ty == Type::Real && v.variability != "constant" && (input(v) || v.exact()))
+                .filter(|v| v.ty == Type::Real && v.variability != "constant" && (v.causality == "input" || v.exact()))
                 .map(|v| v.vr)
                 .collect(),
             state_vrs,
@@ -307,6 +348,7 @@ impl Description {
             fmi3,
             adjoint,
             event_mode,
+            clock,
             directional,
             flexible,
             states,

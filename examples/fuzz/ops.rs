@@ -25,6 +25,14 @@ impl<T> Arr<T> {
         }
     }
 
+    /// The elements (none for NULL).
+    pub fn items(&self) -> &[T] {
+        match self {
+            Arr::Items(v) => v,
+            Arr::Null(_) => &[],
+        }
+    }
+
     pub fn ptr(&self) -> *const T {
         match self {
             Arr::Items(v) => v.as_ptr(),

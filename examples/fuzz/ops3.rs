@@ -102,6 +102,10 @@ pub enum Op3 {
     OtherType { ty: usize, set: bool, vr: Arr<u32> },
     /// fmi3<REFUSED[function]>.
     Refused { function: usize },
+    /// fmi3SetClock and fmi3GetClock (`clock_rules`; the FMUs without a Clock get
+    /// `OtherType`): fmi3Clock values as bytes, so that values other than 0 and 1 can be passed.
+    SetClock { vr: Arr<u32>, values: Arr<u8> },
+    GetClock { vr: Arr<u32>, null_values: bool },
     State(StateCall),
     /// fmi3GetDirectionalDerivative or (`adjoint`) fmi3GetAdjointDerivative: `n_sensitivity`
     /// elements are written.

@@ -255,9 +255,9 @@ fn limit(counted: Counted, m: &Description) -> usize {
 }
 
 /// The most value references a call may pass: the model's variables (FMI 3.0: with `time`, which
-/// modelDescription/fmi3 lists as the independent variable).
+/// modelDescription/fmi3 lists as the independent variable, and the Clock).
 pub fn max_refs(m: &Description) -> usize {
-    m.variables.len()
+    m.variables.len() + usize::from(m.clock.is_some())
 }
 
 /// Why a list of `n` value references must be refused, if it must (issue 25: longer than the

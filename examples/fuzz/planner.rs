@@ -42,6 +42,11 @@ pub trait Phases<S, O> {
     fn step_failed(&mut self, rng: &mut Rng, s: &S) -> O;
     /// Where the fuzzer does not know the instance's phase.
     fn unknown(&mut self, rng: &mut Rng, s: &S) -> O;
+    /// In Event Mode, where the version has a plan of its own (FMI 3.0 with a Clock); else the
+    /// shared plan.
+    fn event_mode(&mut self, _: &mut Rng, _: &S) -> Option<O> {
+        None
+    }
 }
 
 /// A version's ops as the planner makes them.
@@ -162,8 +167,13 @@ impl<O: Planned> Planner<O> {
 
     /// Queues `ops` for `phase`, an FMU state round trip after them, and returns the first.
     pub fn plan_with_round_trip(&mut self, phase: Phase, ops: Vec<O>) -> Option<O> {
-        self.queue.extend(ops.into_iter().map(|op| (phase, op)));
         self.round_trip.start();
+        self.plan(phase, ops)
+    }
+
+    /// Queues `ops` for `phase` and returns the first.
+    pub fn plan(&mut self, phase: Phase, ops: Vec<O>) -> Option<O> {
+        self.queue.extend(ops.into_iter().map(|op| (phase, op)));
         self.queue.pop_front().map(|(_, op)| op)
     }
 
@@ -226,7 +236,7 @@ impl<O: Planned> Planner<O> {
         match s.view.phase {
             Phase::Instantiated | Phase::Initialization => self.initialization(rng, s),
             Phase::StepComplete => self.stepping(rng, s),
-            Phase::EventMode => match rng.below(12) {
+            Phase::EventMode => self.event_mode(rng, s).unwrap_or_else(|| match rng.below(12) {
                 0..=5 => O::ENTER_CONTINUOUS_TIME_MODE,
                 6 => O::UPDATE_DISCRETE_STATES,
                 7 => O::set(rng, m, &m.step_settable).unwrap_or(O::ENTER_CONTINUOUS_TIME_MODE),
@@ -234,7 +244,7 @@ impl<O: Planned> Planner<O> {
                 9 => O::probe(Probe::GetContinuousStates, m),
                 10 => state_op(rng, s),
                 _ => O::TERMINATE,
-            },
+            }),
             Phase::ContinuousTime => self.integrating(rng, s),
             Phase::StepFailed => self.step_failed(rng, s),
             Phase::Terminated => match rng.below(4) {

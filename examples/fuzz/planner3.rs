@@ -2,9 +2,11 @@
 //! same plans and value generators): initialisation with values in range, steps of 0.1 to 10 ms
 //! or, for Model Exchange, an integrator's calls, gets, FMU states, termination, reset; mostly
 //! with the rigid boom (`boom.flexible` = false); the probe paths of `probes`, derivatives in
-//! Initialization Mode, and a smaller step retried after fmi3Discard. Here: its ops
-//! (`Planned`) and its own plans (`Phases`).
+//! Initialization Mode, and a smaller step retried after fmi3Discard; for a model with a Clock,
+//! the calls of a clock master (`clock_master`). Here: its ops (`Planned`) and its own plans
+//! (`Phases`).
 
+use crate::clock_master;
 use crate::model_description::{Description, Type};
 use crate::ops::{Arr, Text};
 use crate::ops3::Op3;
@@ -36,6 +38,9 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
     /// budget or the stop time is reached, gets and the end of the simulation.
     fn stepping(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
         let m = s.model;
+        if m.clock.is_some() {
+            return clock_master::stepping(self, rng, s);
+        }
         let room = s.view.room(s.budget());
         if let Some(h) = s.discarded.filter(|_| room >= 1e-6) {
             // FMI 3.0 4.2.1: after fmi3Discard, a smaller step from the same time.
@@ -64,6 +69,9 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
     /// gets, an event now and then, FMU states, nominals, the numbers of states and event indicators, derivatives.
     fn integrating(&mut self, rng: &mut Rng, s: &Session3) -> Op3 {
         let m = s.model;
+        if m.clock.is_some() {
+            return clock_master::integrating(self, rng, s);
+        }
         match self.integrator(rng, s) {
             Ok(op) => op,
             Err(78..=84) => Op3::get_reals(rng, m),
@@ -75,6 +83,11 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
             Err(96..=97) => Op3::derivative(rng, m, false),
             Err(_) => Op3::GetContinuousStates { n: m.states, null: false },
         }
+    }
+
+    /// With a Clock, the clock master's; else the shared plan.
+    fn event_mode(&mut self, rng: &mut Rng, s: &Session3) -> Option<Op3> {
+        s.model.clock.is_some().then(|| clock_master::event_mode(self, rng, s))
     }
 }
 

@@ -4,7 +4,7 @@
 use crate::callbacks::LogSink;
 use crate::fmu_states::Status;
 use std::borrow::Cow;
-use std::collections::HashSet;
+use std::collections::BTreeSet;
 use std::fmt;
 use std::ptr::null_mut;
 use std::time::Duration;
@@ -137,28 +137,80 @@ impl Report {
     }
 
     /// What tells failures apart: the model, how the child ended, the function of the last call
-    /// and the first two words of the violation without digits (names and values that follow
-    /// differ between failures of one kind).
+    /// and the first two words of the violation and the first three of its reason (after the
+    /// first ": ", where it has one), without digits (names and values that follow differ
+    /// between failures of one kind).
     pub fn signature(&self, identifier: &str, ending: &str) -> String {
         let last = self.tail().last().map(|(_, e)| e.line.text().into_owned()).unwrap_or_default();
         let function = last.split([' ', '(', '{']).next().unwrap_or_default();
-        let first_words = self.violation.text().split(' ').take(2).collect::<Vec<_>>().join(" ");
-        let message: String = first_words.chars().filter(|c| !c.is_ascii_digit()).collect();
+        let violation = self.violation.text();
+        let words = |text: &str, n| text.split(' ').take(n).collect::<Vec<_>>().join(" ");
+        let reason = violation.split_once(": ").map_or(String::new(), |(_, why)| words(why, 3));
+        let message: String =
+            format!("{} / {reason}", words(&violation, 2)).chars().filter(|c| !c.is_ascii_digit()).collect();
         format!("{identifier}: {ending}: {function}: {message}")
     }
 
     /// Prints a failure: the seed, how the child ended, the violation, the last calls, the
-    /// replay command.
-    pub fn print_failure(&self, subject: &dyn Subject, seed: u64, ending: &str) {
+    /// replay command and, for a sequence drawn from a master seed (`new`), the line that adds
+    /// it to the regressions. Pointers are numbered in their order of appearance, so that two
+    /// runs print the same (the addresses differ with the address-space layout).
+    pub fn print_failure(&self, subject: &dyn Subject, seed: u64, ending: &str, new: bool) {
+        let mut pointers = Pointers::default();
         eprintln!("fuzz: FAILURE in {} (FMI {}), sequence seed {seed}: {ending}", subject.identifier(), subject.fmi());
-        if !self.violation.text().is_empty() {
-            eprintln!("fuzz:   {}", self.violation.text());
+        let violation = self.violation.text();
+        if !violation.is_empty() {
+            eprintln!("fuzz:   {}", pointers.name(&violation));
         }
         eprintln!("fuzz:   last calls of the sequence:");
         for (n, entry) in self.tail() {
-            eprintln!("fuzz:     #{n} {} -> {}", entry.line.text(), outcome(entry.outcome, self.fmi3));
+            let call = pointers.name(&entry.line.text());
+            eprintln!("fuzz:     #{n} {call} -> {}", outcome(entry.outcome, self.fmi3));
         }
         eprintln!("fuzz:   replay: bash scripts/fuzz --lib {} --seed {seed} --replay", subject.path().display());
+        if new {
+            let what = if violation.is_empty() { ending } else { &violation };
+            let words: Vec<&str> = what.split_whitespace().take(REGRESSION_WORDS).collect();
+            let what = words.join(" ").replace(['\'', '\\'], "");
+            eprintln!(
+                "fuzz:   add it: echo '{} {seed}  # {what}' >> {}",
+                subject.identifier(),
+                crate::regressions::LIST
+            );
+        }
+    }
+}
+
+/// Words of the violation in the line that adds a failure to the regressions.
+const REGRESSION_WORDS: usize = 12;
+
+/// Names for the pointers of a failure's text (`ptr1`, `ptr2`, ... in their order of appearance;
+/// NULL stays `0x0`).
+#[derive(Default)]
+struct Pointers(Vec<String>);
+
+impl Pointers {
+    /// `text` with every hexadecimal address replaced by its name.
+    fn name(&mut self, text: &str) -> String {
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text;
+        while let Some(at) = rest.find("0x") {
+            out.push_str(&rest[..at]);
+            let digits = rest[at + 2..].find(|c: char| !c.is_ascii_hexdigit()).unwrap_or(rest.len() - at - 2);
+            let address = &rest[at..at + 2 + digits];
+            if address.trim_start_matches("0x").trim_start_matches('0').is_empty() {
+                out.push_str(address);
+            } else {
+                let k = self.0.iter().position(|a| a == address).unwrap_or_else(|| {
+                    self.0.push(address.to_owned());
+                    self.0.len() - 1
+                });
+                out.push_str(&format!("ptr{}", k + 1));
+            }
+            rest = &rest[at + 2 + digits..];
+        }
+        out.push_str(rest);
+        out
     }
 }
 
@@ -263,8 +315,9 @@ pub struct Tally {
     pub elapsed: Duration,
     pub counts: Counts,
     pub failures: u64,
-    /// Kinds of failure (see `Report::signature`); each is shown once.
-    pub kinds: HashSet<String>,
+    /// Kinds of failure (see `Report::signature`); each is shown once. Ordered: a hash set frees
+    /// in a random order, and the forked children would inherit a heap laid out differently.
+    pub kinds: BTreeSet<String>,
     /// The sequence seed and message of the first log message that reported a caught panic.
     pub first_internal_error: Option<(u64, String)>,
 }
@@ -285,22 +338,28 @@ impl Tally {
         self.kinds.extend(other.kinds);
     }
 
-    pub fn line(&self, name: &str) -> String {
-        let (seconds, c) = (self.elapsed.as_secs_f64(), &self.counts);
+    /// The summary line named `name`; with the elapsed time and calls per second for a run on
+    /// a time budget (`timed`), else only what repeats exactly.
+    pub fn line(&self, name: &str, timed: bool) -> String {
+        let c = &self.counts;
+        let seconds = self.elapsed.as_secs_f64();
+        let (time, rate) = match timed {
+            true => (format!(" {seconds:.1} s,"), format!("; {:.0} calls/s", c.calls as f64 / seconds.max(1e-9))),
+            false => (String::new(), String::new()),
+        };
         let kinds = match self.kinds.len() {
             _ if self.failures == 0 => String::new(),
             1 => " (1 kind, each shown once)".into(),
             n => format!(" ({n} kinds, each shown once)"),
         };
         format!(
-            "{name} {seconds:.1} s, {} sequences (CS {}, ME {}), {} calls (CS {}, ME {}; {:.0} calls/s), {} failures{kinds}, {} log messages, {} internal errors",
+            "{name}{time} {} sequences (CS {}, ME {}), {} calls (CS {}, ME {}{rate}), {} failures{kinds}, {} log messages, {} internal errors",
             c.sequences,
             c.sequences - c.me_sequences,
             c.me_sequences,
             c.calls,
             c.calls - c.me_calls,
             c.me_calls,
-            c.calls as f64 / seconds.max(1e-9),
             self.failures,
             c.messages,
             c.internal_errors

@@ -30,6 +30,7 @@ use crate::ops::{Arr, Instantiation, Op, Text};
 use crate::report::Report;
 use crate::required::{self, Derivative};
 use crate::sequence::{driven, Driven};
+use crate::step_outputs;
 use crate::view::{Phase, View};
 use crate::watch::Seen;
 use crate::wild::{instantiation, wild};
@@ -342,7 +343,12 @@ impl<'a> Session<'a> {
             (Op::GetRealStatus { kind: LAST_SUCCESSFUL_TIME, .. }, _) if phase == Phase::Unknown => {
                 self.view.phase = Phase::Broken;
             }
-            (Op::DoStep { t, h, .. }, _) => self.simulated += self.view.stepped(t, h, status),
+            (Op::DoStep { t, h, .. }, _) => {
+                self.simulated += self.view.stepped(t, h, status);
+                if ok {
+                    self.read_after_step()?;
+                }
+            }
             _ => {}
         }
         Ok(())
@@ -350,14 +356,19 @@ impl<'a> Session<'a> {
 
     /// fmi2GetReal said fmi2OK or fmi2Warning: every value must be finite.
     fn check_reals(&self, vr: &Arr<u32>, values: &[f64]) -> Result<(), String> {
-        let Some(i) = values.iter().position(|x| !x.is_finite()) else { return Ok(()) };
-        let name = match vr {
-            Arr::Items(v) => {
-                self.model.variable(v[i]).map_or(format!("vr {}", v[i]), |var| format!("{} (vr {})", var.name, v[i]))
-            }
-            Arr::Null(_) => "a value for a NULL vr array".into(),
-        };
-        Err(format!("fmi2GetReal returned fmi2OK or fmi2Warning, but {name} = {}", values[i]))
+        match step_outputs::non_finite(self.model, vr.items(), values) {
+            Some(what) => Err(format!("fmi2GetReal returned fmi2OK or fmi2Warning, but {what}")),
+            None => Ok(()),
+        }
+    }
+
+    /// fmi2DoStep returned fmi2OK or fmi2Warning: the outputs and locals are read (`step_outputs`).
+    fn read_after_step(&mut self) -> Result<(), String> {
+        let (f, c) = (self.fmi, self.c);
+        // SAFETY: as many value references and values as announced, alive for the call.
+        step_outputs::read(false, self.b.report, self.b.model, |vr, p| unsafe {
+            f.fmi2GetReal(c, vr.as_ptr(), vr.len(), p)
+        })
     }
 }
 

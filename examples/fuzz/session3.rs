@@ -26,16 +26,17 @@
 
 use crate::bookkeeping::{Bookkeeping, Target};
 use crate::callbacks::{environment, last_error_says, log_message, LOG};
+use crate::clock_rules;
 use crate::fmi3::{Fmi3, Instance, Library, Status};
 use crate::fmu_states::{FmuStates, StateOutput};
 use crate::machine3::forbidden;
-use crate::model_description::Description;
 use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3};
 use crate::report::Report;
 use crate::required::{self, Derivative};
 use crate::sequence::{driven, Call, Driven};
 use crate::session::{expect_text, out};
+use crate::step_outputs;
 use crate::view::{Phase, View};
 use crate::watch::Seen;
 use crate::wild3::{instantiation3, wild3};
@@ -163,6 +164,7 @@ impl<'a> Session3<'a> {
                 required::derivative(&call, view, me, m).filter(|_| !adjoint || m.adjoint)
             }
             Op3::SetFloat64 { vr, values } => required::state_set(vr, values, view, me, m),
+            Op3::SetClock { .. } => clock_rules::required(op, view, m),
             Op3::State(call) => required::state_call(call, &self.states),
             _ => None,
         };
@@ -236,6 +238,12 @@ impl<'a> Session3<'a> {
             }
             Op3::OtherType { ty, set, vr } => status(crate::refused::other_type(f, c, *ty, *set, vr)),
             Op3::Refused { function } => status(crate::refused::call(f, c, *function)),
+            Op3::SetClock { vr, values } => status(f.fmi3SetClock(c, vr.ptr(), vr.len(), values.ptr().cast())),
+            Op3::GetClock { vr, null_values } => {
+                let mut v = vec![0u8; vr.len()];
+                let s = f.fmi3GetClock(c, vr.ptr(), vr.len(), out(&mut v, *null_values).cast());
+                (Some(s), Output::Flags(if *null_values { Vec::new() } else { v }))
+            }
             Op3::State(call) => {
                 let (s, output) = call.invoke(f, c);
                 (Some(s), Output::Stateful(output))
@@ -286,6 +294,9 @@ impl<'a> Session3<'a> {
     /// The oracle on what a call to the main instance returned, and the bookkeeping of its state.
     fn observe(&mut self, op: Op3, status: Option<Status>, ok: bool, output: Output, errors: u64) -> Result<(), String> {
         let phase = self.view.phase;
+        if ok {
+            clock_rules::observe(&op, &mut self.b.view, self.b.model);
+        }
         match (op, output) {
             (Op3::GetVersion, Output::Text(p)) => expect_text(p, "3.0", "fmi3GetVersion")?,
             (Op3::Instantiate(spec), Output::Instance(c)) => self.instantiated(&spec, c, errors)?,
@@ -316,7 +327,11 @@ impl<'a> Session3<'a> {
             (Op3::Reset, _) => self.view = View::fresh(),
             (Op3::SetTime { t }, _) => self.view.time = t,
             (Op3::State(call), Output::Stateful(output)) => self.b.states.observe(call, output, &mut self.b.view)?,
-            (Op3::GetFloat64 { vr, .. }, Output::Reals(v)) => finite_values(self.model, &vr, &v)?,
+            (Op3::GetFloat64 { vr, .. }, Output::Reals(v)) => {
+                if let Some(what) = step_outputs::non_finite(self.model, vr.items(), &v) {
+                    return Err(format!("fmi3GetFloat64 returned fmi3OK or fmi3Warning, but {what}"));
+                }
+            }
             (Op3::GetContinuousStates { .. }, Output::Reals(v)) => {
                 finite(&v, "fmi3GetContinuousStates")?;
                 (self.x, self.x_fresh) = (v, true);
@@ -406,9 +421,11 @@ impl<'a> Session3<'a> {
                     self.event_mode, self.early_return
                 ));
             }
-            Some(OK | WARNING) if early != 0 && !(last > t && last < end) => {
+            // 4.2.1: with earlyReturn, lastSuccessfulTime may equal currentCommunicationPoint ("the
+            // detection of an event at currentCommunicationPoint").
+            Some(OK | WARNING) if early != 0 && !(last >= t && last < end) => {
                 return Err(format!(
-                    "fmi3DoStep returned earlyReturn with lastSuccessfulTime = {last}, outside ({t}, {end})"
+                    "fmi3DoStep returned earlyReturn with lastSuccessfulTime = {last}, outside [{t}, {end})"
                 ));
             }
             Some(OK | WARNING) if early == 0 && !near(last, end) => {
@@ -423,12 +440,23 @@ impl<'a> Session3<'a> {
         // An early return ends the step at lastSuccessfulTime.
         let h = if early != 0 && matches!(status, Some(OK | WARNING)) { last - t } else { h };
         self.simulated += self.view.stepped(t, h, status);
-        if status == Some(DISCARD) {
+        match status {
             // FMI 3.0 2.2.4, 4.2.1 (issue 25 item 6): the instance stays as before the call,
             // in Step Mode at t, so that a smaller step can be retried.
-            (self.view, self.discarded) = (before, Some(h));
+            Some(DISCARD) => (self.view, self.discarded) = (before, Some(h)),
+            Some(OK | WARNING) => self.read_after_step()?,
+            _ => {}
         }
         Ok(())
+    }
+
+    /// fmi3DoStep returned fmi3OK or fmi3Warning: the outputs and locals are read (`step_outputs`).
+    fn read_after_step(&mut self) -> Result<(), String> {
+        let (f, c) = (self.fmi, self.c);
+        // SAFETY: as many value references and values as announced, alive for the call.
+        step_outputs::read(true, self.b.report, self.b.model, |vr, p| unsafe {
+            f.fmi3GetFloat64(c, vr.as_ptr(), vr.len(), p, vr.len())
+        })
     }
 }
 
@@ -469,16 +497,6 @@ fn finite(values: &[f64], function: &str) -> Result<(), String> {
         Some(i) => Err(format!("{function} returned fmi3OK or fmi3Warning, but element {i} is {}", values[i])),
         None => Ok(()),
     }
-}
-
-/// fmi3GetFloat64 said fmi3OK or fmi3Warning: every value finite, named by its variable.
-fn finite_values(m: &Description, vr: &Arr<u32>, values: &[f64]) -> Result<(), String> {
-    let Some(i) = values.iter().position(|x| !x.is_finite()) else { return Ok(()) };
-    let name = match vr {
-        Arr::Items(v) if i < v.len() => m.variable(v[i]).map_or(format!("vr {}", v[i]), |var| format!("{} (vr {})", var.name, v[i])),
-        _ => format!("value {i}"),
-    };
-    Err(format!("fmi3GetFloat64 returned fmi3OK or fmi3Warning, but {name} = {}", values[i]))
 }
 
 fn expect_count(n: usize, expected: usize, function: &str, element: &str) -> Result<(), String> {

@@ -32,6 +32,10 @@ pub struct View {
     /// and what needs them (Initialization Mode's derivatives) may fail.
     pub tuned: bool,
     pub set_up: bool,
+    /// FMI 3.0 with a Clock (`clock_rules`): the activations made (the next one due is this
+    /// index) and whether the Clock is active; part of the FMU state, like the time.
+    pub activations: u64,
+    pub clock_active: bool,
     /// False for a state restored from bytes edited with the CRC recomputed.
     certain: bool,
 }
@@ -46,6 +50,8 @@ impl View {
             start: f64::NAN,
             tuned: false,
             set_up: false,
+            activations: 0,
+            clock_active: false,
             certain: true,
         }
     }
@@ -59,6 +65,8 @@ impl View {
             start: f64::NAN,
             tuned: true,
             set_up: true,
+            activations: 0,
+            clock_active: false,
             certain: false,
         }
     }

@@ -4,10 +4,10 @@
 //! differ from the number of value references, fmi3Boolean bytes other than 0 and 1, the types
 //! no variable has, the functions the FMUs do not provide, any function in any state, and
 //! instantiations with a wrong token, name, eventModeUsed or intermediate variables; counts far
-//! larger than the arrays (`oversized`).
+//! larger than the arrays (`oversized`); a Clock set or read with any values and references.
 
 use crate::model_description::{Description, Type, Variable, TYPES};
-use crate::ops::Text;
+use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3, OTHER_TYPES, REFUSED};
 use crate::oversized::Oversized;
 use crate::rng::Rng;
@@ -44,7 +44,10 @@ pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
             }
         }
         12..=15 => wild_set3(rng, m),
-        16 => Op3::OtherType { ty: rng.below(OTHER_TYPES.len()), set: rng.chance(0.5), vr: vrs(rng, m, real) },
+        16 => match (rng.below(OTHER_TYPES.len()), rng.chance(0.5), vrs(rng, m, real)) {
+            (CLOCK, set, vr) if m.clock.is_some() => wild_clock(rng, m, set, vr),
+            (ty, set, vr) => Op3::OtherType { ty, set, vr },
+        },
         17 => Op3::Refused { function: rng.below(REFUSED.len()) },
         18..=20 => Op3::State(wild_state_call(rng, &s.states)),
         21 => {
@@ -76,6 +79,28 @@ pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
         29 => Op3::GetNumberOfContinuousStates { null: rng.chance(0.2) },
         30 => Op3::GetNumberOfEventIndicators { null: rng.chance(0.2) },
         _ => Op3::Instantiate(Instantiation3 { interface: Interface3::ScheduledExecution, ..instantiation3(rng, m) }),
+    }
+}
+
+/// The index of Clock in `OTHER_TYPES`.
+const CLOCK: usize = OTHER_TYPES.len() - 1;
+
+/// fmi3SetClock or (`set` false) fmi3GetClock of a model with a Clock: mostly of the Clock alone,
+/// else of `vr` (Reals, unknown references), with the Clock among them now and then; set to
+/// true, false or a byte that is neither.
+fn wild_clock(rng: &mut Rng, m: &Description, set: bool, vr: Arr<u32>) -> Op3 {
+    let clock = m.clock.as_ref().map_or(0, |c| c.vr);
+    let vr = match (rng.below(4), vr) {
+        (0..=1, _) => Arr::Items(vec![clock]),
+        (2, Arr::Items(mut v)) => {
+            v.insert(rng.below(v.len() + 1), clock);
+            Arr::Items(v)
+        }
+        (_, vr) => vr,
+    };
+    match set {
+        true => Op3::SetClock { values: array(rng, vr.len(), |r| *r.pick(&[1, 1, 1, 0, 2, 255])), vr },
+        false => Op3::GetClock { vr, null_values: rng.chance(0.1) },
     }
 }
 
@@ -121,6 +146,10 @@ pub fn instantiation3(rng: &mut Rng, m: &Description) -> Instantiation3 {
         logger: !rng.chance(0.1),
         ..Instantiation3::quiet(Text::new(&m.guid))
     };
+    if m.clock.is_some() {
+        // FMI 3.0, 2.3.1: "For FMUs that have clocks, eventModeUsed = fmi3True is required".
+        spec.event_mode_used = !rng.chance(0.05);
+    }
     if rng.chance(0.15) {
         match rng.below(5) {
             0 | 1 => spec.token = bad_guid(rng, &m.guid),
@@ -149,9 +178,11 @@ pub fn valid_instantiation(spec: &Instantiation3, m: &Description) -> Option<boo
     }
     let name_ok =
         matches!(&spec.name, Text::Bytes(n) if !n.to_bytes().is_empty() && std::str::from_utf8(n.to_bytes()).is_ok());
-    // Event Mode where the model has it (hasEventMode); intermediate variables only with the
-    // intermediateUpdate callback, which the fuzzer never passes.
-    let co_simulation_ok = spec.interface == Interface3::ModelExchange
-        || ((!spec.event_mode_used || m.event_mode) && spec.required_intermediate.len() == 0);
+    // Event Mode where the model has it (hasEventMode), and with a Clock (2.3.1: required);
+    // intermediate variables only with the intermediateUpdate callback, which the fuzzer never
+    // passes.
+    let event_mode_ok = if spec.event_mode_used { m.event_mode } else { m.clock.is_none() };
+    let co_simulation_ok =
+        spec.interface == Interface3::ModelExchange || (event_mode_ok && spec.required_intermediate.len() == 0);
     (name_ok && co_simulation_ok).then_some(true)
 }
