@@ -13,7 +13,7 @@ from .fmus import FmuFile, boom_switch, with_params
 from .metrics import CBV_OPEN
 from .paths import boomsim_binary
 from .result import COLUMNS, PLANT_OUT, Result
-from .scenarios import controller_start, plant_start, reference
+from .scenarios import communication_references, controller_start, plant_start
 
 
 def run_native(scenario: dict, boom: str = "rigid", step: float | None = None, stop_time: float | None = None,
@@ -29,7 +29,7 @@ def run_native(scenario: dict, boom: str = "rigid", step: float | None = None, s
     t_end, step, n, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
     table = scenario["reference"]
     # The reference at the communication points as `run` computes them (t = k step, then t + step).
-    u_ref = [reference(table, 0.0)] + [reference(table, k * step + step) for k in range(n)]
+    u_ref = communication_references(table, step, n).tolist()
     request = {"stop_time": t_end, "step": step, "record_every": record_every, "interpolate": interpolate,
                "feedback_start": fb_start, "enable": bool(scenario["controller"]["enable"]),
                "u_ref": u_ref, "outputs": PLANT_OUT, "cbv_open": CBV_OPEN,

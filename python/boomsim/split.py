@@ -5,39 +5,28 @@ HydraulicBoom), and the sweep of the communication step that finds each coupling
     boomsim-split U --coupling tlm [--boom rigid] [--step 1e-3]
     boomsim-split --sweep [--boom flexible]
 
-Couplings (the port is documented in the FMUs and in the README, "Coupling your own mechanics"):
-    plain    Gauss-Seidel: mechanics.doStep with F_k held -> x_k+1, v_k+1 -> the circuit steps
-             with v linear from v_k to v_k+1 (fmi2SetRealInputDerivatives) -> F_k+1
-    jacobi   plain, both step from the values at t_k (v held), as a parallel master does
-    tlm      port.coupling = 1: waves c_h, c_m exchanged once per step (Jacobi), held over it
-The controller is coupled to the circuit exactly as cosim.py couples it to HydraulicBoom.
+The couplings are boomsim.coupled's (docs/coupling.md); the mechanics is BoomMechanics through
+boomsim.mechanics. The controller is coupled to the circuit exactly as cosim.py couples it to
+HydraulicBoom.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 
 import numpy as np
 from fmpy.fmi1 import FMICallException
 
 from . import cosim
+from .coupled import COUPLINGS, PORT_CODES, Drive, Unstable, loop, start_circuit, start_controller
 from .errors import cli
-from .fmus import FmuFile
-from .result import COLUMNS, PLANT_OUT, Result
+from .fmus import FmuFile, release
+from .mechanics import BoomMechanicsFmu
+from .result import COLUMNS, Result
 from .scenarios import load_scenario, reference
 from . import metrics as mx
 from . import regression
-
-COUPLINGS = ("plain", "jacobi", "tlm", "tlm-jacobi")
-#: Circuit outputs recorded (PLANT_OUT without the stroke and velocity, which come from
-#: the mechanics).
-CIRCUIT_OUT = [c for c in PLANT_OUT if not c.startswith("cylinder.")]
-
-
-class Unstable(Exception):
-    """The coupled run diverged (a step was refused or the motion left the stroke)."""
 
 
 def own_params(fmu: FmuFile, plant: dict) -> dict:
@@ -57,11 +46,10 @@ def run(scenario: dict, boom: str = "rigid", coupling: str = "tlm", step: float 
     step = scenario["step"] if step is None else step
     n = int(round(t_end / step))
     ctrl_cfg, table = scenario["controller"], scenario["reference"]
-    mode = 1 if coupling.startswith("tlm") else 0
+    port = "tlm" if coupling.startswith("tlm") else "plain"
     circ = circ_f.slave(f"{scenario['id']}.circuit")
     mech = mech_f.slave(f"{scenario['id']}.mechanics")
     ctrl = ctrl_f.slave(f"{scenario['id']}.controller")
-    vh, vm, vc = circ_f.vr, mech_f.vr, ctrl_f.vr
     try:
         for s in (circ, mech, ctrl):
             s.setupExperiment(tolerance=tolerance, startTime=0.0, stopTime=t_end)
@@ -69,97 +57,21 @@ def run(scenario: dict, boom: str = "rigid", coupling: str = "tlm", step: float 
         x0 = scenario["start_stroke"]
         mech_f.set(mech, "start.x", x0)
         mech_f.set(mech, "boom.flexible", boom == "flexible")
-        mech_f.set(mech, "port.coupling", mode)
+        mech_f.set(mech, "port.coupling", PORT_CODES[port])
         for k, v in own_params(mech_f, scenario["plant"]).items():
             mech_f.set(mech, k, v)
         mech.exitInitializationMode()
-        f_start, x, v = mech.getReal([vm["start.F"], vm["cylinder.x"], vm["cylinder.v"]])
-        for name, value in (("start.x", x0), ("start.F", f_start), ("port.coupling", mode),
-                            ("cylinder.x", x), ("cylinder.v", v)):
-            circ_f.set(circ, name, value)
-        for k, val in own_params(circ_f, scenario["plant"]).items():
-            circ_f.set(circ, k, val)
-        circ.exitInitializationMode()
-        p4 = circ.getReal([vh["p4"]])[0]
-        enable = bool(ctrl_cfg["enable"])
-        for name in ("K_f", "omega_f", "u_min", "u_max"):
-            if name in ctrl_cfg:
-                ctrl_f.set(ctrl, name, ctrl_cfg[name])
-        ctrl_f.set(ctrl, "enable", enable)
-        ctrl.setReal([vc["p"], vc["u_ref"]], [p4, reference(table, 0.0)])
-        ctrl.exitInitializationMode()
-
-        data = _loop((circ, circ_f), (mech, mech_f), (ctrl, ctrl_f), scenario, coupling, step, n, (x, v, p4))
+        mechanics = BoomMechanicsFmu(mech_f, mech, port)
+        (x,), (v,) = mechanics.motion()
+        start_circuit(circ_f, circ, port, x, v, mechanics.holding_force()[0], own_params(circ_f, scenario["plant"]))
+        start_controller(ctrl_f, ctrl, ctrl_cfg, circ.getReal([circ_f.vr["p4"]])[0], reference(table, 0.0))
+        drive = Drive(circ, circ_f, table, ctrl, ctrl_f)
+        data, = loop([drive], mechanics, coupling, step, n, max(1, int(round(1e-3 / step))))
     except FMICallException as e:
         raise Unstable(f"{coupling}, h = {step:g} s: an FMU refused a call ({e}), the run diverged") from e
     finally:
-        for s in (circ, mech, ctrl):
-            try:
-                s.terminate()
-            except Exception:  # noqa: BLE001 - terminate after an error may be refused
-                pass
-            s.freeInstance()
+        release(circ, mech, ctrl)
     return Result(scenario, boom, step, True, {c: data[:, i] for i, c in enumerate(COLUMNS)}, 0.0)
-
-
-def _loop(circuit, mechanics, controller, scenario, coupling, step, n, start) -> np.ndarray:
-    """The communication steps of `run` from the initialised (slave, FmuFile) pairs and the start
-    values (x, v, p4): the recorded rows (COLUMNS)."""
-    (circ, circ_f), (mech, mech_f), (ctrl, ctrl_f) = circuit, mechanics, controller
-    vh, vm, vc = circ_f.vr, mech_f.vr, ctrl_f.vr
-    x, v, p4 = start
-    table = scenario["reference"]
-    record_every = max(1, int(round(1e-3 / step)))
-    out_h = [vh[c] for c in CIRCUIT_OUT]
-    i_p4 = CIRCUIT_OUT.index("p4")
-    rows = []
-    y = circ.getReal(out_h)
-    u_ref = reference(table, 0.0)
-    stroke = circ.getReal([vh["cylinder.stroke"]])[0]
-    for k in range(n + 1):
-        t = k * step
-        u, u_comp = ctrl.getReal([vc["u"], vc["u_comp"]])
-        circ.setReal([vh["valve.u_ref"]], [u])
-        if k % record_every == 0:
-            rec = dict(zip(CIRCUIT_OUT, y), **{"cylinder.x": x, "cylinder.v": v})
-            rows.append([t, u_ref, u_comp, u, *(rec[c] for c in PLANT_OUT)])
-        if k == n:
-            break
-        if not (-0.05 < x < stroke + 0.05) or not all(map(math.isfinite, y)):
-            raise Unstable(f"{coupling}, h = {step:g} s: the motion diverged at t = {t:.4g} s (x = {x:.4g} m)")
-        if coupling.startswith("tlm"):
-            c_h, = circ.getReal([vh["port.c_h"]])
-            c_m, = mech.getReal([vm["port.c_m"]])
-            mech.setReal([vm["port.c_h"]], [c_h])
-            circ.setReal([vh["port.c_m"]], [c_m])
-            if coupling == "tlm":
-                mech.doStep(t, step)
-                c_m1, = mech.getReal([vm["port.c_m"]])
-                circ.setRealInputDerivatives([vh["port.c_m"]], [1], [(c_m1 - c_m) / step])
-                circ.doStep(t, step)
-            else:
-                circ.doStep(t, step)
-                mech.doStep(t, step)
-            x, v = mech.getReal([vm["cylinder.x"], vm["cylinder.v"]])
-        else:
-            mech.setReal([vm["cylinder.F"]], circ.getReal([vh["cylinder.F"]]))
-            if coupling == "jacobi":
-                circ.doStep(t, step)
-            mech.doStep(t, step)
-            x1, v1 = mech.getReal([vm["cylinder.x"], vm["cylinder.v"]])
-            if coupling == "plain":
-                circ.setRealInputDerivatives([vh["cylinder.v"]], [1], [(v1 - v) / step])
-                circ.doStep(t, step)
-            x, v = x1, v1
-            circ.setReal([vh["cylinder.x"], vh["cylinder.v"]], [x, v])
-        y = circ.getReal(out_h)
-        p4_next = y[i_p4]
-        ctrl.setRealInputDerivatives([vc["p"]], [1], [(p4_next - p4) / step])
-        ctrl.doStep(t, step)
-        p4 = p4_next
-        u_ref = reference(table, t + step)
-        ctrl.setReal([vc["p"], vc["u_ref"]], [p4, u_ref])
-    return np.array(rows)
 
 
 #: Steps of the stability sweep [s].
@@ -184,29 +96,39 @@ def rings_down(r: Result) -> tuple[bool, str]:
     return late < REST_PTP or late < 0.8 * mid, f"p3 swing {mid / 1e5:.3g} -> {late / 1e5:.3g} bar over the last 2 x 0.5 s"
 
 
-def stable(boom: str, coupling: str, step: float, alpha: float = 0.0) -> tuple[bool, str]:
+def stable(boom: str, coupling: str, step: float, alpha: float = 0.0, runner=None) -> tuple[bool, str]:
     """(stable, why) for the LIFT scenario with `step` and TLM wave damping `alpha`: the run
-    completes within the stroke and p3 rings down (`rings_down`)."""
+    completes within the stroke and p3 rings down (`rings_down`). `runner(scenario, coupling,
+    step)`: the coupled run (default: `run` with BoomMechanics and `boom`)."""
     sc = dict(LIFT, plant={"port.alpha": alpha})
+    runner = runner or (lambda s, c, h: run(s, boom, c, h))
     try:
-        return rings_down(run(sc, boom, coupling, step))
+        return rings_down(runner(sc, coupling, step))
     except Unstable as e:
         return False, str(e)
 
 
-def sweep(boom: str, couplings=COUPLINGS, steps=SWEEP_STEPS, alpha: float = 0.0) -> dict:
+def sweep(boom: str, couplings=COUPLINGS, steps=SWEEP_STEPS, alpha: float = 0.0, runner=None) -> dict:
     """{coupling: (largest stable step, {step: (stable, why)})}; the sweep of a coupling stops at
     its first unstable step."""
     out = {}
     for c in couplings:
         rows, largest = {}, None
         for h in steps:
-            rows[h] = stable(boom, c, h, alpha)
+            rows[h] = stable(boom, c, h, alpha, runner)
             if not rows[h][0]:
                 break
             largest = h
         out[c] = (largest, rows)
     return out
+
+
+def print_sweep(label: str, result: dict) -> None:
+    """One line per coupling of a `sweep` result."""
+    for c, (largest, rows) in result.items():
+        print(f"{label} {c:10s} largest stable step {largest}:",
+              "; ".join(f"{h * 1e3:g} ms {'stable' if ok else 'UNSTABLE'} ({why})" for h, (ok, why) in rows.items()),
+              flush=True)
 
 
 def compare(a: dict, b: dict, rel: float = 0.02) -> dict:
@@ -243,10 +165,7 @@ def main(argv=None):
     sc = load_scenario(args.scenario)
     if args.sweep:
         couplings = COUPLINGS if args.alpha == 0 else ("tlm", "tlm-jacobi")
-        for c, (largest, rows) in sweep(args.boom, couplings, alpha=args.alpha).items():
-            print(f"{args.boom} alpha {args.alpha:g} {c:10s} largest stable step {largest}:",
-                  "; ".join(f"{h * 1e3:g} ms {'stable' if ok else 'UNSTABLE'} ({why})" for h, (ok, why) in rows.items()),
-                  flush=True)
+        print_sweep(f"{args.boom} alpha {args.alpha:g}", sweep(args.boom, couplings, alpha=args.alpha))
         return
     mono = mx.compute(cosim.run(sc, args.boom, args.step))
     split = mx.compute(run(sc, args.boom, args.coupling, args.step))

@@ -207,6 +207,13 @@ impl Variable {
         self
     }
 
+    /// The same calculated variable as a parameter computed from the others in Initialization
+    /// Mode and fixed after it (`causality="calculatedParameter" variability="fixed"`).
+    pub const fn calculated_parameter(mut self) -> Self {
+        self.causality = Causality::CalculatedParameter;
+        self.fixed()
+    }
+
     /// The same variable, but fixed (settable only before initialisation ends).
     pub const fn fixed(mut self) -> Self {
         self.variability = Variability::Fixed;

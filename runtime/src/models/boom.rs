@@ -26,6 +26,11 @@ pub(crate) fn boom_configurations() -> Vec<Vec<(u32, Value)>> {
     ]
 }
 
+/// The boom parameters of the values ([`BOOM_PARAMS`] at [`vr::BOOM`]).
+pub(crate) fn boom_params(values: &Values) -> BoomParams {
+    BoomParams::from_values(|k| param_value(values, vr::BOOM + k as u32, &BOOM_PARAMS[k].spec))
+}
+
 /// The boom the cylinder drives.
 #[derive(Debug, Clone)]
 pub enum Boom {
@@ -36,7 +41,7 @@ pub enum Boom {
 impl Boom {
     /// The boom of the parameter values (boom, beam, `boom.flexible`) for a cylinder `stroke`.
     pub(crate) fn from_values(values: &Values, stroke: f64) -> Result<Self, String> {
-        let params = BoomParams::from_values(|k| param_value(values, vr::BOOM + k as u32, &BOOM_PARAMS[k].spec));
+        let params = boom_params(values);
         let boom = if values.boolean(vr::FLEXIBLE) {
             let beam = BeamParams::from_values(|k| param_value(values, vr::BEAM + k as u32, &BEAM_PARAMS[k].spec));
             FlexibleBoom::new(&params, &beam, stroke).map(Boom::Flexible)

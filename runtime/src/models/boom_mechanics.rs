@@ -9,7 +9,7 @@
 //! (`cylinder.k_stop`, `cylinder.c_stop`). HydraulicCircuit's port force has none, so the pair
 //! coupled equals HydraulicBoom, and the boom alone with no force comes to rest on the bottom stop.
 
-use super::boom::Boom;
+use super::boom::{boom_params, Boom};
 use super::port::{self, Coupling, Ramp, FORCE_RANGE};
 use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
 use super::terminals;
@@ -20,6 +20,9 @@ use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::mechanics::kinematics::BoomKinematics;
+use crate::mechanics::params::BoomParams;
+use nalgebra::Vector2;
 use crate::scalar::{Dual64, Scalar};
 use crate::solver::{OdeSystem, SecondOrder};
 
@@ -28,6 +31,8 @@ use crate::solver::{OdeSystem, SecondOrder};
 pub mod vr {
     pub use crate::models::port::vr::{ALPHA, COUPLING, C_H, C_M, START_F, Z_C};
     pub use crate::models::vr::*;
+    /// The rigid boom's geometry and mass ([`super::GEOMETRY`]): `GEOMETRY + k` is its row k.
+    pub const GEOMETRY: u32 = 90;
 }
 
 /// The circuit parameters the boom uses (indices in [`PARAMS`]): the cylinder's stroke, its range
@@ -35,6 +40,38 @@ pub mod vr {
 const STROKE: usize = super::table::param_index("cylinder.stroke");
 const K_STOP: usize = super::table::param_index("cylinder.k_stop");
 const C_STOP: usize = super::table::param_index("cylinder.c_stop");
+
+/// The rigid boom's geometry and mass, in the order of [`geometry`], computed from the parameters:
+/// what another engine needs to build the same boom (boomsim.mujoco builds its MJCF from them).
+/// Unit and display unit of a length.
+const LENGTH: (&str, &str) = ("m", "mm");
+
+#[rustfmt::skip]
+const GEOMETRY: [Variable; 8] = [
+    geometry_row("boom.joint.x", 0, LENGTH, "Boom joint B from the lower cylinder pin A, horizontal (s_AB, below eq. 2.10)"),
+    geometry_row("boom.joint.y", 1, LENGTH, "Boom joint B from the lower cylinder pin A, vertical (s_AB, below eq. 2.10)"),
+    geometry_row("boom.pin.x", 2, LENGTH, "Upper cylinder pin C from B along the arm's centre line (w1 cos phi2, eq. 2.1, 2.5)"),
+    geometry_row("boom.pin.y", 3, LENGTH,
+        "Upper cylinder pin C from B normal to the arm's centre line, > 0 up (-w1 sin phi2, eq. 2.1, 2.5)"),
+    geometry_row("boom.cm.x", 4, LENGTH, "Mass centre D of arm and payload from B along the arm's centre line (e_cm, eq. 2.8)"),
+    geometry_row("boom.cm.y", 5, LENGTH, "Mass centre D of arm and payload from B normal to the arm's centre line (e_cm, eq. 2.8)"),
+    geometry_row("boom.m_D", 6, ("kg", ""), "Mass of arm and payload, m_D = m_arm + payload.m (eq. 2.8)"),
+    geometry_row("boom.J_B", 7, ("kg.m2", ""), "Moment of inertia of arm and payload about the joint B (J_B, below eq. 2.18)"),
+];
+
+/// Row `k` of [`GEOMETRY`].
+const fn geometry_row(name: &'static str, k: u32, (unit, display): (&'static str, &'static str), description: &'static str) -> Variable {
+    out(name, vr::GEOMETRY + k, unit, display, description).calculated_parameter()
+}
+
+/// The values of [`GEOMETRY`] for the boom parameters `p`.
+fn geometry(p: &BoomParams) -> [f64; 8] {
+    let k = BoomKinematics::new(p);
+    let (t, b) = (k.triangle(), k.body());
+    let joint = k.point(0.0, Vector2::zeros());
+    let pin = Vector2::new(t.w1 * t.phi2.cos(), -t.w1 * t.phi2.sin());
+    [joint.x, joint.y, pin.x, pin.y, b.e_cm.x, b.e_cm.y, b.m_d, b.j_b]
+}
 
 #[rustfmt::skip]
 const OWN: [Variable; 17] = [
@@ -62,7 +99,7 @@ const OWN: [Variable; 17] = [
     port::PORT_F.depends(&[vr::F]),
 ];
 
-const N_VARS: usize = OWN.len() + SOLVER_VARIABLES.len() + 3 + N_BOOM_ROWS + BOOM_DERIVATIVES.len();
+const N_VARS: usize = OWN.len() + GEOMETRY.len() + SOLVER_VARIABLES.len() + 3 + N_BOOM_ROWS + BOOM_DERIVATIVES.len();
 const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .vars(&SOLVER_VARIABLES)
     .sections()
@@ -71,6 +108,7 @@ const TABLE: [Variable; N_VARS] = TableBuilder::new(&OWN)
     .hydraulics(PARAMS, K_STOP, K_STOP + 1)
     .hydraulics(PARAMS, C_STOP, C_STOP + 1)
     .vars(&BOOM_DERIVATIVES)
+    .vars(&GEOMETRY)
     .build();
 
 const DOCUMENTATION: &str = concat!(
@@ -152,6 +190,8 @@ pub struct BoomMechanics {
     sys: PortedBoom,
     /// Holding force at the start.
     f_start: f64,
+    /// The values of [`GEOMETRY`].
+    geometry: [f64; 8],
     t: f64,
     /// The wave emitted at `t` (TLM).
     c_m: f64,
@@ -178,7 +218,7 @@ impl BoomMechanics {
         let sys = PortedBoom { boom, coupling: Coupling::from_values(values), input, cylinder };
         let state =
             super::plant::checked_state(sys.dim(), state, || Ok([&rest.q[..], &vec![0.0; rest.q.len()]].concat()))?;
-        Ok(BoomMechanics { sys, f_start: rest.f_cyl, t, c_m, state })
+        Ok(BoomMechanics { sys, f_start: rest.f_cyl, geometry: geometry(&boom_params(values)), t, c_m, state })
     }
 
     /// The port input over the next step: `cylinder.F` (plain) or `port.c_h` (TLM).
@@ -289,6 +329,9 @@ impl Model for BoomMechanics {
         let f = sys.force(self.t, v);
         let c_m = if sys.coupling == Coupling::Plain { f } else { self.c_m };
         for (r, y) in [(vr::X, x), (vr::V, v), (vr::START_F, self.f_start), (vr::C_M, c_m), (port::vr::F, f)] {
+            values.set_real(r, y);
+        }
+        for (r, y) in (vr::GEOMETRY..).zip(self.geometry) {
             values.set_real(r, y);
         }
         sys.boom.outputs(q, qd, [vr::THETA, vr::OMEGA, vr::PAYLOAD_X, vr::PAYLOAD_Y], values);

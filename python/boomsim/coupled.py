@@ -1,0 +1,160 @@
+"""The co-simulation loop of one or more HydraulicCircuit instances (FMI 2.0 Co-Simulation through
+fmpy), each with its valve command and optionally its PressureFeedbackController, and one
+mechanics (boomsim.mechanics) with a cylinder for each: boomsim.split (BoomMechanics) and
+boomsim.mujoco (MuJoCo) run it.
+
+Couplings (docs/coupling.md):
+    plain        Gauss-Seidel: mechanics first with F_k held -> x_k+1, v_k+1 -> each circuit steps
+                 with v linear from v_k to v_k+1 (fmi2SetRealInputDerivatives) -> F_k+1
+    jacobi       plain, both step from the values at t_k (v held), as a parallel master does
+    tlm          waves c_h, c_m exchanged once per step: mechanics first with c_h held, then each
+                 circuit with c_m linear over the step
+    tlm-jacobi   TLM, both from the waves at t_k
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .fmus import Direct
+from .result import PLANT_OUT
+from .scenarios import communication_references
+
+COUPLINGS = ("plain", "jacobi", "tlm", "tlm-jacobi")
+#: HydraulicCircuit's and BoomMechanics' port.coupling of each port.
+PORT_CODES = {"plain": 0, "tlm": 1}
+#: Circuit outputs recorded (PLANT_OUT without the stroke and velocity, which come from
+#: the mechanics).
+CIRCUIT_OUT = [c for c in PLANT_OUT if not c.startswith("cylinder.")]
+
+
+class Unstable(Exception):
+    """The coupled run diverged (a step was refused or the motion left the stroke)."""
+
+
+@dataclasses.dataclass
+class Drive:
+    """One cylinder's hydraulics, initialised: a HydraulicCircuit instance and its FmuFile, the
+    operator's reference table ([t, u_ref] rows), and a PressureFeedbackController instance with
+    its FmuFile, or None (the valve then takes the reference)."""
+
+    circuit: object
+    circuit_f: object
+    table: np.ndarray
+    controller: object = None
+    controller_f: object = None
+
+
+def start_circuit(circuit_f, circuit, port: str, x: float, v: float, f_start: float, params: dict) -> None:
+    """Sets a HydraulicCircuit in Initialization Mode to its mechanics' start (stroke, rate and the
+    holding force; the port) and `params`, and leaves Initialization Mode."""
+    for name, value in (("start.x", x), ("start.F", f_start), ("port.coupling", PORT_CODES[port]),
+                        ("cylinder.x", x), ("cylinder.v", v), *params.items()):
+        circuit_f.set(circuit, name, value)
+    circuit.exitInitializationMode()
+
+
+def start_controller(controller_f, controller, config: dict, p4: float, u_ref: float) -> None:
+    """Sets a PressureFeedbackController in Initialization Mode to `config` (enable, and K_f,
+    omega_f, u_min, u_max where given), its inputs to the circuit's p4 and the reference at t = 0,
+    and leaves Initialization Mode."""
+    for name in ("K_f", "omega_f", "u_min", "u_max"):
+        if name in config:
+            controller_f.set(controller, name, config[name])
+    controller_f.set(controller, "enable", bool(config["enable"]))
+    vc = controller_f.vr
+    controller.setReal([vc["p"], vc["u_ref"]], [p4, u_ref])
+    controller.exitInitializationMode()
+
+
+class _Calls:
+    """One drive's FMU calls of the loop, bound once (boomsim.fmus.Direct)."""
+
+    def __init__(self, d: Drive):
+        vh, c = d.circuit_f.vr, Direct(d.circuit)
+        self.outputs = c.getter([vh[k] for k in CIRCUIT_OUT])
+        self.c_h, self.force = c.getter([vh["port.c_h"]]), c.getter([vh["cylinder.F"]])
+        self.u_ref, self.c_m, self.motion = c.setter([vh["valve.u_ref"]]), c.setter([vh["port.c_m"]]), \
+            c.setter([vh["cylinder.x"], vh["cylinder.v"]])
+        self.c_m_slope, self.v_slope = c.setter([vh["port.c_m"]], True), c.setter([vh["cylinder.v"]], True)
+        self.step = c.stepper()
+        self.controlled = d.controller is not None
+        if self.controlled:
+            vc, k = d.controller_f.vr, Direct(d.controller)
+            self.command = k.getter([vc["u"], vc["u_comp"]])
+            self.p_slope, self.inputs = k.setter([vc["p"]], True), k.setter([vc["p"], vc["u_ref"]])
+            self.control_step = k.stepper()
+
+
+def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, record_every: int) -> list[np.ndarray]:
+    """`n` communication steps of `step` from t = 0 with the drives and mechanics initialised (each
+    circuit's start state from the mechanics' start); per drive its recorded rows (COLUMNS) every
+    `record_every` steps. Raises Unstable when a stroke leaves its range or an output its domain."""
+    calls = [_Calls(d) for d in drives]
+    x, v = mechanics.motion()
+    i_p4 = CIRCUIT_OUT.index("p4")
+    at = {c: k for k, c in enumerate(CIRCUIT_OUT)}
+    order = [at.get(c) for c in PLANT_OUT]  # PLANT_OUT's circuit columns in CIRCUIT_OUT, None: x, v
+    y = [list(c.outputs()) for c in calls]
+    stroke = [d.circuit.getReal([d.circuit_f.vr["cylinder.stroke"]])[0] for d in drives]
+    p4 = [yi[i_p4] for yi in y]
+    refs = [communication_references(d.table, step, n) for d in drives]
+    u_ref = [r[0] for r in refs]
+    rows = [[] for _ in drives]
+    for k in range(n + 1):
+        t = k * step
+        for i, (d, c) in enumerate(zip(drives, calls)):
+            u, u_comp = c.command() if c.controlled else (u_ref[i], 0.0)
+            c.u_ref((u,))
+            if k % record_every == 0:
+                motion = {"cylinder.x": x[i], "cylinder.v": v[i]}
+                rows[i].append([t, u_ref[i], u_comp, u,
+                                *(y[i][j] if j is not None else motion[col] for j, col in zip(order, PLANT_OUT))])
+        if k == n:
+            break
+        for i in range(len(drives)):
+            if not (-0.05 < x[i] < stroke[i] + 0.05) or not all(map(math.isfinite, y[i])):
+                raise Unstable(f"{coupling}, h = {step:g} s: the motion diverged at t = {t:.4g} s "
+                               f"(cylinder {i}: x = {x[i]:.4g} m)")
+        if coupling.startswith("tlm"):
+            c_h = [c.c_h()[0] for c in calls]
+            c_m = mechanics.wave()
+            for c, w in zip(calls, c_m):
+                c.c_m((w,))
+            if coupling == "tlm":
+                mechanics.step(t, step, c_h)
+                for c, c0, c1 in zip(calls, c_m, mechanics.wave()):
+                    c.c_m_slope(((c1 - c0) / step,))
+                    c.step(t, step)
+            else:
+                for c in calls:
+                    c.step(t, step)
+                mechanics.step(t, step, c_h)
+            x, v = mechanics.motion()
+        else:
+            force = [c.force()[0] for c in calls]
+            if coupling == "jacobi":
+                for c in calls:
+                    c.step(t, step)
+            mechanics.step(t, step, force)
+            x1, v1 = mechanics.motion()
+            if coupling == "plain":
+                for c, a, b in zip(calls, v, v1):
+                    c.v_slope(((b - a) / step,))
+                    c.step(t, step)
+            x, v = x1, v1
+            for c, xi, vi in zip(calls, x, v):
+                c.motion((xi, vi))
+        for i, (d, c) in enumerate(zip(drives, calls)):
+            y[i] = list(c.outputs())
+            u_ref[i] = refs[i][k + 1]
+            if c.controlled:
+                p4_next = y[i][i_p4]
+                c.p_slope(((p4_next - p4[i]) / step,))
+                c.control_step(t, step)
+                c.inputs((p4_next, u_ref[i]))
+            p4[i] = y[i][i_p4]
+    return [np.array(r) for r in rows]
