@@ -1,6 +1,7 @@
 """Records every output a refactor must leave unchanged, for `scripts/same-outputs`: the time
 series of every scenario variant of the regression (Co-Simulation, FMI 2.0), of scenario B over
-the regression's communication steps, of U and B through `boomsim cosim` (the native runner), in
+the regression's communication steps, of U and B through `boomsim cosim` (the native runner) and
+the split system (HydraulicCircuit + BoomMechanics, each coupling, 5 s), in
 FMI 3.0 Co-Simulation (inputs held) and in
 Model Exchange under fmpy's CVode (FMI 2.0 and 3.0, rigid boom, 1 s), with the work counts of each
 run, and the counts of `boomsim bench --json` (steps, right-hand sides, Jacobians; not its
@@ -24,7 +25,7 @@ import sys
 
 import numpy as np
 
-from boomsim import cosim, regression
+from boomsim import cosim, regression, split
 from boomsim.model_exchange import run_me
 from boomsim.native import run_native
 from boomsim.paths import boomsim_binary
@@ -49,6 +50,8 @@ def record(path: pathlib.Path) -> None:
     runs += [(f"step/{h:g}", lambda h=h: cosim.run(b, "rigid", step=h)) for h in STEPS]
     for sid in ("U", "B"):
         sc = load_scenario(sid)
+        for coupling in split.COUPLINGS:
+            runs.append((f"split/{sid} {coupling}", lambda sc=sc, c=coupling: split.run(sc, "rigid", c, 1e-3, 5.0)))
         runs.append((f"fmi3/{sid}", lambda sc=sc: cosim.run(sc, "rigid", fmi=3, interpolate=False)))
         runs.append((f"native/{sid}", lambda sc=sc: run_native(sc, "rigid")))
         for fmi in (2, 3):

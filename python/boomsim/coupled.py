@@ -89,10 +89,13 @@ class _Calls:
             self.control_step = k.stepper()
 
 
-def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, record_every: int) -> list[np.ndarray]:
+def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, record_every: int,
+         control_every: int = 1) -> list[np.ndarray]:
     """`n` communication steps of `step` from t = 0 with the drives and mechanics initialised (each
     circuit's start state from the mechanics' start); per drive its recorded rows (COLUMNS) every
-    `record_every` steps. Raises Unstable when a stroke leaves its range or an output its domain."""
+    `record_every` steps. The controllers step every `control_every` steps (their command held,
+    p4 linear over their step). Raises Unstable when a stroke leaves its range or an output its
+    domain."""
     calls = [_Calls(d) for d in drives]
     x, v = mechanics.motion()
     i_p4 = CIRCUIT_OUT.index("p4")
@@ -100,14 +103,19 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
     order = [at.get(c) for c in PLANT_OUT]  # PLANT_OUT's circuit columns in CIRCUIT_OUT, None: x, v
     y = [list(c.outputs()) for c in calls]
     stroke = [d.circuit.getReal([d.circuit_f.vr["cylinder.stroke"]])[0] for d in drives]
-    p4 = [yi[i_p4] for yi in y]
     refs = [communication_references(d.table, step, n) for d in drives]
     u_ref = [r[0] for r in refs]
     rows = [[] for _ in drives]
+    held = [(0.0, 0.0)] * len(drives)  # each controller's (u, u_comp) over its step
+    p4_held = [yi[i_p4] for yi in y]  # p4 at the start of each controller's step
     for k in range(n + 1):
         t = k * step
         for i, (d, c) in enumerate(zip(drives, calls)):
-            u, u_comp = c.command() if c.controlled else (u_ref[i], 0.0)
+            if not c.controlled:
+                held[i] = (u_ref[i], 0.0)
+            elif k % control_every == 0:
+                held[i] = tuple(c.command())
+            u, u_comp = held[i]
             c.u_ref((u,))
             if k % record_every == 0:
                 motion = {"cylinder.x": x[i], "cylinder.v": v[i]}
@@ -151,10 +159,10 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
         for i, (d, c) in enumerate(zip(drives, calls)):
             y[i] = list(c.outputs())
             u_ref[i] = refs[i][k + 1]
-            if c.controlled:
-                p4_next = y[i][i_p4]
-                c.p_slope(((p4_next - p4[i]) / step,))
-                c.control_step(t, step)
+            if c.controlled and (k + 1) % control_every == 0:
+                p4_next, macro = y[i][i_p4], control_every * step
+                c.p_slope(((p4_next - p4_held[i]) / macro,))
+                c.control_step((k + 1 - control_every) * step, macro)
                 c.inputs((p4_next, u_ref[i]))
-            p4[i] = y[i][i_p4]
+                p4_held[i] = p4_next
     return [np.array(r) for r in rows]

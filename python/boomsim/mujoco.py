@@ -187,18 +187,22 @@ class MujocoMechanics(Mechanics):
         self._rods = [(float(c.rod_mass * self.model.opt.gravity[2]), int(a), int(b), int(t))
                       for c, a, b, t in zip(cylinders, self.site_from, self.site_to, self.tendon)]
         self.substeps = substeps
-        self.monitor, self.record_every, self.records, self.steps = monitor, record_every, [], 0
+        self.monitor, self.record_every, self.records, self.qpos, self.steps = monitor, record_every, [], [], 0
         mujoco.mj_forward(self.model, self.data)
         self._record(0.0)
 
     def _record(self, t: float) -> None:
-        if self.monitor is not None and self.steps % self.record_every == 0:
-            self.records.append([float(y) for y in self.monitor(t, self.model, self.data)])
+        if self.steps % self.record_every == 0:
+            self.qpos.append(self.data.qpos.copy())
+            if self.monitor is not None:
+                self.records.append([float(y) for y in self.monitor(t, self.model, self.data)])
 
     def _jacobian(self) -> np.ndarray:
         """The cylinders' tendon Jacobians (rows) now."""
         m = self.model
-        return np.asarray(self.data.ten_J).reshape(m.ntendon, m.nv)[self.tendon]
+        dense = np.zeros((m.ntendon, m.nv))
+        mujoco.mju_sparse2dense(dense, self.data.ten_J, m.ten_J_rownnz, m.ten_J_rowadr, m.ten_J_colind)
+        return dense[self.tendon]
 
     def _rod_weight(self) -> np.ndarray:
         """The rod's weight along each cylinder's axis, > 0 pushing out: m_rod g . e, e the unit
@@ -219,9 +223,22 @@ class MujocoMechanics(Mechanics):
 
     def holding_force(self) -> np.ndarray:
         """The forces along the cylinders that hold the model at rest at the start: least squares
-        of J^T F = qfrc_bias - qfrc_passive over the joints, and the rods' weight."""
-        d = self.data
-        force = np.linalg.lstsq(self._jacobian().T, d.qfrc_bias - d.qfrc_passive, rcond=None)[0]
+        of J^T F = qfrc_bias - qfrc_passive - qfrc_constraint over the joints, and the rods' weight.
+        The constraint forces (a rope, a contact) depend on F: the fixed point of F and their
+        solution, to 1e-10 of F."""
+        m, d = self.model, self.data
+        force = np.zeros(len(self.tendon))
+        for _ in range(100):
+            d.ctrl[self.actuator] = force + np.array(self._rod_weight())
+            mujoco.mj_forward(m, d)
+            load = d.qfrc_bias - d.qfrc_passive - d.qfrc_constraint
+            new = np.linalg.lstsq(self._jacobian().T, load, rcond=None)[0]
+            done = np.all(np.abs(new - force) <= 1e-10 * np.abs(new))
+            force = new
+            if done:
+                break
+        d.ctrl[:] = 0.0
+        mujoco.mj_forward(m, d)
         return force - np.array(self._rod_weight())
 
     def motion(self) -> tuple[np.ndarray, np.ndarray]:
@@ -305,23 +322,35 @@ def check_damping_bound(mech: MujocoMechanics, cylinders: list[Cylinder]) -> Non
                 f"{bound * m_eff / z_c:.3g} s")
 
 
+def whole_multiple(name: str, value: float, of: str, unit: float) -> int:
+    """`value` / `unit`, a whole number >= 1, or a UsageError naming `name`."""
+    k = int(round(value / unit))
+    if k < 1 or abs(k * unit - value) > 1e-9 * value:
+        raise UsageError(f"{name} = {value:g} s must be {of} {unit:g} s or a whole multiple of it")
+    return k
+
+
 @dataclasses.dataclass
 class MujocoRun:
-    """A coupled run: a Result per cylinder (by name), the monitor's rows (one per recorded
-    communication point) and the compiled MjModel with the cylinders' tendons and actuators."""
+    """A coupled run: a Result per cylinder (by name), the monitor's rows and MuJoCo's qpos (one
+    per recorded communication point) and the compiled MjModel with the cylinders' tendons and
+    actuators."""
 
     results: dict
     monitored: np.ndarray
+    qpos: np.ndarray
     model: object
 
 
 def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | None = None,
-        stop_time: float = 1.0, key: str | None = "start", monitor=None, record_every: int | None = None) -> MujocoRun:
+        stop_time: float = 1.0, key: str | None = "start", monitor=None, record_every: int | None = None,
+        control_step: float | None = None) -> MujocoRun:
     """Couples a HydraulicCircuit to each cylinder of the MJCF `model` (text, path or MjSpec), from
     rest at the keyframe `key`, for `stop_time` [s] at the communication step `step` (MuJoCo's
     timestep when None, else a whole multiple of it) with `coupling` (boomsim.coupled.COUPLINGS).
     Records every `record_every` steps (1 ms by default); `monitor(t, model, data)` returns the
-    numbers to keep at each recorded point (a contact force, a body position)."""
+    numbers to keep at each recorded point (a contact force, a body position). The controllers
+    step every `control_step` (default: `step`; a whole multiple of it)."""
     if coupling not in COUPLINGS:
         raise UsageError(f"coupling = {coupling!r}: must be one of {COUPLINGS}")
     if not cylinders:
@@ -331,11 +360,10 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
     port = "tlm" if coupling.startswith("tlm") else "plain"
     timestep = spec.option.timestep
     step = timestep if step is None else step
-    substeps = int(round(step / timestep))
-    if substeps < 1 or abs(substeps * timestep - step) > 1e-9 * step:
-        raise UsageError(f"step = {step:g} s must be MuJoCo's timestep {timestep:g} s or a whole multiple of it")
+    substeps = whole_multiple("step", step, "MuJoCo's timestep", timestep)
     n = int(round(stop_time / step))
     record_every = record_every or max(1, int(round(1e-3 / step)))
+    control_every = whole_multiple("control_step", step if control_step is None else control_step, "the step", step)
     circ_f, ctrl_f = FmuFile.get("HydraulicCircuit"), FmuFile.get("PressureFeedbackController")
     for c in cylinders:
         for name in c.circuit:
@@ -368,7 +396,7 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
                 p4 = circ.getReal([circ_f.vr["p4"]])[0]
                 start_controller(ctrl_f, ctrl, {"enable": True, **c.controller}, p4, reference(table, 0.0))
             drives.append(Drive(circ, circ_f, table, ctrl, ctrl_f))
-        data = loop(drives, mech, coupling, step, n, record_every)
+        data = loop(drives, mech, coupling, step, n, record_every, control_every)
         counts = [dict(zip(COUNTS, map(int, d.circuit.getReal([circ_f.vr[f"solver.{k}"] for k in COUNTS]))))
                   for d in drives]
     except FMICallException as e:
@@ -380,21 +408,21 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
         scenario = {"id": c.name, "stop_time": stop_time, "step": step, "reference": table}
         results[c.name] = Result(scenario, "mujoco", step, True, {col: rows[:, j] for j, col in enumerate(COLUMNS)}, None,
                                  counts=work)
-    return MujocoRun(results, np.array(mech.records), mech.model)
+    return MujocoRun(results, np.array(mech.records), np.array(mech.qpos), mech.model)
 
 
 def scenario_run(sc: dict, coupling: str = "tlm", step: float = 5e-4, integrator: str = "RK4",
                  stop_time: float | None = None) -> Result:
     """A boomsim scenario (its start stroke, reference, controller and [plant] parameters) with the
     thesis' rigid boom in MuJoCo at the communication step `step` (MuJoCo's timestep: `step`, at
-    most 1 ms)."""
+    most 1 ms), the controller at the scenario's step (as HydraulicBoom's runs take it) or `step`."""
     boom = FmuFile.get("BoomMechanics").vars
     params = {k: v for k, v in sc["plant"].items() if k in boom and boom[k].causality == "parameter"}
     xml = boom_mjcf(sc["start_stroke"], params, timestep=min(step, 1e-3), integrator=integrator)
     circuit = {k: v for k, v in sc["plant"].items() if k in FmuFile.get("HydraulicCircuit").vars}
     controller = sc["controller"] if sc["controller"].get("enable") else None
     r = run(xml, [thesis_cylinder(sc["reference"], controller, circuit, params)], coupling, step,
-            sc["stop_time"] if stop_time is None else stop_time)
+            sc["stop_time"] if stop_time is None else stop_time, control_step=max(step, sc["step"]))
     return dataclasses.replace(r.results["boom"], scenario=sc)
 
 
@@ -419,32 +447,41 @@ def main(argv=None):
     ap.add_argument("--table", action="store_true", help="each metric's error against the step, plain and TLM")
     ap.add_argument("--sweep", action="store_true", help="largest stable step of each coupling (LIFT)")
     ap.add_argument("--alpha", type=float, default=0.0, help="TLM wave damping port.alpha of the sweep")
+    ap.add_argument("--repeats", type=int, default=1, help="wall times: the best of this many runs")
     args = ap.parse_args(argv)
     if args.sweep:
         runner = lambda sc, c, h: scenario_run(sc, c, h, args.integrator)  # noqa: E731
         split.print_sweep(f"mujoco {args.integrator} alpha {args.alpha:g}",
                           split.sweep("rigid", alpha=args.alpha, runner=runner))
         return
+    def timed(f):
+        """f() and its best wall time of --repeats runs."""
+        best = float("inf")
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            out = f()
+            best = min(best, time.perf_counter() - t0)
+        return out, best
+
     for sid in args.scenario:
         sc = load_scenario(sid)
-        t0 = time.perf_counter()
-        mono = cosim.run(sc, "rigid", 1e-3)
-        t_mono = time.perf_counter() - t0
+        mono, t_mono = timed(lambda: cosim.run(sc, "rigid", 1e-3))
         ref = mx.compute(mono)
         cases = [(c, h) for c in ("tlm", "plain") for h in TABLE_STEPS] if args.table else [(args.coupling, args.step)]
         got = {}
         for c, h in cases:
-            t0 = time.perf_counter()
-            r = scenario_run(sc, c, h, args.integrator)
-            got[c, h] = (mx.compute(r), time.perf_counter() - t0, r.counts)
+            r, wall = timed(lambda: scenario_run(sc, c, h, args.integrator))
+            got[c, h] = (mx.compute(r), wall, r.counts)
         print(f"\n{sid}-rigid, MuJoCo {args.integrator}: error of each metric against HydraulicBoom + controller "
-              f"through fmpy at 1 ms (wall {t_mono:.2f} s, {mono.counts['rhs']} RHS)\n")
+              f"through fmpy at 1 ms (wall {t_mono:.2f} s, best of {args.repeats}; {mono.counts['rhs']} RHS); the "
+              f"controller at 1 ms\n")
         print("| metric | HydraulicBoom | " + " | ".join(f"{c} {h * 1e3:g} ms" for c, h in cases) + " |")
         print("|---|---|" + "---|" * len(cases))
         for k, a in ref.items():
             if a is None or a == 0 or any(g[0][k] is None for g in got.values()):
                 continue
             print(f"| {k} | {a:.5g} | " + " | ".join(f"{(g[0][k] - a) / abs(a) * 100:+.2f} %" for g in got.values()) + " |")
+        print(f"| wall time [s] | {t_mono:.2f} | " + " | ".join(f"{g[1]:.2f}" for g in got.values()) + " |")
         print("| wall time / HydraulicBoom's | 1 | " + " | ".join(f"{g[1] / t_mono:.2f}" for g in got.values()) + " |")
         print("| circuit steps, RHS | | " + " | ".join(f"{g[2]['steps']}, {g[2]['rhs_evals']}" for g in got.values()) + " |")
 
@@ -455,3 +492,27 @@ if __name__ == "__main__":
     from .errors import cli
 
     sys.exit(cli(main))
+
+
+def draw(ax, model, qpos, color="0.3") -> None:
+    """The model at `qpos` in MuJoCo's x-z plane (the thesis' x-y): capsules as lines, boxes as
+    their outline, planes as the ground line, tendons (the cylinders, a rope) through their sites
+    (red)."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    for g in range(model.ngeom):
+        kind, size, pos, rot = model.geom_type[g], model.geom_size[g], data.geom_xpos[g], data.geom_xmat[g].reshape(3, 3)
+        if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
+            ends = np.array([pos - rot[:, 2] * size[1], pos + rot[:, 2] * size[1]])
+            ax.plot(ends[:, 0], ends[:, 2], color=color, lw=4, solid_capstyle="round")
+        elif kind == mujoco.mjtGeom.mjGEOM_BOX:
+            corners = np.array([pos + rot @ (size * [a, 0, b]) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1))])
+            ax.fill(corners[:, 0], corners[:, 2], color=color, alpha=0.5)
+        elif kind == mujoco.mjtGeom.mjGEOM_PLANE:
+            ax.axhline(pos[2], color="0.5", lw=1)
+    for t in range(model.ntendon):
+        wraps = range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t])
+        sites = [model.wrap_objid[w] for w in wraps if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_SITE]
+        points = data.site_xpos[sites]
+        ax.plot(points[:, 0], points[:, 2], color="tab:red", lw=2)

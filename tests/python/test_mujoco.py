@@ -18,6 +18,7 @@ import mujoco
 from boomsim import cosim, split
 from boomsim import metrics as mx
 from boomsim import mujoco as bm
+from boomsim import mujoco_scenes
 from boomsim.errors import UsageError
 from boomsim.fmus import FmuFile
 from boomsim.scenarios import load_scenario
@@ -60,7 +61,7 @@ def test_effective_mass_is_the_rigid_booms():
     (the inverse moment arm): 1e-9, rounding."""
     m = mechanics(bm.boom_mjcf(), bm.thesis_cylinder())
     g = bm.boom_geometry()
-    moment_arm = np.asarray(m.data.ten_J).ravel()[0]  # dl/dtheta2
+    moment_arm = m._jacobian()[0, 0]  # dl/dtheta2
     assert m.effective_mass()[0] == pytest.approx(g["boom.J_B"] / moment_arm**2 + g["cylinder.m_rod"], rel=1e-9)
 
 
@@ -115,10 +116,13 @@ def test_bad_cylinder_is_named(change, message):
 
 
 def test_bad_run_arguments_are_named():
-    """A step that is not a multiple of the timestep, a missing keyframe, an unknown coupling."""
+    """A step that is not a multiple of the timestep, a controller step that is not one of the
+    step, a missing keyframe, an unknown coupling, MJCF that does not load."""
     c = bm.thesis_cylinder(-0.3)
-    with pytest.raises(UsageError, match="whole multiple"):
+    with pytest.raises(UsageError, match="step = 0.0015 s must be MuJoCo's timestep 0.001 s or a whole multiple"):
         bm.run(BOOM, [c], "tlm", step=1.5e-3, stop_time=0.01)
+    with pytest.raises(UsageError, match="control_step = 0.0025 s must be the step 0.001 s or a whole multiple"):
+        bm.run(BOOM, [c], "tlm", stop_time=0.01, control_step=2.5e-3)
     with pytest.raises(UsageError, match="no keyframe 'rest'"):
         bm.run(BOOM, [c], "tlm", stop_time=0.01, key="rest")
     with pytest.raises(UsageError, match="coupling"):
@@ -135,3 +139,23 @@ def test_implicit_integrator_has_no_damping_bound():
     run = bm.run(xml, [c], "tlm", stop_time=0.05)
     assert np.all(np.isfinite(run.results["boom"]["p3"]))
     assert mujoco.mjtIntegrator(run.model.opt.integrator) == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+
+
+def test_touchdown_rests_the_payload_on_the_ground(tmp_path):
+    """Example (a): the boom lowers its payload on a rope onto the ground, then the valve closes.
+    At the end the payload rests on the ground with the rope slack: the contact force is its
+    weight, payload.m g (statics of a body at rest; 1 %: the soft contact's residual motion), it
+    touched down before the valve closed, and every pressure stayed finite and above absolute zero
+    (-1.01325 bar gauge, the model's domain)."""
+    scene = mujoco_scenes.touchdown()
+    run = mujoco_scenes.run(scene)
+    res, mon = run.results["boom"], run.monitored
+    boom = FmuFile.get("BoomMechanics").vars
+    weight = float(boom["payload.m"].start) * float(boom["env.g"].start)
+    t = res["time"]
+    assert mon[-1, 0] == pytest.approx(weight, rel=0.01)
+    assert mon[-1, 2] < 0.5, "the rope is slack"
+    assert t[np.argmax(mon[:, 0] > 0)] < 9.0, "touchdown before the valve closes"
+    for p in ("p1", "p2", "p3", "p4"):
+        assert np.all(np.isfinite(res[p])) and res[p].min() > -1.01325e5, p
+    mujoco_scenes.plot_touchdown(run, tmp_path / "touchdown.png")
