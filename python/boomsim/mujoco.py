@@ -90,30 +90,30 @@ def boom_geometry(start_stroke: float = 0.48, params: dict | None = None) -> dic
     """BoomMechanics' GEOMETRY values with `params` (BoomMechanics parameters by name) at rest at
     `start_stroke` [m]: the same numbers the FMUs compute with, none copied."""
     f = FmuFile.get("BoomMechanics")
+    for name in params or {}:
+        if name not in f.vars or f.vars[name].causality != "parameter":
+            raise UsageError(f"BoomMechanics has no parameter {name!r}")
     s = f.slave("boomsim.mujoco.geometry")
     try:
         s.setupExperiment(startTime=0.0)
         s.enterInitializationMode()
         for name, value in {"boom.flexible": False, "start.x": start_stroke, **(params or {})}.items():
-            if name not in f.vars:
-                raise UsageError(f"BoomMechanics has no parameter {name!r}")
             f.set(s, name, value)
         s.exitInitializationMode()
         return dict(zip(GEOMETRY, s.getReal([f.vr[n] for n in GEOMETRY])))
     finally:
-        s.terminate()
-        s.freeInstance()
+        release(s)
 
 
 def boom_mjcf(start_stroke: float = 0.48, params: dict | None = None, timestep: float = 1e-3,
-              integrator: str = "RK4", ground: float | None = None) -> str:
+              integrator: str = "RK4") -> str:
     """MJCF of the thesis' rigid boom (2.1.1-2.1.2) from `boom_geometry`: the lower cylinder pin A
     at the origin (site `cylinder.lower`), the boom a body on a hinge at the joint B (joint
     `boom.theta`, its angle theta2, > 0 up, in MuJoCo's x-z plane: thesis x -> x, y -> z) with arm
     and payload's mass m_D, mass centre e_cm and J_B about B, the upper pin C (site
-    `cylinder.upper`), and the keyframe `start` at rest at `start_stroke`. Its geoms carry no mass:
-    a capsule along the arm and a 0.3 m cube at the payload's mass centre, which the thesis does
-    not size (contact with `ground`, a plane at that height [m], when given)."""
+    `cylinder.upper`), and the keyframe `start` at rest at `start_stroke`. Its geoms carry no mass
+    and touch nothing: a capsule along the arm and a 0.3 m cube at the payload's mass centre,
+    which the thesis does not size."""
     g = boom_geometry(start_stroke, params)
     theta = g["boom.theta"]
     rot = np.array([[np.cos(theta), np.sin(theta)], [-np.sin(theta), np.cos(theta)]])
@@ -121,13 +121,10 @@ def boom_mjcf(start_stroke: float = 0.48, params: dict | None = None, timestep: 
     cm = (g["boom.cm.x"], g["boom.cm.y"])
     i_cm = g["boom.J_B"] - g["boom.m_D"] * (cm[0] ** 2 + cm[1] ** 2)  # about the mass centre (parallel axis)
     arm0, arm1 = -g["boom.b7"], g["boom.l_arm"] - g["boom.b7"]
-    floor = "" if ground is None else f'<geom name="ground" type="plane" pos="0 0 {ground!r}" size="6 3 0.1"/>'
-    contact = 'contype="1" conaffinity="1"' if ground is not None else 'contype="0" conaffinity="0"'
     return f"""<mujoco model="boomsim thesis boom">
   <compiler angle="radian" inertiafromgeom="false"/>
   <option timestep="{timestep!r}" integrator="{integrator}" gravity="0 0 {-g['env.g']!r}"/>
   <worldbody>
-    {floor}
     <site name="cylinder.lower" pos="0 0 0" size="0.03"/>
     <geom name="lower_beam" type="capsule" fromto="0 0 0 {g['boom.joint.x']!r} 0 {g['boom.joint.y']!r}" size="0.04"
           contype="0" conaffinity="0"/>
@@ -135,7 +132,8 @@ def boom_mjcf(start_stroke: float = 0.48, params: dict | None = None, timestep: 
       <joint name="boom.theta" type="hinge" axis="0 -1 0"/>
       <inertial pos="{cm[0]!r} 0 {cm[1]!r}" mass="{g['boom.m_D']!r}" diaginertia="{i_cm!r} {i_cm!r} {i_cm!r}"/>
       <geom name="arm" type="capsule" fromto="{arm0!r} 0 0 {arm1!r} 0 0" size="0.05" contype="0" conaffinity="0"/>
-      <geom name="payload" type="box" pos="{payload[0]!r} 0 {payload[1]!r}" size="0.15 0.15 0.15" {contact}/>
+      <geom name="payload" type="box" pos="{payload[0]!r} 0 {payload[1]!r}" size="0.15 0.15 0.15"
+            contype="0" conaffinity="0"/>
       <site name="cylinder.upper" pos="{g['boom.pin.x']!r} 0 {g['boom.pin.y']!r}" size="0.03"/>
     </body>
   </worldbody>
