@@ -79,6 +79,10 @@ class Cylinder:
         return table
 
 
+#: Half the side of the payload's cube in `boom_mjcf` [m]: for drawing and contact; the thesis
+#: does not size it.
+PAYLOAD_HALF = 0.15
+
 #: BoomMechanics' variables the MJCF of the thesis' boom is built from: the rigid boom's geometry
 #: and mass (calculated parameters), the start angle and payload, the cylinder's and gravity.
 GEOMETRY = ("boom.joint.x", "boom.joint.y", "boom.pin.x", "boom.pin.y", "boom.cm.x", "boom.cm.y", "boom.m_D",
@@ -112,8 +116,8 @@ def boom_mjcf(start_stroke: float = 0.48, params: dict | None = None, timestep: 
     `boom.theta`, its angle theta2, > 0 up, in MuJoCo's x-z plane: thesis x -> x, y -> z) with arm
     and payload's mass m_D, mass centre e_cm and J_B about B, the upper pin C (site
     `cylinder.upper`), and the keyframe `start` at rest at `start_stroke`. Its geoms carry no mass
-    and touch nothing: a capsule along the arm and a 0.3 m cube at the payload's mass centre,
-    which the thesis does not size."""
+    and touch nothing: a capsule along the arm and a cube of PAYLOAD_HALF at the payload's mass
+    centre."""
     g = boom_geometry(start_stroke, params)
     theta = g["boom.theta"]
     rot = np.array([[np.cos(theta), np.sin(theta)], [-np.sin(theta), np.cos(theta)]])
@@ -132,7 +136,7 @@ def boom_mjcf(start_stroke: float = 0.48, params: dict | None = None, timestep: 
       <joint name="boom.theta" type="hinge" axis="0 -1 0"/>
       <inertial pos="{cm[0]!r} 0 {cm[1]!r}" mass="{g['boom.m_D']!r}" diaginertia="{i_cm!r} {i_cm!r} {i_cm!r}"/>
       <geom name="arm" type="capsule" fromto="{arm0!r} 0 0 {arm1!r} 0 0" size="0.05" contype="0" conaffinity="0"/>
-      <geom name="payload" type="box" pos="{payload[0]!r} 0 {payload[1]!r}" size="0.15 0.15 0.15"
+      <geom name="payload" type="box" pos="{payload[0]!r} 0 {payload[1]!r}" size="{PAYLOAD_HALF} {PAYLOAD_HALF} {PAYLOAD_HALF}"
             contype="0" conaffinity="0"/>
       <site name="cylinder.upper" pos="{g['boom.pin.x']!r} 0 {g['boom.pin.y']!r}" size="0.03"/>
     </body>
@@ -187,6 +191,7 @@ class MujocoMechanics(Mechanics):
         self.substeps = substeps
         self.monitor, self.record_every, self.records, self.qpos, self.steps = monitor, record_every, [], [], 0
         mujoco.mj_forward(self.model, self.data)
+        self._holding = self._static_force()
         self._record(0.0)
 
     def _record(self, t: float) -> None:
@@ -220,6 +225,9 @@ class MujocoMechanics(Mechanics):
         return np.array(out)
 
     def holding_force(self) -> np.ndarray:
+        return self._holding
+
+    def _static_force(self) -> np.ndarray:
         """The forces along the cylinders that hold the model at rest at the start: least squares
         of J^T F = qfrc_bias - qfrc_passive - qfrc_constraint over the joints, and the rods' weight.
         The constraint forces (a rope, a contact) depend on F: the fixed point of F and their

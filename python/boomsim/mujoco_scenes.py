@@ -17,8 +17,6 @@ import mujoco
 from . import mujoco as bm
 from .fmus import FmuFile
 
-#: Half the side of the payload's cube [m]: the thesis does not size it.
-PAYLOAD_HALF = 0.15
 #: The rope's stretch at the start [m]: MuJoCo's limit acts once the length passes its range.
 ROPE_STRETCH = 1e-3
 
@@ -42,7 +40,7 @@ def _payload_mass() -> float:
 def touchdown(start_stroke: float = 0.48, drop: float = 0.25, rope: float = 0.5, close_at: float = 9.0,
               timestep: float = 5e-4) -> Scene:
     """The arm of the thesis (its payload.m = 0 in the body) with the payload, BoomMechanics'
-    payload.m, a cube of PAYLOAD_HALF on a rope of `rope` m from the payload's point on the arm;
+    payload.m, a cube of bm.PAYLOAD_HALF on a rope of `rope` m from the payload's point on the arm;
     the ground `drop` m below the cube at the start. The valve lowers as in experiment B (u_ref =
     -0.05 with the corrected feedback) and closes at `close_at` s, after touchdown. Monitor:
     contact force on the cube (normal, summed) [N], its height [m], the rope's length [m]."""
@@ -57,15 +55,15 @@ def touchdown(start_stroke: float = 0.48, drop: float = 0.25, rope: float = 0.5,
     data.qpos[0] = g["boom.theta"]
     mujoco.mj_kinematics(probe, data)
     hook = data.site_xpos[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_SITE, "hook")].copy()
-    centre = hook - [0.0, 0.0, rope + PAYLOAD_HALF + ROPE_STRETCH]
+    centre = hook - [0.0, 0.0, rope + bm.PAYLOAD_HALF + ROPE_STRETCH]
     m = _payload_mass()
     cube = spec.worldbody.add_body(name="payload", pos=centre, mass=m, explicitinertial=True, ipos=[0.0, 0.0, 0.0],
-                                   inertia=[m * (2 * PAYLOAD_HALF) ** 2 / 6] * 3)
+                                   inertia=[m * (2 * bm.PAYLOAD_HALF) ** 2 / 6] * 3)
     cube.add_freejoint(name="payload.free")
-    cube.add_geom(name="payload", type=mujoco.mjtGeom.mjGEOM_BOX, size=[PAYLOAD_HALF] * 3, contype=1, conaffinity=1)
-    cube.add_site(name="payload.top", pos=[0, 0, PAYLOAD_HALF], size=[0.02, 0, 0])
+    cube.add_geom(name="payload", type=mujoco.mjtGeom.mjGEOM_BOX, size=[bm.PAYLOAD_HALF] * 3, contype=1, conaffinity=1)
+    cube.add_site(name="payload.top", pos=[0, 0, bm.PAYLOAD_HALF], size=[0.02, 0, 0])
     spec.worldbody.add_geom(name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[6, 3, 0.1],
-                            pos=[0, 0, centre[2] - PAYLOAD_HALF - drop], contype=1, conaffinity=1)
+                            pos=[0, 0, centre[2] - bm.PAYLOAD_HALF - drop], contype=1, conaffinity=1)
     r = spec.add_tendon(name="rope", limited=True, range=[0.0, rope])
     r.wrap_site("hook")
     r.wrap_site("payload.top")

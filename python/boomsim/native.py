@@ -29,7 +29,7 @@ def run_native(scenario: dict, boom: str = "rigid", step: float | None = None, s
     t_end, step, n, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
     table = scenario["reference"]
     # The reference at the communication points as `run` computes them (t = k step, then t + step).
-    u_ref = communication_references(table, step, n).tolist()
+    u_ref = communication_references(table, step, n)
     request = {"stop_time": t_end, "step": step, "record_every": record_every, "interpolate": interpolate,
                "feedback_start": fb_start, "enable": bool(scenario["controller"]["enable"]),
                "u_ref": u_ref, "outputs": PLANT_OUT, "cbv_open": CBV_OPEN,

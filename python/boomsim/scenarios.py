@@ -51,28 +51,23 @@ def all_scenarios() -> list[dict]:
     return [load_scenario(SCENARIO_DIR / f"{s}.toml") for s in scenario_ids()]
 
 
-def references(table: np.ndarray, times) -> np.ndarray:
-    """Operator reference at `times`: piecewise linear through the table rows, right-continuous at
+def reference(table: np.ndarray, t: float) -> float:
+    """Operator reference: piecewise linear through the table rows, right-continuous at
     repeated times (a row pair [t, a], [t, b] is a step from a to b at t); held after the end."""
     ts, us = table[:, 0], table[:, 1]
-    t = np.asarray(times, dtype=float)
     i = np.searchsorted(ts, t, side="right")
-    lo, hi = np.clip(i - 1, 0, len(ts) - 1), np.clip(i, 0, len(ts) - 1)
-    t0, t1, u0, u1 = ts[lo], ts[hi], us[lo], us[hi]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        inside = u0 + (u1 - u0) * (t - t0) / (t1 - t0)
-    return np.where(i == 0, us[0], np.where(i >= len(ts), us[-1], inside))
+    if i == 0:
+        return float(us[0])
+    if i >= len(ts):
+        return float(us[-1])
+    t0, t1, u0, u1 = ts[i - 1], ts[i], us[i - 1], us[i]
+    return float(u0 + (u1 - u0) * (t - t0) / (t1 - t0))
 
 
-def reference(table: np.ndarray, t: float) -> float:
-    """`references` at one time."""
-    return float(references(table, [t])[0])
-
-
-def communication_references(table: np.ndarray, step: float, n: int) -> np.ndarray:
+def communication_references(table: np.ndarray, step: float, n: int) -> list[float]:
     """The reference at the communication points of `n` steps of `step` as the runners step them:
     t = 0, then t_k + step with t_k = k step."""
-    return references(table, np.concatenate([[0.0], np.arange(n) * step + step]))
+    return [reference(table, 0.0)] + [reference(table, k * step + step) for k in range(n)]
 
 
 def variant_name(scenario: dict, boom: str, feedback_start: str = "t0") -> str:

@@ -53,6 +53,11 @@ impl Triangle {
         Self { w1: ux.hypot(uy), w2: lx.hypot(ly), phi1: ly.atan2(lx), phi2: uy.atan2(ux) }
     }
 
+    /// The upper cylinder pin C from B in the boom frame, (w1 cos phi2, -w1 sin phi2) (eq. 2.1, 2.5).
+    pub fn upper_pin(&self) -> Vector2<f64> {
+        Vector2::new(self.w1 * self.phi2.cos(), -self.w1 * self.phi2.sin())
+    }
+
     /// Angle at A between A -> B and A -> C, eq. (2.3).
     pub fn alpha(&self, l_cyl: f64) -> f64 {
         law_of_cosines(self.w2, l_cyl, self.w1)
@@ -150,13 +155,13 @@ impl BoomKinematics {
     pub fn new(p: &BoomParams) -> Self {
         let triangle = Triangle::new(p);
         let body = Body::new(p);
-        let Triangle { w1, w2, phi1, phi2 } = triangle;
+        let Triangle { w2, phi1, .. } = triangle;
         Self {
             triangle,
             body,
             s_ab: Vector2::new(-w2 * phi1.cos(), w2 * phi1.sin()),
             s_db: -body.e_cm,
-            s_dc: Vector2::new(w1 * phi2.cos(), -w1 * phi2.sin()) - body.e_cm,
+            s_dc: triangle.upper_pin() - body.e_cm,
         }
     }
 

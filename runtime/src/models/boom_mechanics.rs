@@ -41,11 +41,11 @@ const STROKE: usize = super::table::param_index("cylinder.stroke");
 const K_STOP: usize = super::table::param_index("cylinder.k_stop");
 const C_STOP: usize = super::table::param_index("cylinder.c_stop");
 
-/// The rigid boom's geometry and mass, in the order of [`geometry`], computed from the parameters:
-/// what another engine needs to build the same boom (boomsim.mujoco builds its MJCF from them).
 /// Unit and display unit of a length.
 const LENGTH: (&str, &str) = ("m", "mm");
 
+/// The rigid boom's geometry and mass, in the order of [`geometry`], computed from the parameters:
+/// what another engine needs to build the same boom (boomsim.mujoco builds its MJCF from them).
 #[rustfmt::skip]
 const GEOMETRY: [Variable; 8] = [
     geometry_row("boom.joint.x", 0, LENGTH, "Boom joint B from the lower cylinder pin A, horizontal (s_AB, below eq. 2.10)"),
@@ -68,8 +68,7 @@ const fn geometry_row(name: &'static str, k: u32, (unit, display): (&'static str
 fn geometry(p: &BoomParams) -> [f64; 8] {
     let k = BoomKinematics::new(p);
     let (t, b) = (k.triangle(), k.body());
-    let joint = k.point(0.0, Vector2::zeros());
-    let pin = Vector2::new(t.w1 * t.phi2.cos(), -t.w1 * t.phi2.sin());
+    let (joint, pin) = (k.point(0.0, Vector2::zeros()), t.upper_pin());
     [joint.x, joint.y, pin.x, pin.y, b.e_cm.x, b.e_cm.y, b.m_d, b.j_b]
 }
 
