@@ -191,6 +191,7 @@ class MujocoMechanics(Mechanics):
         self.substeps = substeps
         self.monitor, self.record_every, self.records, self.qpos, self.steps = monitor, record_every, [], [], 0
         mujoco.mj_forward(self.model, self.data)
+        self._read_motion()
         self._holding = self._static_force()
         self._record(0.0)
 
@@ -248,8 +249,12 @@ class MujocoMechanics(Mechanics):
         return force - np.array(self._rod_weight())
 
     def motion(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._motion
+
+    def _read_motion(self) -> None:
+        """Reads the strokes and rates once after each step (`motion` is asked twice a step)."""
         d = self.data
-        return d.ten_length[self.tendon] - self.l_retracted, d.ten_velocity[self.tendon].copy()
+        self._motion = d.ten_length[self.tendon] - self.l_retracted, d.ten_velocity[self.tendon].copy()
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         """`substeps` mj_step with the port input u plus the rods' weight as the actuators'
@@ -260,6 +265,7 @@ class MujocoMechanics(Mechanics):
             d.ctrl[self.actuator] = u + self._rod_weight()
             mujoco.mj_step(m, d)
         mujoco.mj_forward(m, d)
+        self._read_motion()
         self.steps += 1
         self._record(t + h)
 
