@@ -71,21 +71,24 @@ def start_controller(controller_f, controller, config: dict, p4: float, u_ref: f
 
 
 class _Calls:
-    """One drive's FMU calls of the loop, bound once (boomsim.fmus.Direct)."""
+    """One drive's FMU calls of the loop, bound once (boomsim.fmus.Direct): per step one read of
+    the outputs with the port's c_h and F, one write of the inputs before the step, one of their
+    slope and the doStep."""
 
-    def __init__(self, d: Drive):
+    def __init__(self, d: Drive, port: str):
         vh, c = d.circuit_f.vr, Direct(d.circuit)
-        self.outputs = c.getter([vh[k] for k in CIRCUIT_OUT])
-        self.c_h, self.force = c.getter([vh["port.c_h"]]), c.getter([vh["cylinder.F"]])
-        self.u_ref, self.c_m, self.motion = c.setter([vh["valve.u_ref"]]), c.setter([vh["port.c_m"]]), \
-            c.setter([vh["cylinder.x"], vh["cylinder.v"]])
-        self.c_m_slope, self.v_slope = c.setter([vh["port.c_m"]], True), c.setter([vh["cylinder.v"]], True)
+        self.read = c.getter([vh[k] for k in CIRCUIT_OUT] + [vh["port.c_h"], vh["cylinder.F"]])
+        # TLM: the command and the mechanics' wave together; plain: the command, and after the
+        # mechanics' step its stroke and rate
+        self.inputs = c.setter([vh["valve.u_ref"]] + ([vh["port.c_m"]] if port == "tlm" else []))
+        self.motion = c.setter([vh["cylinder.x"], vh["cylinder.v"]])
+        self.slope = c.setter([vh["port.c_m" if port == "tlm" else "cylinder.v"]], True)
         self.step = c.stepper()
         self.controlled = d.controller is not None
         if self.controlled:
             vc, k = d.controller_f.vr, Direct(d.controller)
             self.command = k.getter([vc["u"], vc["u_comp"]])
-            self.p_slope, self.inputs = k.setter([vc["p"]], True), k.setter([vc["p"], vc["u_ref"]])
+            self.p_slope, self.control_inputs = k.setter([vc["p"]], True), k.setter([vc["p"], vc["u_ref"]])
             self.control_step = k.stepper()
 
 
@@ -96,46 +99,46 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
     `record_every` steps. The controllers step every `control_every` steps (their command held,
     p4 linear over their step). Raises Unstable when a stroke leaves its range or an output its
     domain."""
-    calls = [_Calls(d) for d in drives]
+    tlm, gauss_seidel = coupling.startswith("tlm"), coupling in ("plain", "tlm")
+    calls = [_Calls(d, "tlm" if tlm else "plain") for d in drives]
     x, v = mechanics.motion()
-    i_p4 = CIRCUIT_OUT.index("p4")
-    at = {c: k for k, c in enumerate(CIRCUIT_OUT)}
-    order = [at.get(c) for c in PLANT_OUT]  # PLANT_OUT's circuit columns in CIRCUIT_OUT, None: x, v
-    y = [list(c.outputs()) for c in calls]
+    # a read holds CIRCUIT_OUT, c_h, F; a recorded row takes PLANT_OUT from it and the motion
+    read = [*CIRCUIT_OUT, "port.c_h", "cylinder.F", "cylinder.x", "cylinder.v"]
+    i_p4, i_c_h, i_force = (read.index(c) for c in ("p4", "port.c_h", "cylinder.F"))
+    order = [read.index(c) for c in PLANT_OUT]
+    y = [c.read()[:] for c in calls]
     stroke = [d.circuit.getReal([d.circuit_f.vr["cylinder.stroke"]])[0] for d in drives]
     refs = [communication_references(d.table, step, n) for d in drives]
-    u_ref = [r[0] for r in refs]
     rows = [[] for _ in drives]
     held = [(0.0, 0.0)] * len(drives)  # each controller's (u, u_comp) over its step
     p4_held = [yi[i_p4] for yi in y]  # p4 at the start of each controller's step
     for k in range(n + 1):
         t = k * step
-        for i, (d, c) in enumerate(zip(drives, calls)):
+        for i, c in enumerate(calls):
             if not c.controlled:
-                held[i] = (u_ref[i], 0.0)
+                held[i] = (refs[i][k], 0.0)
             elif k % control_every == 0:
                 held[i] = tuple(c.command())
-            u, u_comp = held[i]
-            c.u_ref((u,))
             if k % record_every == 0:
-                motion = {"cylinder.x": x[i], "cylinder.v": v[i]}
-                rows[i].append([t, u_ref[i], u_comp, u,
-                                *(y[i][j] if j is not None else motion[col] for j, col in zip(order, PLANT_OUT))])
+                u, u_comp = held[i]
+                values = y[i] + [x[i], v[i]]
+                rows[i].append([t, refs[i][k], u_comp, u, *[values[j] for j in order]])
         if k == n:
             break
         for i in range(len(drives)):
-            if not (-0.05 < x[i] < stroke[i] + 0.05) or not all(map(math.isfinite, y[i])):
+            # a sum of finite outputs is finite: one test for all of them
+            if not (-0.05 < x[i] < stroke[i] + 0.05) or not math.isfinite(sum(y[i])):
                 raise Unstable(f"{coupling}, h = {step:g} s: the motion diverged at t = {t:.4g} s "
                                f"(cylinder {i}: x = {x[i]:.4g} m)")
-        if coupling.startswith("tlm"):
-            c_h = [c.c_h()[0] for c in calls]
+        if tlm:
             c_m = mechanics.wave()
-            for c, w in zip(calls, c_m):
-                c.c_m((w,))
-            if coupling == "tlm":
+            for c, u, w in zip(calls, held, c_m):
+                c.inputs((u[0], w))
+            c_h = [yi[i_c_h] for yi in y]
+            if gauss_seidel:
                 mechanics.step(t, step, c_h)
                 for c, c0, c1 in zip(calls, c_m, mechanics.wave()):
-                    c.c_m_slope(((c1 - c0) / step,))
+                    c.slope(((c1 - c0) / step,))
                     c.step(t, step)
             else:
                 for c in calls:
@@ -143,26 +146,26 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
                 mechanics.step(t, step, c_h)
             x, v = mechanics.motion()
         else:
-            force = [c.force()[0] for c in calls]
-            if coupling == "jacobi":
+            for c, u in zip(calls, held):
+                c.inputs((u[0],))
+            if not gauss_seidel:
                 for c in calls:
                     c.step(t, step)
-            mechanics.step(t, step, force)
+            mechanics.step(t, step, [yi[i_force] for yi in y])
             x1, v1 = mechanics.motion()
-            if coupling == "plain":
+            if gauss_seidel:
                 for c, a, b in zip(calls, v, v1):
-                    c.v_slope(((b - a) / step,))
+                    c.slope(((b - a) / step,))
                     c.step(t, step)
             x, v = x1, v1
             for c, xi, vi in zip(calls, x, v):
                 c.motion((xi, vi))
-        for i, (d, c) in enumerate(zip(drives, calls)):
-            y[i] = list(c.outputs())
-            u_ref[i] = refs[i][k + 1]
+        for i, c in enumerate(calls):
+            y[i] = c.read()[:]
             if c.controlled and (k + 1) % control_every == 0:
                 p4_next, macro = y[i][i_p4], control_every * step
                 c.p_slope(((p4_next - p4_held[i]) / macro,))
                 c.control_step((k + 1 - control_every) * step, macro)
-                c.inputs((p4_next, u_ref[i]))
+                c.control_inputs((p4_next, refs[i][k + 1]))
                 p4_held[i] = p4_next
     return [np.array(r) for r in rows]

@@ -30,13 +30,15 @@ PORTS = ("plain", "tlm")
 
 class Mechanics(ABC):
     """Mechanics driven through the port `port` ("plain" or "tlm") with the TLM impedance `z_c`
-    [N s/m] and wave filter `alpha` (HydraulicCircuit's port.Z_c and port.alpha: equal on both
-    sides of the line)."""
+    [N s/m] and wave filter `alpha` of each cylinder (HydraulicCircuit's port.Z_c and port.alpha:
+    equal on both sides of the line)."""
 
-    def __init__(self, port: str, z_c: float = 0.0, alpha: float = 0.0):
+    def __init__(self, port: str, z_c=0.0, alpha=0.0):
         if port not in PORTS:
             raise UsageError(f"port = {port!r}: must be one of {PORTS}")
-        self.port, self.z_c, self.alpha = port, z_c, alpha
+        self.port = port
+        # per cylinder (a number: one cylinder)
+        self.z_c, self.alpha = ([float(a) for a in np.atleast_1d(b)] for b in (z_c, alpha))
         self._c_m = None
 
     @abstractmethod
@@ -44,28 +46,28 @@ class Mechanics(ABC):
         """The force along each cylinder that holds the mechanics at rest at its start [N]."""
 
     @abstractmethod
-    def motion(self) -> tuple[np.ndarray, np.ndarray]:
+    def motion(self) -> tuple[list[float], list[float]]:
         """(x, v): each cylinder's stroke [m] and rate [m/s] now."""
 
     @abstractmethod
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+    def advance(self, t: float, h: float, u) -> None:
         """One step from `t` to `t + h` under the port input `u` (force or wave c_h), held."""
 
-    def step(self, t: float, h: float, u: np.ndarray) -> None:
+    def step(self, t: float, h: float, u) -> None:
         """`advance`, then (TLM) the wave emitted from the state reached: c_m = F_M - Z_c v with
         F_M = c_h - Z_c v (the line force at the step end), filtered by alpha as the circuit filters
-        its own (c <- alpha c + (1 - alpha) c_new)."""
-        u = np.asarray(u, dtype=float)
+        its own (c <- alpha c + (1 - alpha) c_new). Per cylinder in Python floats: for one or two
+        cylinders numpy's per-call cost is most of a step's."""
         self.advance(t, h, u)
         if self.port == "tlm":
             _, v = self.motion()
-            fresh = u - 2.0 * self.z_c * v
-            self._c_m = self.alpha * self.wave() + (1.0 - self.alpha) * fresh
+            self._c_m = [a * c + (1.0 - a) * (ui - 2.0 * z * vi)
+                         for a, c, ui, z, vi in zip(self.alpha, self.wave(), u, self.z_c, v)]
 
-    def wave(self) -> np.ndarray:
+    def wave(self) -> list[float]:
         """TLM: the wave c_m to the circuit; at the start the holding force (both sides at rest)."""
         if self._c_m is None:
-            self._c_m = np.asarray(self.holding_force(), dtype=float)
+            self._c_m = [float(f) for f in self.holding_force()]
         return self._c_m
 
 
@@ -83,17 +85,17 @@ class BoomMechanicsFmu(Mechanics):
     def holding_force(self) -> np.ndarray:
         return np.array(self.s.getReal([self.f.vr["start.F"]]))
 
-    def motion(self) -> tuple[np.ndarray, np.ndarray]:
+    def motion(self) -> tuple[list[float], list[float]]:
         x, v = self._motion()
-        return np.array([x]), np.array([v])
+        return [x], [v]
 
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        self._input((float(u[0]),))
+    def advance(self, t: float, h: float, u) -> None:
+        self._input(u)
         self._step(t, h)
 
-    def step(self, t: float, h: float, u: np.ndarray) -> None:
+    def step(self, t: float, h: float, u) -> None:
         """The FMU emits its own wave."""
         self.advance(t, h, u)
 
-    def wave(self) -> np.ndarray:
-        return np.array(self._wave())
+    def wave(self) -> list[float]:
+        return self._wave()[:]

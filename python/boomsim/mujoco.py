@@ -19,6 +19,7 @@ computed from MuJoCo's tendon velocity (boomsim.mechanics).
 from __future__ import annotations
 
 import dataclasses
+from typing import NamedTuple
 
 import numpy as np
 
@@ -161,6 +162,17 @@ def thesis_cylinder(command=0.0, controller: dict | None = None, circuit: dict |
 COUNTS = ("steps", "rhs_evals", "jacobian_evals")
 
 
+class _Rod(NamedTuple):
+    """One cylinder in the compiled model: its rod's weight factor m_rod g_z [N] and ids."""
+
+    weight: float
+    site_from: int
+    site_to: int
+    tendon: int
+    actuator: int
+    l_retracted: float
+
+
 class MujocoMechanics(Mechanics):
     """The cylinders of an MjSpec (`add_cylinders`) compiled, stepped `substeps` timesteps per
     communication step, at rest in the keyframe `key` at the start (qpos0 without one).
@@ -169,7 +181,7 @@ class MujocoMechanics(Mechanics):
 
     def __init__(self, spec, cylinders: list[Cylinder], port: str, z_c, alpha, substeps: int = 1,
                  key: str | None = "start", monitor=None, record_every: int = 1):
-        super().__init__(port, np.asarray(z_c, dtype=float), np.asarray(alpha, dtype=float))
+        super().__init__(port, z_c, alpha)
         add_cylinders(spec, cylinders, port)
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
@@ -183,11 +195,11 @@ class MujocoMechanics(Mechanics):
         self.actuator = ids(mujoco.mjtObj.mjOBJ_ACTUATOR, [c.name for c in cylinders])
         self.site_from = ids(mujoco.mjtObj.mjOBJ_SITE, [c.site_from for c in cylinders])
         self.site_to = ids(mujoco.mjtObj.mjOBJ_SITE, [c.site_to for c in cylinders])
-        self.model.actuator_biasprm[self.actuator, 2] = -self.z_c if port == "tlm" else 0.0
-        self.l_retracted = np.array([c.l_retracted for c in cylinders])
-        #: (m_rod g_z, site_from, site_to, tendon) of each cylinder, as Python numbers.
-        self._rods = [(float(c.rod_mass * self.model.opt.gravity[2]), int(a), int(b), int(t))
-                      for c, a, b, t in zip(cylinders, self.site_from, self.site_to, self.tendon)]
+        self.model.actuator_biasprm[self.actuator, 2] = -np.array(self.z_c) if port == "tlm" else 0.0
+        #: Each cylinder's ids and numbers for the per-step work, in Python numbers (numpy's per-call
+        #: cost is most of a step's).
+        self._rods = [_Rod(float(c.rod_mass * self.model.opt.gravity[2]), int(a), int(b), int(t), int(u), c.l_retracted)
+                      for c, a, b, t, u in zip(cylinders, self.site_from, self.site_to, self.tendon, self.actuator)]
         self.substeps = substeps
         self.monitor, self.record_every, self.records, self.qpos, self.steps = monitor, record_every, [], [], 0
         mujoco.mj_forward(self.model, self.data)
@@ -208,11 +220,11 @@ class MujocoMechanics(Mechanics):
         mujoco.mju_sparse2dense(dense, self.data.ten_J, m.ten_J_rownnz, m.ten_J_rowadr, m.ten_J_colind)
         return dense[self.tendon]
 
-    def _rod_weight(self) -> np.ndarray:
+    def _rod_weight(self) -> list[float]:
         """The rod's weight along each cylinder's axis, > 0 pushing out: m_rod g . e, e the unit
         axis from the barrel's pin to the rod's (rigid boom: -m_rod g sin theta1, eq. 2.62)."""
         xpos, length = self.data.site_xpos, self.data.ten_length
-        return [w * (xpos[b, 2] - xpos[a, 2]) / length[t] for w, a, b, t in self._rods]
+        return [r.weight * (xpos[r.site_to, 2] - xpos[r.site_from, 2]) / length[r.tendon] for r in self._rods]
 
     def effective_mass(self) -> np.ndarray:
         """Each cylinder's effective mass at its pins now, 1 / (J M^-1 J^T) (MuJoCo's M holds the
@@ -248,21 +260,24 @@ class MujocoMechanics(Mechanics):
         mujoco.mj_forward(m, d)
         return force - np.array(self._rod_weight())
 
-    def motion(self) -> tuple[np.ndarray, np.ndarray]:
+    def motion(self) -> tuple[list[float], list[float]]:
         return self._motion
 
     def _read_motion(self) -> None:
         """Reads the strokes and rates once after each step (`motion` is asked twice a step)."""
-        d = self.data
-        self._motion = d.ten_length[self.tendon] - self.l_retracted, d.ten_velocity[self.tendon].copy()
+        length, rate = self.data.ten_length, self.data.ten_velocity
+        self._motion = ([float(length[r.tendon]) - r.l_retracted for r in self._rods],
+                        [float(rate[r.tendon]) for r in self._rods])
 
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+    def advance(self, t: float, h: float, u) -> None:
         """`substeps` mj_step with the port input u plus the rods' weight as the actuators'
         controls (the weight's direction from the step's start), then mj_forward: after mj_step
         the tendons' lengths and velocities are still those of the step's start."""
         m, d = self.model, self.data
+        ctrl = d.ctrl
         for _ in range(self.substeps):
-            d.ctrl[self.actuator] = u + self._rod_weight()
+            for r, ui, w in zip(self._rods, u, self._rod_weight()):
+                ctrl[r.actuator] = ui + w
             mujoco.mj_step(m, d)
         mujoco.mj_forward(m, d)
         self._read_motion()
