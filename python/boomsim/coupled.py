@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from .fmus import Direct
-from .result import PLANT_OUT
+from .result import COLUMNS, PLANT_OUT
 from .scenarios import communication_references
 
 COUPLINGS = ("plain", "jacobi", "tlm", "tlm-jacobi")
@@ -29,6 +29,9 @@ PORT_CODES = {"plain": 0, "tlm": 1}
 #: Circuit outputs recorded (PLANT_OUT without the stroke and velocity, which come from
 #: the mechanics).
 CIRCUIT_OUT = [c for c in PLANT_OUT if not c.startswith("cylinder.")]
+#: The columns of a recorded row: COLUMNS and the circuit's force on the rod (plain: to the
+#: mechanics; TLM: pressure forces - friction at the circuit's rod).
+RECORDED = [*COLUMNS, "cylinder.F"]
 
 
 class Unstable(Exception):
@@ -95,8 +98,8 @@ class _Calls:
 def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, record_every: int,
          control_every: int = 1) -> list[np.ndarray]:
     """`n` communication steps of `step` from t = 0 with the drives and mechanics initialised (each
-    circuit's start state from the mechanics' start); per drive its recorded rows (COLUMNS) every
-    `record_every` steps. The controllers step every `control_every` steps (their command held,
+    circuit's start state from the mechanics' start); per drive its recorded rows every
+    `record_every` steps (RECORDED). The controllers step every `control_every` steps (their command held,
     p4 linear over their step). Raises Unstable when a stroke leaves its range or an output its
     domain."""
     tlm, gauss_seidel = coupling.startswith("tlm"), coupling in ("plain", "tlm")
@@ -105,7 +108,7 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
     # a read holds CIRCUIT_OUT, c_h, F; a recorded row takes PLANT_OUT from it and the motion
     read = [*CIRCUIT_OUT, "port.c_h", "cylinder.F", "cylinder.x", "cylinder.v"]
     i_p4, i_c_h, i_force = (read.index(c) for c in ("p4", "port.c_h", "cylinder.F"))
-    order = [read.index(c) for c in PLANT_OUT]
+    order = [read.index(c) for c in (*PLANT_OUT, "cylinder.F")]
     y = [c.read()[:] for c in calls]
     stroke = [d.circuit.getReal([d.circuit_f.vr["cylinder.stroke"]])[0] for d in drives]
     refs = [communication_references(d.table, step, n) for d in drives]

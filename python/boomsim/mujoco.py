@@ -25,11 +25,11 @@ import numpy as np
 
 from fmpy.fmi1 import FMICallException
 
-from .coupled import COUPLINGS, Drive, Unstable, loop, start_circuit, start_controller
+from .coupled import COUPLINGS, RECORDED, Drive, Unstable, loop, start_circuit, start_controller
 from .errors import UsageError
 from .fmus import FmuFile, release
 from .mechanics import Mechanics
-from .result import COLUMNS, Result
+from .result import Result
 from .scenarios import reference
 
 try:
@@ -359,14 +359,15 @@ def whole_multiple(name: str, value: float, of: str, unit: float) -> int:
 
 @dataclasses.dataclass
 class MujocoRun:
-    """A coupled run: a Result per cylinder (by name), the monitor's rows and MuJoCo's qpos (one
-    per recorded communication point) and the compiled MjModel with the cylinders' tendons and
-    actuators."""
+    """A coupled run: a Result per cylinder (by name; RECORDED's columns), the monitor's rows and
+    MuJoCo's qpos (one per recorded communication point), the compiled MjModel with the cylinders'
+    tendons and actuators, and the cylinders."""
 
     results: dict
     monitored: np.ndarray
     qpos: np.ndarray
     model: object
+    cylinders: list
 
 
 def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | None = None,
@@ -433,9 +434,9 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
     results = {}
     for c, table, rows, work in zip(cylinders, tables, data, counts):
         scenario = {"id": c.name, "stop_time": stop_time, "step": step, "reference": table}
-        results[c.name] = Result(scenario, "mujoco", step, True, {col: rows[:, j] for j, col in enumerate(COLUMNS)}, None,
+        results[c.name] = Result(scenario, "mujoco", step, True, {col: rows[:, j] for j, col in enumerate(RECORDED)}, None,
                                  counts=work)
-    return MujocoRun(results, np.array(mech.records), np.array(mech.qpos), mech.model)
+    return MujocoRun(results, np.array(mech.records), np.array(mech.qpos), mech.model, list(cylinders))
 
 
 def scenario_run(sc: dict, coupling: str = "tlm", step: float = 5e-4, integrator: str = "RK4",

@@ -2,8 +2,11 @@
 
     touchdown   the thesis' boom sets its payload down on the ground: the payload hangs on a rope
                 from the arm's end (a tendon that only pulls), MuJoCo's contact takes it over
+    knuckle     a knuckle boom: the thesis' boom with a jib hinged at its end, two cylinders, two
+                HydraulicCircuit instances and two valve commands; a closed motion and its energy
+                balance
 
-    boomsim-mujoco-scene touchdown [--out PNG]   runs the scene, writes its figure
+    boomsim-mujoco-scene touchdown|knuckle [--out PNG]   runs the scene, writes its figure
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ class Scene:
     monitor: object
     columns: tuple
     stop_time: float
+    record_every: int | None = None
 
 
 def _payload_mass() -> float:
@@ -89,7 +93,117 @@ def _touchdown_monitor(_t, model, data):
 
 def run(scene: Scene, coupling: str = "tlm", step: float | None = None):
     """The scene coupled (boomsim.mujoco.run) from rest at its keyframe."""
-    return bm.run(scene.mjcf, scene.cylinders, coupling, step, scene.stop_time, monitor=scene.monitor)
+    return bm.run(scene.mjcf, scene.cylinders, coupling, step, scene.stop_time, monitor=scene.monitor,
+                  record_every=scene.record_every)
+
+
+@dataclasses.dataclass(frozen=True)
+class Jib:
+    """The knuckle boom's jib and its cylinder: the example's own numbers (the thesis has one boom),
+    chosen for a small knuckle crane that the thesis' cylinder and circuit can work: a 1.5 m, 60 kg
+    jib with 150 kg at its end (the two weigh about what the thesis' 383 kg payload does at the
+    boom's end); the cylinder's barrel pin 0.8 m back along the boom and 0.35 m below its axis,
+    its rod pin 0.35 m below the jib's hinge (a 0.27 m lever at the start), 0.5 m pin to pin
+    retracted; at the start the jib hangs 0.6 rad below the boom's axis."""
+
+    length: float = 1.5
+    mass: float = 60.0
+    load: float = 150.0
+    pin_back: float = 0.8
+    pin_below: float = 0.35
+    l_retracted: float = 0.5
+    start_angle: float = -0.6
+
+
+#: Both valves' commands of the knuckle scene ([t, u_ref] rows): the boom lifts at 0.4 from 0.2 to
+#: 1.7 s, the jib from 0.5 to 2.0 s; both lower at -0.4 from 2.5 and 3.0 s until they are back
+#: near the start (lowering is faster at the same command), then hold.
+KNUCKLE_COMMANDS = {"boom": [[0.0, 0.0], [0.2, 0.0], [0.2, 0.4], [1.7, 0.4], [1.7, 0.0], [2.5, 0.0], [2.5, -0.4],
+                             [3.9, -0.4], [3.9, 0.0]],
+                    "jib": [[0.0, 0.0], [0.5, 0.0], [0.5, 0.4], [2.0, 0.4], [2.0, 0.0], [3.0, 0.0], [3.0, -0.4],
+                            [4.5, -0.4], [4.5, 0.0]]}
+
+
+def knuckle(start_stroke: float = 0.30, jib: Jib = Jib(), timestep: float = 5e-4) -> Scene:
+    """The thesis' boom (its payload.m = 0 in the body) at `start_stroke` with `jib` hinged at the
+    payload's point (joint `jib.phi`, its angle to the boom, > 0 up), the jib's load a cube at its
+    end. Both cylinders are the thesis' cylinder and circuit with its feedback (B's gains), their
+    rods' mass in the circuits only (port.m): MuJoCo's energy is then the whole machine's. The
+    commands are KNUCKLE_COMMANDS. Recorded every step; monitor: MuJoCo's kinetic + potential
+    energy [J] (mjENBL_ENERGY)."""
+    params = {"payload.m": 0.0}
+    g = bm.boom_geometry(start_stroke, params)
+    spec = bm.mjcf_spec(bm.boom_mjcf(start_stroke, params, timestep=timestep))
+    spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+    hinge = spec.geom("payload").pos.copy()
+    spec.delete(spec.geom("payload"))
+    boom = spec.body("boom")
+    lower = [hinge[0] - jib.pin_back, 0.0, hinge[2] - jib.pin_below]
+    boom.add_site(name="jib.lower", pos=lower, size=[0.03, 0, 0])
+    # the pins' brackets, drawn only (no mass, no contact)
+    boom.add_geom(name="jib.lower.bracket", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[lower[0], 0, 0, *lower],
+                  size=[0.02, 0, 0], contype=0, conaffinity=0, mass=0.0)
+    arm = boom.add_body(name="jib", pos=hinge, mass=jib.mass, explicitinertial=True, ipos=[jib.length / 2, 0.0, 0.0],
+                        inertia=[jib.mass * jib.length ** 2 / 12] * 3)
+    arm.add_joint(name="jib.phi", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, -1, 0])
+    arm.add_geom(name="jib", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, jib.length, 0, 0], size=[0.04, 0, 0],
+                 contype=0, conaffinity=0)
+    arm.add_site(name="jib.upper", pos=[0.0, 0.0, -jib.pin_below], size=[0.03, 0, 0])
+    arm.add_geom(name="jib.upper.bracket", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, 0, 0, -jib.pin_below],
+                 size=[0.02, 0, 0], contype=0, conaffinity=0, mass=0.0)
+    load = arm.add_body(name="jib.load", pos=[jib.length, 0.0, 0.0], mass=jib.load, explicitinertial=True,
+                        ipos=[0.0, 0.0, 0.0], inertia=[jib.load * (2 * bm.PAYLOAD_HALF) ** 2 / 6] * 3)
+    load.add_geom(name="jib.load", type=mujoco.mjtGeom.mjGEOM_BOX, size=[bm.PAYLOAD_HALF] * 3, contype=0, conaffinity=0)
+    spec.key("start").qpos = [g["boom.theta"], jib.start_angle]
+    feedback = {"enable": True, "K_f": 1.24e-11, "omega_f": 35.8}
+    cylinders = [dataclasses.replace(bm.thesis_cylinder(KNUCKLE_COMMANDS["boom"], feedback, params=params), rod_mass=0.0),
+                 bm.Cylinder("jib", "jib.lower", "jib.upper", jib.l_retracted, KNUCKLE_COMMANDS["jib"], feedback)]
+    return Scene("knuckle", spec, cylinders, _energy_monitor, ("mechanical energy [J]",), 6.5, record_every=1)
+
+
+def _energy_monitor(_t, _model, data):
+    return (data.energy[0] + data.energy[1],)
+
+
+def pressure_force(run, cylinder) -> np.ndarray:
+    """The pressure force on a cylinder's piston over a run, p3 A - p4 mu_c A (eq. 2.60-2.61),
+    A and mu_c A from its circuit's cylinder.d_piston and d_rod [N]."""
+    circuit = FmuFile.get("HydraulicCircuit").vars
+    d_p, d_r = (cylinder.circuit.get(k, float(circuit[k].start)) for k in ("cylinder.d_piston", "cylinder.d_rod"))
+    r = run.results[cylinder.name]
+    return r["p3"] * np.pi / 4 * d_p ** 2 - r["p4"] * np.pi / 4 * (d_p ** 2 - d_r ** 2)
+
+
+def powers(run) -> tuple[np.ndarray, np.ndarray]:
+    """(hydraulic, friction) power of all cylinders over a run [W]: the pressure forces' power
+    on the pistons, sum of pressure_force v, and the cylinders' friction's, sum of F_fr v with
+    F_fr = pressure force - cylinder.F (the circuit's force on the rod)."""
+    hydraulic = friction = 0.0
+    for c in run.cylinders:
+        r = run.results[c.name]
+        force = pressure_force(run, c)
+        hydraulic = hydraulic + force * r["cylinder.v"]
+        friction = friction + (force - r["cylinder.F"]) * r["cylinder.v"]
+    return hydraulic, friction
+
+
+def work(power: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The work of `power` from t[0] to each t, by the trapezoid rule [J]."""
+    return np.concatenate([[0.0], np.cumsum((power[1:] + power[:-1]) / 2 * np.diff(t))])
+
+
+def energy_balance(run) -> dict:
+    """The energy of a run recorded every step [J], `powers` integrated (`work`):
+    `hydraulic`, the pressure forces' work on the pistons; `friction`, the work the cylinders'
+    friction dissipates; `mechanical`, the change of MuJoCo's kinetic + potential energy (the
+    monitor's first column); `throughput`, the integral of |hydraulic power| (the scale of the
+    balance); `imbalance` = hydraulic - friction - mechanical."""
+    t = run.results[run.cylinders[0].name]["time"]
+    power, lost = powers(run)
+    hydraulic, friction, throughput = (work(p, t)[-1] for p in (power, lost, np.abs(power)))
+    mechanical = run.monitored[-1, 0] - run.monitored[0, 0]
+    return {"hydraulic": hydraulic, "friction": friction, "mechanical": mechanical, "throughput": throughput,
+            "imbalance": hydraulic - friction - mechanical}
 
 
 def plot_touchdown(run, path) -> None:
@@ -127,13 +241,58 @@ def plot_touchdown(run, path) -> None:
     plt.close(fig)
 
 
+def plot_knuckle(run, path) -> None:
+    """The knuckle figure: the machine at the start, at its highest and at the end, both
+    cylinders' strokes and commands, their piston-side pressures, and the energy balance over
+    time (the pistons' work against friction + MuJoCo's energy change)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .figures import save
+
+    boom, jib = run.results["boom"], run.results["jib"]
+    t = boom["time"]
+    top = int(np.argmax(boom["cylinder.x"] + jib["cylinder.x"]))
+    fig, axes = plt.subplots(1, 4, figsize=(19, 4.5), layout="constrained")
+    scene, stroke, pressure, energy = axes
+    for i, shade in ((0, "0.75"), (top, "0.45"), (len(t) - 1, "0.2")):
+        bm.draw(scene, run.model, run.qpos[i], shade)
+    scene.set(aspect="equal", xlabel="x [m]", ylabel="z [m]",
+              title=f"t = 0, {t[top]:.1f} s (highest), {t[-1]:.1f} s: light to dark")
+    for r, name in ((boom, "boom"), (jib, "jib")):
+        line, = stroke.plot(t, r["cylinder.x"] * 1e3, label=f"{name} stroke")
+        pressure.plot(t, r["p3"] / 1e5, color=line.get_color(), label=f"{name} p3")
+        pressure.plot(t, r["p4"] / 1e5, color=line.get_color(), ls="--", label=f"{name} p4")
+    command = stroke.twinx()
+    for r, name, style in ((boom, "boom", "-"), (jib, "jib", "--")):
+        command.plot(t, r["u_ref"], color="0.5", ls=style, lw=1, label=f"{name} command")
+    command.set_ylabel("valve command u_ref [-]")
+    stroke.set(xlabel="time [s]", ylabel="stroke [mm]", title="strokes and valve commands")
+    stroke.legend(loc="upper left")
+    command.legend(loc="upper right")
+    pressure.set(xlabel="time [s]", ylabel="pressure [bar]", title="cylinder pressures")
+    pressure.legend(fontsize=8)
+    power, lost = powers(run)
+    energy.plot(t, work(power, t) / 1e3, label="work of the pressure forces")
+    energy.plot(t, (work(lost, t) + run.monitored[:, 0] - run.monitored[0, 0]) / 1e3, ls="--",
+                label="friction + MuJoCo's energy change")
+    b = energy_balance(run)
+    energy.set(xlabel="time [s]", ylabel="energy [kJ]",
+               title=f"energy balance: {b['imbalance']:+.3f} J of {b['throughput'] / 1e3:.2f} kJ throughput")
+    energy.legend()
+    save(fig, path, dpi=110)
+    plt.close(fig)
+
+
 def main(argv=None):
     import argparse
 
     from .paths import OUT
 
     ap = argparse.ArgumentParser(description="A MuJoCo scene driven by HydraulicCircuit: runs it, writes its figure")
-    ap.add_argument("scene", choices=("touchdown",))
+    ap.add_argument("scene", choices=("touchdown", "knuckle"))
     ap.add_argument("--out", default=None, help="the figure (default: out/mujoco_<scene>.png)")
     args = ap.parse_args(argv)
     out = args.out or OUT / f"mujoco_{args.scene}.png"
