@@ -1,15 +1,18 @@
-"""The co-simulation loop of one or more HydraulicCircuit instances (FMI 2.0 Co-Simulation through
-fmpy), each with its valve command and optionally its PressureFeedbackController, and one
+"""The co-simulation loop of one or more HydraulicCircuit instances (FMI 2.0 or 3.0 Co-Simulation
+through fmpy), each with its valve command and optionally its PressureFeedbackController, and one
 mechanics (boomsim.mechanics) with a cylinder for each: boomsim.split (BoomMechanics) and
 boomsim.mujoco (MuJoCo) run it.
 
 Couplings (docs/coupling.md):
     plain        Gauss-Seidel: mechanics first with F_k held -> x_k+1, v_k+1 -> each circuit steps
-                 with v linear from v_k to v_k+1 (fmi2SetRealInputDerivatives) -> F_k+1
+                 with v linear from v_k to v_k+1 -> F_k+1
     jacobi       plain, both step from the values at t_k (v held), as a parallel master does
     tlm          waves c_h, c_m exchanged once per step: mechanics first with c_h held, then each
                  circuit with c_m linear over the step
     tlm-jacobi   TLM, both from the waves at t_k
+
+An input linear over a step is an input derivative in FMI 2.0 and an intermediate update in FMI
+3.0 (boomsim.fmus.Direct.ramp): `slave` makes each instance with what its version needs.
 """
 
 from __future__ import annotations
@@ -19,13 +22,15 @@ import math
 
 import numpy as np
 
-from .fmus import Direct
+from .fmus import Direct, LinearInputs
 from .result import COLUMNS, PLANT_OUT
 from .scenarios import communication_references
 
 COUPLINGS = ("plain", "jacobi", "tlm", "tlm-jacobi")
 #: HydraulicCircuit's and BoomMechanics' port.coupling of each port.
 PORT_CODES = {"plain": 0, "tlm": 1}
+#: The input linear over each step: the circuit's of each port, the controller's.
+RAMPED = {"tlm": "port.c_m", "plain": "cylinder.v", "controller": "p"}
 #: Circuit outputs recorded (PLANT_OUT without the stroke and velocity, which come from
 #: the mechanics).
 CIRCUIT_OUT = [c for c in PLANT_OUT if not c.startswith("cylinder.")]
@@ -38,17 +43,29 @@ class Unstable(Exception):
     """The coupled run diverged (a step was refused or the motion left the stroke)."""
 
 
+def slave(fmu_file, name: str, ramped: str):
+    """(instance, its LinearInputs or None): a Co-Simulation instance of `fmu_file` whose input
+    `ramped` (a RAMPED value) the loop makes linear over each step; FMI 3.0 by intermediate update."""
+    if fmu_file.fmi == 2:
+        return fmu_file.slave(name), None
+    inputs = LinearInputs([fmu_file.vr[ramped]])
+    return fmu_file.slave(name, inputs=inputs), inputs
+
+
 @dataclasses.dataclass
 class Drive:
     """One cylinder's hydraulics, initialised: a HydraulicCircuit instance and its FmuFile, the
     operator's reference table ([t, u_ref] rows), and a PressureFeedbackController instance with
-    its FmuFile, or None (the valve then takes the reference)."""
+    its FmuFile, or None (the valve then takes the reference); each instance's LinearInputs
+    (`slave`; FMI 3.0)."""
 
     circuit: object
     circuit_f: object
     table: np.ndarray
     controller: object = None
     controller_f: object = None
+    circuit_inputs: LinearInputs | None = None
+    controller_inputs: LinearInputs | None = None
 
 
 def start_circuit(circuit_f, circuit, port: str, x: float, v: float, f_start: float, params: dict) -> None:
@@ -76,7 +93,7 @@ def start_controller(controller_f, controller, config: dict, p4: float, u_ref: f
 class _Calls:
     """One drive's FMU calls of the loop, bound once (boomsim.fmus.Direct): per step one read of
     the outputs with the port's c_h and F, one write of the inputs before the step, one of their
-    slope and the doStep."""
+    ramp and the doStep."""
 
     def __init__(self, d: Drive, port: str):
         vh, c = d.circuit_f.vr, Direct(d.circuit)
@@ -85,13 +102,14 @@ class _Calls:
         # mechanics' step its stroke and rate
         self.inputs = c.setter([vh["valve.u_ref"]] + ([vh["port.c_m"]] if port == "tlm" else []))
         self.motion = c.setter([vh["cylinder.x"], vh["cylinder.v"]])
-        self.slope = c.setter([vh["port.c_m" if port == "tlm" else "cylinder.v"]], True)
+        self.ramp = c.ramp([vh[RAMPED[port]]], d.circuit_inputs)
         self.step = c.stepper()
         self.controlled = d.controller is not None
         if self.controlled:
             vc, k = d.controller_f.vr, Direct(d.controller)
             self.command = k.getter([vc["u"], vc["u_comp"]])
-            self.p_slope, self.control_inputs = k.setter([vc["p"]], True), k.setter([vc["p"], vc["u_ref"]])
+            self.p_ramp = k.ramp([vc[RAMPED["controller"]]], d.controller_inputs)
+            self.control_inputs = k.setter([vc["p"], vc["u_ref"]])
             self.control_step = k.stepper()
 
 
@@ -141,7 +159,7 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
             if gauss_seidel:
                 mechanics.step(t, step, c_h)
                 for c, c0, c1 in zip(calls, c_m, mechanics.wave()):
-                    c.slope(((c1 - c0) / step,))
+                    c.ramp(t, step, (c0,), (c1,))
                     c.step(t, step)
             else:
                 for c in calls:
@@ -158,7 +176,7 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
             x1, v1 = mechanics.motion()
             if gauss_seidel:
                 for c, a, b in zip(calls, v, v1):
-                    c.slope(((b - a) / step,))
+                    c.ramp(t, step, (a,), (b,))
                     c.step(t, step)
             x, v = x1, v1
             for c, xi, vi in zip(calls, x, v):
@@ -166,9 +184,9 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
         for i, c in enumerate(calls):
             y[i] = c.read()[:]
             if c.controlled and (k + 1) % control_every == 0:
-                p4_next, macro = y[i][i_p4], control_every * step
-                c.p_slope(((p4_next - p4_held[i]) / macro,))
-                c.control_step((k + 1 - control_every) * step, macro)
+                p4_next, macro, t0 = y[i][i_p4], control_every * step, (k + 1 - control_every) * step
+                c.p_ramp(t0, macro, (p4_held[i],), (p4_next,))
+                c.control_step(t0, macro)
                 c.control_inputs((p4_next, refs[i][k + 1]))
                 p4_held[i] = p4_next
     return [np.array(r) for r in rows]

@@ -156,13 +156,15 @@ class FmuFile:
 
 
 class Direct:
-    """fmi2GetReal, fmi2SetReal, fmi2SetRealInputDerivatives and fmi2DoStep of one fmpy FMI 2.0
-    instance called straight through ctypes with each value-reference list's arrays built once:
-    fmpy's methods build them on every call, which in a loop of 1 ms steps costs more than the
-    FMU's own work. A status above Warning raises FMICallException, as fmpy's calls do."""
+    """GetReal/GetFloat64, SetReal/SetFloat64, ramped inputs and DoStep of one fmpy Co-Simulation
+    instance (FMI 2.0, or FMI 3.0 behind `Fmi3`) called straight through ctypes with each
+    value-reference list's arrays built once: fmpy's methods build them on every call, which in a
+    loop of 1 ms steps costs more than the FMU's own work. A status above Warning raises
+    FMICallException, as fmpy's calls do."""
 
     def __init__(self, instance):
         self.i = instance
+        self.fmi = 3 if isinstance(instance, Fmi3) else 2
 
     def _function(self, name: str):
         """The FMU's function `name` and the instance's component (fmpy set its argtypes)."""
@@ -180,51 +182,82 @@ class Direct:
         from ctypes import c_double, c_uint
 
         n, refs, out = len(vrs), (c_uint * len(vrs))(*vrs), (c_double * len(vrs))()
-        f, c = self._function("fmi2GetReal")
+        name = "fmi3GetFloat64" if self.fmi == 3 else "fmi2GetReal"
+        f, c = self._function(name)
+        args = (c, refs, n, out, n) if self.fmi == 3 else (c, refs, n, out)
 
         def get():
-            status = f(c, refs, n, out)
+            status = f(*args)
             if status > 1:
-                self._refused("fmi2GetReal", status)
+                self._refused(name, status)
             return out
 
         return get
 
-    def setter(self, vrs: list[int], derivative: bool = False):
-        """A function setting `vrs` to its argument's values (their first derivatives with
-        `derivative`: fmi2SetRealInputDerivatives)."""
-        from ctypes import c_double, c_int, c_uint
+    def setter(self, vrs: list[int]):
+        """A function setting `vrs` to its argument's values."""
+        from ctypes import c_double, c_uint
 
         n, refs, values = len(vrs), (c_uint * len(vrs))(*vrs), (c_double * len(vrs))()
-        if derivative:
-            order, (f, c) = (c_int * n)(*[1] * n), self._function("fmi2SetRealInputDerivatives")
+        name = "fmi3SetFloat64" if self.fmi == 3 else "fmi2SetReal"
+        f, c = self._function(name)
+        args = (c, refs, n, values, n) if self.fmi == 3 else (c, refs, n, values)
 
-            def put(x):
-                values[:] = x
-                status = f(c, refs, n, order, values)
-                if status > 1:
-                    self._refused("fmi2SetRealInputDerivatives", status)
-        else:
-            f, c = self._function("fmi2SetReal")
-
-            def put(x):
-                values[:] = x
-                status = f(c, refs, n, values)
-                if status > 1:
-                    self._refused("fmi2SetReal", status)
+        def put(x):
+            values[:] = x
+            status = f(*args)
+            if status > 1:
+                self._refused(name, status)
 
         return put
 
-    def stepper(self):
-        """fmi2DoStep(t, h) with noSetFMUStatePriorToCurrentPoint = true."""
-        f, c = self._function("fmi2DoStep")
+    def ramp(self, vrs: list[int], inputs: LinearInputs | None = None):
+        """A function ramp(t, h, start, end) making the inputs `vrs` linear over the step from
+        `t` of size `h`, from `start` (already set) to `end`: FMI 2.0 their first derivatives
+        (fmi2SetRealInputDerivatives), FMI 3.0 by intermediate update through `inputs`, the
+        LinearInputs of `vrs` the instance was made with."""
+        if self.fmi == 3:
+            if inputs is None or list(inputs.vrs) != list(vrs):
+                raise UsageError(f"FMI 3.0 ramps inputs {vrs} by intermediate update: make the instance with "
+                                 f"LinearInputs({vrs})")
+            return lambda t, h, start, end: inputs.over(t, h, start, end)
+        from ctypes import c_double, c_int, c_uint
 
-        def step(t, h):
-            status = f(c, t, h, 1)
+        n, refs, values = len(vrs), (c_uint * len(vrs))(*vrs), (c_double * len(vrs))()
+        order, (f, c) = (c_int * n)(*[1] * n), self._function("fmi2SetRealInputDerivatives")
+
+        def ramp(_t, h, start, end):
+            values[:] = [(b - a) / h for a, b in zip(start, end)]
+            status = f(c, refs, n, order, values)
             if status > 1:
-                self._refused("fmi2DoStep", status)
+                self._refused("fmi2SetRealInputDerivatives", status)
 
-        return step
+        return ramp
+
+    def stepper(self):
+        """DoStep(t, h) with noSetFMUStatePriorToCurrentPoint = true; FMI 3.0: a step that asks to
+        terminate the simulation is refused too (FMI 3.0, 4.2.4: the master stops)."""
+        if self.fmi == 2:
+            f, c = self._function("fmi2DoStep")
+
+            def step(t, h):
+                status = f(c, t, h, 1)
+                if status > 1:
+                    self._refused("fmi2DoStep", status)
+
+            return step
+        from ctypes import byref, c_bool, c_double
+
+        f, c = self._function("fmi3DoStep")
+        event, terminate, early, last = c_bool(), c_bool(), c_bool(), c_double()
+        flags = (byref(event), byref(terminate), byref(early), byref(last))
+
+        def step3(t, h):
+            status = f(c, t, h, True, *flags)
+            if status > 1 or terminate.value:
+                self._refused("fmi3DoStep", max(status, 2))
+
+        return step3
 
 
 def boom_switch(plant: FmuFile, boom: str):

@@ -4,7 +4,7 @@
 Each cylinder is two sites of the MJCF model, one on each body it joins: boomsim adds a spatial
 tendon between them (its length is the pin-to-pin length, l_retracted + stroke x; its velocity the
 rate v) and a `general` actuator on the tendon (the force along it, > 0 pushing the sites apart).
-Each cylinder has its own HydraulicCircuit (FMI 2.0 Co-Simulation through fmpy), its valve command
+Each cylinder has its own HydraulicCircuit (FMI 2.0 or 3.0 Co-Simulation through fmpy), its valve command
 and optionally its PressureFeedbackController; the loop is boomsim.coupled's (plain or TLM port,
 Gauss-Seidel or Jacobi). The TLM port's impedance -Z_c v is the actuator's affine velocity bias,
 so MuJoCo's implicit integrators (implicitfast, implicit) treat it implicitly; the wave c_m is
@@ -25,7 +25,7 @@ import numpy as np
 
 from fmpy.fmi1 import FMICallException
 
-from .coupled import COUPLINGS, RECORDED, Drive, Unstable, loop, start_circuit, start_controller
+from .coupled import COUPLINGS, RAMPED, RECORDED, Drive, Unstable, loop, slave, start_circuit, start_controller
 from .errors import UsageError
 from .fmus import FmuFile, release
 from .mechanics import Mechanics
@@ -372,17 +372,20 @@ class MujocoRun:
 
 def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | None = None,
         stop_time: float = 1.0, key: str | None = "start", monitor=None, record_every: int | None = None,
-        control_step: float | None = None) -> MujocoRun:
+        control_step: float | None = None, fmi: int = 2) -> MujocoRun:
     """Couples a HydraulicCircuit to each cylinder of the MJCF `model` (text, path or MjSpec), from
     rest at the keyframe `key`, for `stop_time` [s] at the communication step `step` (MuJoCo's
     timestep when None, else a whole multiple of it) with `coupling` (boomsim.coupled.COUPLINGS).
     Records every `record_every` steps (1 ms by default); `monitor(t, model, data)` returns the
     numbers to keep at each recorded point (a contact force, a body position). The controllers
-    step every `control_step` (default: `step`; a whole multiple of it)."""
+    step every `control_step` (default: `step`; a whole multiple of it). `fmi`: the FMUs' FMI
+    version, 2 or 3 (Co-Simulation; FMI 3.0 ramps its inputs by intermediate update)."""
     if coupling not in COUPLINGS:
         raise UsageError(f"coupling = {coupling!r}: must be one of {COUPLINGS}")
     if not cylinders:
         raise UsageError("no cylinders: give at least one boomsim.mujoco.Cylinder")
+    if fmi not in (2, 3):
+        raise UsageError(f"fmi = {fmi!r}: the FMUs are FMI 2 or 3")
     spec = mjcf_spec(model)
     tables = [c.table() for c in cylinders]
     port = "tlm" if coupling.startswith("tlm") else "plain"
@@ -392,7 +395,7 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
     n = int(round(stop_time / step))
     record_every = record_every or max(1, int(round(1e-3 / step)))
     control_every = whole_multiple("control_step", step if control_step is None else control_step, "the step", step)
-    circ_f, ctrl_f = FmuFile.get("HydraulicCircuit"), FmuFile.get("PressureFeedbackController")
+    circ_f, ctrl_f = FmuFile.get("HydraulicCircuit", fmi), FmuFile.get("PressureFeedbackController", fmi)
     for c in cylinders:
         for name in c.circuit:
             if name not in circ_f.vars or circ_f.vars[name].causality != "parameter":
@@ -410,20 +413,20 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
     try:
         drives = []
         for i, (c, table) in enumerate(zip(cylinders, tables)):
-            circ = circ_f.slave(f"{c.name}.circuit")
+            circ, circ_inputs = slave(circ_f, f"{c.name}.circuit", RAMPED[port])
             instances.append(circ)
             circ.setupExperiment(startTime=0.0, stopTime=stop_time)
             circ.enterInitializationMode()
             start_circuit(circ_f, circ, port, x[i], v[i], force[i], c.circuit)
-            ctrl = None
+            ctrl = ctrl_inputs = None
             if c.controller is not None:
-                ctrl = ctrl_f.slave(f"{c.name}.controller")
+                ctrl, ctrl_inputs = slave(ctrl_f, f"{c.name}.controller", RAMPED["controller"])
                 instances.append(ctrl)
                 ctrl.setupExperiment(startTime=0.0, stopTime=stop_time)
                 ctrl.enterInitializationMode()
                 p4 = circ.getReal([circ_f.vr["p4"]])[0]
                 start_controller(ctrl_f, ctrl, {"enable": True, **c.controller}, p4, reference(table, 0.0))
-            drives.append(Drive(circ, circ_f, table, ctrl, ctrl_f))
+            drives.append(Drive(circ, circ_f, table, ctrl, ctrl_f, circ_inputs, ctrl_inputs))
         data = loop(drives, mech, coupling, step, n, record_every, control_every)
         counts = [dict(zip(COUNTS, map(int, d.circuit.getReal([circ_f.vr[f"solver.{k}"] for k in COUNTS]))))
                   for d in drives]
@@ -440,7 +443,7 @@ def run(model, cylinders: list[Cylinder], coupling: str = "tlm", step: float | N
 
 
 def scenario_run(sc: dict, coupling: str = "tlm", step: float = 5e-4, integrator: str = "RK4",
-                 stop_time: float | None = None) -> Result:
+                 stop_time: float | None = None, fmi: int = 2) -> Result:
     """A boomsim scenario (its start stroke, reference, controller and [plant] parameters) with the
     thesis' rigid boom in MuJoCo at the communication step `step` (MuJoCo's timestep: `step`, at
     most 1 ms), the controller at the scenario's step (as HydraulicBoom's runs take it) or `step`."""
@@ -450,7 +453,7 @@ def scenario_run(sc: dict, coupling: str = "tlm", step: float = 5e-4, integrator
     circuit = {k: v for k, v in sc["plant"].items() if k in FmuFile.get("HydraulicCircuit").vars}
     controller = sc["controller"] if sc["controller"].get("enable") else None
     r = run(xml, [thesis_cylinder(sc["reference"], controller, circuit, params)], coupling, step,
-            sc["stop_time"] if stop_time is None else stop_time, control_step=max(step, sc["step"]))
+            sc["stop_time"] if stop_time is None else stop_time, control_step=max(step, sc["step"]), fmi=fmi)
     return dataclasses.replace(r.results["boom"], scenario=sc)
 
 
@@ -476,9 +479,10 @@ def main(argv=None):
     ap.add_argument("--sweep", action="store_true", help="largest stable step of each coupling (LIFT)")
     ap.add_argument("--alpha", type=float, default=0.0, help="TLM wave damping port.alpha of the sweep")
     ap.add_argument("--repeats", type=int, default=1, help="wall times: the best of this many runs")
+    ap.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the circuits' and controllers' FMI version")
     args = ap.parse_args(argv)
     if args.sweep:
-        runner = lambda sc, c, h: scenario_run(sc, c, h, args.integrator)  # noqa: E731
+        runner = lambda sc, c, h: scenario_run(sc, c, h, args.integrator, fmi=args.fmi)  # noqa: E731
         split.print_sweep(f"mujoco {args.integrator} alpha {args.alpha:g}",
                           split.sweep("rigid", alpha=args.alpha, runner=runner))
         return
@@ -498,7 +502,7 @@ def main(argv=None):
         cases = [(c, h) for c in ("tlm", "plain") for h in TABLE_STEPS] if args.table else [(args.coupling, args.step)]
         got = {}
         for c, h in cases:
-            r, wall = timed(lambda: scenario_run(sc, c, h, args.integrator))
+            r, wall = timed(lambda: scenario_run(sc, c, h, args.integrator, fmi=args.fmi))
             got[c, h] = (mx.compute(r), wall, r.counts)
         print(f"\n{sid}-rigid, MuJoCo {args.integrator}: error of each metric against HydraulicBoom + controller "
               f"through fmpy at 1 ms (wall {t_mono:.2f} s, best of {args.repeats}; {mono.counts['rhs']} RHS); the "

@@ -80,6 +80,21 @@ def test_mujoco_moves_as_boom_mechanics(coupling):
     assert np.abs(p3 - p3_ref).max() < 1e-5 * np.ptp(p3_ref)
 
 
+@pytest.mark.parametrize("coupling", ["tlm", "plain"])
+def test_fmi3_circuits_follow_fmi2(coupling):
+    """The same run with the FMI 3.0 circuit and controller (their inputs ramped by intermediate
+    update, FMI 3.0 4.2.3) as with FMI 2.0 (input derivatives): the same binaries and the same
+    ramp, so the same run to rounding. Scenario B (controller, lowering) and U (limit cycle) for
+    2 s: p3 within 1e-6 of its range (measured 5e-10 over 3 s)."""
+    for scenario in ("U", "B"):
+        sc = load_scenario(scenario)
+        controller = sc["controller"] if sc["controller"]["enable"] else None
+        xml = bm.boom_mjcf(sc["start_stroke"], timestep=5e-4)
+        p3 = [bm.run(xml, [bm.thesis_cylinder(sc["reference"], controller)], coupling, 5e-4, 2.0, control_step=1e-3,
+                     fmi=fmi).results["boom"]["p3"] for fmi in (2, 3)]
+        assert np.abs(p3[1] - p3[0]).max() < 1e-6 * np.ptp(p3[0]), scenario
+
+
 #: The coupling docs/mujoco.md recommends: TLM, Gauss-Seidel, 0.5 ms, MuJoCo's RK4.
 RECOMMENDED = {"coupling": "tlm", "step": 5e-4}
 
@@ -119,7 +134,8 @@ def test_bad_cylinder_is_named(change, message):
 
 def test_bad_run_arguments_are_named():
     """A step that is not a multiple of the timestep, a controller step that is not one of the
-    step, a missing keyframe, an unknown coupling, MJCF that does not load."""
+    step, a missing keyframe, an unknown coupling, MJCF that does not load, an FMI version the FMUs
+    do not have."""
     c = bm.thesis_cylinder(-0.3)
     with pytest.raises(UsageError, match="step = 0.0015 s must be MuJoCo's timestep 0.001 s or a whole multiple"):
         bm.run(BOOM, [c], "tlm", step=1.5e-3, stop_time=0.01)
@@ -131,6 +147,8 @@ def test_bad_run_arguments_are_named():
         bm.run(BOOM, [c], "gauss", stop_time=0.01)
     with pytest.raises(UsageError, match="does not load"):
         bm.run("<mujoco><worldbody><bad/></worldbody></mujoco>", [c], stop_time=0.01)
+    with pytest.raises(UsageError, match="fmi = 1: the FMUs are FMI 2 or 3"):
+        bm.run(BOOM, [c], "tlm", stop_time=0.01, fmi=1)
 
 
 def test_implicit_integrator_has_no_damping_bound():
