@@ -526,6 +526,41 @@ if __name__ == "__main__":
     sys.exit(cli(main))
 
 
+def render(model, qpos, width: int = 900, height: int = 500) -> np.ndarray:
+    """MuJoCo's offscreen picture (RGB, height x width) of the compiled `model` at `qpos`, seen
+    along the hinges' axis, the cylinders (tendons) red, boxes orange, planes see-through, the rest
+    grey. It needs an
+    offscreen OpenGL that MuJoCo picks when it is imported: MUJOCO_GL=osmesa (Debian's libosmesa6,
+    which scripts/setup installs) or egl (a GPU's driver); without one, a UsageError."""
+    import copy
+
+    m = copy.copy(model)
+    m.vis.global_.offwidth, m.vis.global_.offheight = max(width, m.vis.global_.offwidth), max(height, m.vis.global_.offheight)
+    m.vis.headlight.ambient[:], m.vis.headlight.diffuse[:], m.vis.headlight.specular[:] = 0.45, 0.55, 0.1
+    m.tendon_width[:], m.tendon_rgba[:] = 0.035, [0.85, 0.15, 0.1, 1.0]
+    m.geom_rgba[:] = [0.55, 0.6, 0.7, 1.0]
+    m.geom_rgba[m.geom_type == mujoco.mjtGeom.mjGEOM_BOX] = [0.95, 0.6, 0.1, 1.0]
+    m.geom_rgba[m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE] = [0.5, 0.55, 0.5, 0.3]
+    data = mujoco.MjData(m)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(m, data)
+    try:
+        renderer = mujoco.Renderer(m, height, width)
+    except Exception as e:  # noqa: BLE001 - mujoco.FatalError, or GLFW's without a display
+        raise UsageError(f"MuJoCo's renderer found no offscreen OpenGL ({e}): set MUJOCO_GL=osmesa (Debian's "
+                         "libosmesa6) or MUJOCO_GL=egl before Python starts") from e
+    try:
+        solid = m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE  # a plane's bound is infinite
+        reach = m.geom_rbound[solid][:, None]
+        lo, hi = (data.geom_xpos[solid] - reach).min(axis=0), (data.geom_xpos[solid] + reach).max(axis=0)
+        camera = mujoco.MjvCamera()
+        camera.lookat[:], camera.distance, camera.azimuth, camera.elevation = (lo + hi) / 2, 1.4 * max(hi - lo), 80, -8
+        renderer.update_scene(data, camera)
+        return renderer.render().copy()
+    finally:
+        renderer.close()
+
+
 def draw(ax, model, qpos, color="0.3") -> None:
     """The model at `qpos` in MuJoCo's x-z plane (the thesis' x-y): capsules as lines, boxes as
     their outline, planes as the ground line, tendons (the cylinders, a rope) through their sites

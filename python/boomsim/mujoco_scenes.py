@@ -6,7 +6,8 @@
                 HydraulicCircuit instances and two valve commands; a closed motion and its energy
                 balance
 
-    boomsim-mujoco-scene touchdown|knuckle [--out PNG]   runs the scene, writes its figure
+    boomsim-mujoco-scene touchdown|knuckle [--out PNG] [--render PNG]   runs the scene, writes its
+        figure (and MuJoCo's picture of its end: MUJOCO_GL=osmesa or egl, boomsim.mujoco.render)
 """
 
 from __future__ import annotations
@@ -294,11 +295,19 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description="A MuJoCo scene driven by HydraulicCircuit: runs it, writes its figure")
     ap.add_argument("scene", choices=("touchdown", "knuckle"))
     ap.add_argument("--out", default=None, help="the figure (default: out/mujoco_<scene>.png)")
+    ap.add_argument("--render", default=None, help="MuJoCo's offscreen picture of the scene's end, a PNG "
+                    "(needs MUJOCO_GL=osmesa or egl)")
     args = ap.parse_args(argv)
     out = args.out or OUT / f"mujoco_{args.scene}.png"
     scene = globals()[args.scene]()
-    globals()[f"plot_{args.scene}"](run(scene), out)
+    result = run(scene)
+    globals()[f"plot_{args.scene}"](result, out)
     print(f"wrote {out}")
+    if args.render:
+        import matplotlib.pyplot as plt
+
+        plt.imsave(args.render, bm.render(result.model, result.qpos[-1]))
+        print(f"wrote {args.render}")
 
 
 if __name__ == "__main__":

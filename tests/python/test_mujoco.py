@@ -220,6 +220,26 @@ def test_the_knuckle_page_states_the_jib():
         assert phrase in text, phrase
 
 
+def test_mujoco_renders_the_boom_offscreen():
+    """MuJoCo's offscreen renderer (MUJOCO_GL=osmesa, libosmesa6 from scripts/setup; the variable
+    must be set before mujoco is imported, so in a fresh interpreter) pictures the thesis' boom:
+    the cylinder's red and the payload's orange are both in the picture, and most of it is the
+    black background (the boom is a thin structure)."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import numpy as np; from boomsim import mujoco as bm; import mujoco; "
+            "s = bm.mjcf_spec(bm.boom_mjcf()); bm.add_cylinders(s, [bm.thesis_cylinder()], 'tlm'); m = s.compile(); "
+            "p = bm.render(m, m.key_qpos[0]).astype(int); r, g, b = p[..., 0], p[..., 1], p[..., 2]; "
+            "print(int(np.sum((r > 150) & (g < 80) & (b < 80))), int(np.sum((r - b > 100) & (g > 60) & (r > g + 30))), "
+            "float(np.mean(p.sum(axis=2) == 0)))")
+    out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "MUJOCO_GL": "osmesa"}, capture_output=True,
+                         text=True, timeout=120, check=True).stdout.split()
+    red, orange, black = int(out[0]), int(out[1]), float(out[2])
+    assert red > 100 and orange > 100 and black > 0.5, out
+
+
 def test_the_docs_example_runs():
     """docs/mujoco.md's first Python block runs as written: the boom lowers (the angle falls) and
     every recorded pressure is finite."""
