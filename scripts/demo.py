@@ -1,14 +1,15 @@
 """Demo: the coupled co-simulation of the two FMUs (boomsim.cosim) for experiment U (no
 compensation, step 0.10: the boom oscillates) and experiment B (corrected filter, step 0.05:
 stabilised), each with the feedback from t = 0 (thesis conditions) and from the CBV opening.
-Writes out/<variant>.csv, out/<variant>.png and out/summary.md."""
+Writes out/<variant>.csv, out/<variant>.png, out/summary.md and out/u_against_b.png (the README's
+figure: U against B, both with the feedback from t = 0)."""
 
 import sys
 
 from boomsim import cosim
 from boomsim.paths import OUT
 from boomsim.errors import cli
-from boomsim.plots import plot
+from boomsim.plots import plot, plot_u_against_b
 from boomsim.result import write_csv
 from boomsim.scenarios import load_scenario
 from boomsim import metrics as mx
@@ -20,11 +21,12 @@ def fmt(x, unit=""):
 
 def main():
     OUT.mkdir(exist_ok=True)
-    rows = []
+    rows, first = [], {}
     for sid in ("U", "B"):
         sc = load_scenario(sid)
         for start in sc["starts"]:
             res = cosim.run(sc, "rigid", feedback_start=start)
+            first.setdefault(sid, res)
             m = mx.compute(res)
             write_csv(res, OUT / f"{res.name}.csv")
             plot(res, OUT / f"{res.name}.png", m)
@@ -47,6 +49,7 @@ def main():
               "and holds the load for about 2.8 s (docs/python.md, \"Motion start\").", ""]
     lines += [f"![{name}]({name}.png)" for name, _, _ in rows]
     (OUT / "summary.md").write_text("\n".join(lines) + "\n")
+    plot_u_against_b(first["U"], first["B"], OUT / "u_against_b.png")
     print("demo: plots, CSVs and summary.md in out/")
 
 

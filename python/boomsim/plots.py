@@ -74,3 +74,24 @@ def plot(res: Result, path, metrics: dict | None = None, zoom: float = 3.0):
     axes[0, 0].figure.align_ylabels(axes[:, 0])
     figures.save(fig, path, dpi=90)
     plt.close(fig)
+
+
+def plot_u_against_b(u: Result, b: Result, path) -> None:
+    """The README's figure: the piston-side pressure p3 and the cylinder velocity of experiment U
+    (no feedback: the lowering oscillates, thesis 7.1) against B (the high-pass-filtered pressure
+    feedback: it settles, 9.1), in the FMUs' signs (lowering < 0)."""
+    import matplotlib.pyplot as plt
+
+    fig, (p, v) = plt.subplots(2, 1, sharex=True, figsize=(10, 5.5), constrained_layout=True)
+    for res in (u, b):
+        t = res.data["time"]
+        p.plot(t, res.data["p3"] / BAR, label=res.scenario["title"], lw=1)
+        v.plot(t, res.data["cylinder.v"] * 1e3, lw=1)
+    p.set(ylabel="p3, piston side [bar]", title="Lowering the load: the counterbalance valve oscillates without "
+          "the feedback (U) and settles with it (B)")
+    v.set(ylabel="cylinder velocity [mm/s]", xlabel="time [s]", xlim=(0, max(u.data["time"][-1], b.data["time"][-1])))
+    p.legend(loc="upper right")
+    for a in (p, v):
+        a.grid(alpha=0.3)
+    figures.save(fig, path, dpi=100)
+    plt.close(fig)

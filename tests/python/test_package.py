@@ -104,6 +104,43 @@ def test_a_result_is_numpy_columns_and_a_dataframe():
     assert len(r.time) == 201  # one row per millisecond, both ends
 
 
+def test_the_readmes_first_screen_states_the_models_numbers(monkeypatch):
+    """The README's first screen against the code: the payload (BoomMechanics' payload.m, rounded
+    to kg) and the arm's length (boom.l_arm), U's and B's valve commands (their scenario files),
+    and its fmpy block run as written (matplotlib's window off): p3 of U swings by "some 200 bar"
+    (within 25 %: the limit cycle's peak-to-peak over its last 2 s) between its own figures. Each
+    licence that Cargo.toml declares has its file."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from boomsim.fmus import FmuFile
+    from boomsim.scenarios import load_scenario
+
+    readme = (ROOT / "README.md").read_text()
+    first = " ".join(readme.split("## The FMUs")[0].split())
+    boom = FmuFile.get("BoomMechanics").vars
+    assert f"lowering a {float(boom['payload.m'].start):.0f} kg load on a {float(boom['boom.l_arm'].start):g} m" in first
+    for sid, words in (("U", "**U** lowers the load at a valve command of {:.2f} without feedback"),
+                       ("B", "**B** lowers at {:.2f} with the feedback")):
+        assert words.format(load_scenario(sid)["reference"][-1, 1]) in first, sid
+    assert "swings by some 200 bar" in first
+    block = readme.split("## Loading one in fmpy", 1)[1].split("```python\n", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setattr(plt, "show", lambda: None)
+    scope = {}
+    exec(block, scope)
+    r = scope["r"]
+    late = r["p3"][r["time"] >= r["time"][-1] - 2.0]
+    assert 150e5 <= np.ptp(late) <= 250e5, np.ptp(late) / 1e5
+    licences = re.search(r'^license = "(.*)"', (ROOT / "Cargo.toml").read_text(), re.M).group(1).split(" OR ")
+    for name in licences:
+        text = (ROOT / f"LICENSE-{name.split('-')[0].upper()}").read_text()
+        assert {"MIT": "MIT License", "Apache-2.0": "Apache License"}[name] in text
+
+
 def test_the_readme_is_read_in_five_minutes():
     """At most 200 lines (issue 28): what boomsim is in its first three lines, then the two
     commands; every page it links exists."""
