@@ -25,7 +25,7 @@ fn wrong_arguments_get_one_clear_line() {
         (&["eigen", "--set", "boom.xi=-0.1"], &["boom.xi = -0.1 is outside its valid range [0, 1]"]),
         (&["eigen", "--set", "p3=1"], &["HydraulicBoom has no parameter \"p3\""]),
         (&["eigen", "--set", "boom.n2"], &["expected NAME=VALUE"]),
-        (&["bench", "--set", "boom.damping=3"], &["boom.damping = 3 is outside its valid range [0, 2]"]),
+        (&["bench", "--set", "boom.damping=4"], &["boom.damping = 4 is outside its valid range [0, 3]"]),
         (&["bench", "--set", "boom.damping=1", "--json"], &["does not go with --json"]),
         (&["bench", "--realtime", "--set", "boom.damping=1"], &["does not go with --realtime"]),
         (&["linearize", "--u-ref", "-2"], &["--u-ref -2 is outside [-1, 1]"]),

@@ -123,6 +123,14 @@ pub const BAND: f64 = 50.0 * std::f64::consts::TAU;
 /// oscillation.
 pub const QUASI_STATIC: f64 = 1.0;
 
+/// `boom.damping` of the converged-modal law: every locked mode that the lumping has converged
+/// keeps the damping ratio `boom.xi`, the modes beyond are damped up to critical (module doc).
+pub const CONVERGED_MODAL_DAMPING: usize = 3;
+
+/// A locked mode is converged when its frequency moves less than this from the chain's section
+/// counts to twice them (issue 48).
+pub const CONVERGED: f64 = 0.01;
+
 /// Most sections the chain may have: max(n2, 1) + n3.
 pub const MAX_SECTIONS: usize = 32;
 
@@ -218,6 +226,13 @@ fn lift<T: Scalar>(v: Vector2<f64>) -> Vector2<T> {
 }
 
 /// Series combination of two springs or dampers (2.35, 2.38); infinity is a rigid side.
+/// The converged-modal law's damping ratio at `ratio` = omega / omega_c: `zeta` up to 1, then a
+/// C1 smoothstep in log2(ratio) to [`QUASI_STATIC`] at 2 (one octave), at least `zeta`.
+pub fn converged_ratio(zeta: f64, ratio: f64) -> f64 {
+    let s = ratio.log2().clamp(0.0, 1.0);
+    zeta + (QUASI_STATIC - zeta).max(0.0) * s * s * (3.0 - 2.0 * s)
+}
+
 fn series(a: f64, b: f64) -> f64 {
     1.0 / (1.0 / a + 1.0 / b)
 }
@@ -308,6 +323,11 @@ impl FlexibleBoom {
         if beam.damping == MODAL_DAMPING {
             boom.modal_damping()?;
         }
+        if beam.damping == CONVERGED_MODAL_DAMPING {
+            let refined = BeamParams { n2: (2 * beam.n2).min(16), n3: (2 * beam.n3).min(16), damping: 0, ..*beam };
+            let reference = Self::new(p, &refined, stroke)?.locked_frequencies()?;
+            boom.converged_modal_damping(beam.xi, &reference)?;
+        }
         Ok(boom)
     }
 
@@ -357,6 +377,13 @@ impl FlexibleBoom {
         Ok(self.locked_modes()?.0.min().sqrt())
     }
 
+    /// The frequencies of [`Self::locked_modes`] (rad/s), ascending.
+    pub fn locked_frequencies(&self) -> Result<Vec<f64>, MechanicsError> {
+        let mut omega: Vec<f64> = self.locked_modes()?.0.iter().map(|w2| w2.sqrt()).collect();
+        omega.sort_by(f64::total_cmp);
+        Ok(omega)
+    }
+
     /// The arm's modes with the cylinder locked: omega^2 and the shapes w of K w = omega^2 M w,
     /// undeformed and horizontal (q = 0), g^T w = 0 (the rotation about B and the rod stand
     /// still), springs only; the shapes (columns, in q) normalised to w^T M w = 1.
@@ -383,21 +410,49 @@ impl FlexibleBoom {
         Ok((eigen.eigenvalues, z * l_inv.transpose() * eigen.eigenvectors))
     }
 
-    /// `boom.damping` = 2, the modal law (module doc): the joints' damping matrix C that gives
-    /// each locked mode j its own damping, psi_j^T C psi_j = 2 zeta_j omega_j and psi_i^T C psi_j
-    /// = 0, with psi_j the mode's joint deflections: the per-section law's own value below
-    /// [`BAND`], at least [`QUASI_STATIC`] above it. C = Psi^-T diag(2 zeta omega) Psi^-1 (Psi is
-    /// regular: the n - 1 deflections of a locked shape fix it, g^T w = 0 excluding the rigid
-    /// turn about B that has none).
+    /// `boom.damping` = 2, the modal law (module doc): each locked mode keeps the per-section law's
+    /// own damping below [`BAND`], at least [`QUASI_STATIC`] above it ([`Self::set_modal_damping`]).
     fn modal_damping(&mut self) -> Result<(), MechanicsError> {
+        let c = self.c;
+        self.set_modal_damping(|omega, shape| {
+            let thesis = (0..shape.len()).map(|l| c[l] * shape[l].powi(2)).sum::<f64>();
+            if omega < BAND { thesis } else { thesis.max(2.0 * QUASI_STATIC * omega) }
+        })
+    }
+
+    /// `boom.damping` = 3, the converged-modal law: each locked mode j whose frequency is within
+    /// [`CONVERGED`] of the refined chain's (`reference`: omega^2 of the chain with twice the
+    /// sections, ascending) gets the damping ratio `zeta`, a steel structure's (the thesis' 2 %,
+    /// [3, p. 97]); above the frequency omega_c where the relative difference reaches
+    /// [`CONVERGED`] the ratio rises smoothly to [`QUASI_STATIC`] over an octave
+    /// ([`converged_ratio`]). omega_c follows the modes: interpolated in log-log between the last
+    /// mode inside and the first outside (the lumping's error grows as omega^2), so no mode's
+    /// damping jumps when a parameter moves it.
+    fn converged_modal_damping(&mut self, zeta: f64, reference: &[f64]) -> Result<(), MechanicsError> {
+        let omega = self.locked_frequencies()?;
+        let error: Vec<f64> = omega.iter().zip(reference).map(|(w, r)| (w / r - 1.0).abs()).collect();
+        let omega_c = match error.iter().position(|&e| e >= CONVERGED) {
+            None => f64::INFINITY,
+            // Below the first mode: its error as omega^2.
+            Some(0) => omega[0] * (CONVERGED / error[0]).sqrt(),
+            Some(j) => {
+                let (w0, w1, e0, e1) = (omega[j - 1].ln(), omega[j].ln(), error[j - 1].max(1e-300).ln(), error[j].ln());
+                (w0 + (w1 - w0) * (CONVERGED.ln() - e0) / (e1 - e0)).exp()
+            }
+        };
+        self.set_modal_damping(|omega, _| 2.0 * converged_ratio(zeta, omega / omega_c) * omega)
+    }
+
+    /// The joints' damping matrix C that gives each locked mode j its own damping,
+    /// psi_j^T C psi_j = `modal(omega_j, psi_j)` (2 zeta_j omega_j) and psi_i^T C psi_j = 0, with
+    /// psi_j the mode's joint deflections: C = Psi^-T diag(modal) Psi^-1 (Psi is regular: the
+    /// n - 1 deflections of a locked shape fix it, g^T w = 0 excluding the rigid turn about B that
+    /// has none).
+    fn set_modal_damping(&mut self, modal: impl Fn(f64, &[f64]) -> f64) -> Result<(), MechanicsError> {
         let m = self.n - 1;
         let (omega2, shapes) = self.locked_modes()?;
         let psi = DMatrix::from_fn(m, m, |i, j| shapes[(i + 1, j)] - shapes[(i, j)]);
-        let modal = DVector::from_fn(m, |j, _| {
-            let omega = omega2[j].sqrt();
-            let thesis = (0..m).map(|l| self.c[l] * psi[(l, j)].powi(2)).sum::<f64>();
-            if omega < BAND { thesis } else { thesis.max(2.0 * QUASI_STATIC * omega) }
-        });
+        let modal = DVector::from_fn(m, |j, _| modal(omega2[j].sqrt(), psi.column(j).as_slice()));
         let modal = DMatrix::from_diagonal(&modal);
         let inv = psi.try_inverse().ok_or(MechanicsError::InvalidBeam("the arm's locked modes are not independent"))?;
         let c = inv.transpose() * modal * &inv;
@@ -410,7 +465,7 @@ impl FlexibleBoom {
     /// Torque of the damper of joint i (between sections i and i + 1): its own rate's under the
     /// per-section and structural laws (2.36-2.38), every joint's under the modal law.
     fn damper<T: Scalar>(&self, qd: &[T], i: usize) -> T {
-        if self.damping == MODAL_DAMPING {
+        if self.damping == MODAL_DAMPING || self.damping == CONVERGED_MODAL_DAMPING {
             let row = &self.modal[i * MAX_SECTIONS..][..self.n - 1];
             row.iter().enumerate().fold(T::from(0.0), |tau, (j, &c)| tau + (qd[j + 1] - qd[j]) * c)
         } else {
@@ -1015,3 +1070,4 @@ mod tests {
         println!("accelerations, 4 + 5 sections: {:.0} ns per call", start.elapsed().as_nanos() as f64 / calls as f64);
     }
 }
+

@@ -141,7 +141,8 @@ pub const BEAM_PARAMS: &[Param<BeamParams>] = &[
         "Young's modulus of the arm", NOMENCLATURE),
     param!("boom.xi", xi, 0.02, "1", "%", [0.0, 1.0],
         "Damping ratio of the arm: of each section's torsional damper (boom.damping = 0, eq. 2.36-2.38, and 2 \
-         below its band) or of the arm's first bending mode (boom.damping = 1)", "section 2.1.4, [3, p. 97]"),
+         below its band), of the arm's first bending mode (boom.damping = 1) or of each converged mode \
+         (boom.damping = 3)", "section 2.1.4, [3, p. 97]"),
     param!("boom.x_mount", x_mount, 0.590, "m", "mm", [0.01, 3.0],
         "Joint B to the boundary between beam parts II and III at the upper cylinder mount",
         "section 3.1.2, Table 3.1 (the pin itself is at x1 = w1 cos(phi2), eq. 2.25)"),
@@ -149,16 +150,19 @@ pub const BEAM_PARAMS: &[Param<BeamParams>] = &[
         "Sections of beam part II, joint B to the cylinder mount (0: rigid)", "section 3.1.2, experiment III"),
     param!(int "boom.n3", n3, 5.0, [1.0, 16.0],
         "Sections of beam part III, cylinder mount to the arm's end", "section 3.1.2, experiment II"),
-    param!(int "boom.damping", damping, 2.0, [0.0, 2.0],
+    param!(int "boom.damping", damping, 2.0, [0.0, 3.0],
         "Damping law of the arm's joints: 0 per section as the thesis (c = 2 xi sqrt(k J) of each section, its \
          modal damping falls with the number of sections), 1 structural (stiffness-proportional, c = beta k \
          with beta = 2 xi / omega_b: the damping ratio xi at the arm's first bending mode omega_b, whatever \
          the sections), 2 modal, the default (the arm's modes with the cylinder locked below 50 Hz keep the \
-         damping of law 0, those above it are damped critically: quasi-static)",
+         damping of law 0, those above it are damped critically: quasi-static), 3 converged-modal (each \
+         locked mode within 1 % of its frequency with twice the sections gets the damping ratio xi, the \
+         others up to critical, smoothly in frequency)",
         "eq. 2.36-2.38; 1: not in the thesis, Rayleigh stiffness-proportional damping (Clough & Penzien, \
          Dynamics of Structures, 3rd ed., sec. 12-5) anchored where [3, p. 97]'s 1-2 % for steel structures \
          applies; 2: not in the thesis, the damping matrix of modal damping ratios (ibid., same section) with \
-         the modes above the band quasi-static as in a modal truncation with static correction"),
+         the modes above the band quasi-static as in a modal truncation with static correction; 3: not in the \
+         thesis, the same matrix with [3, p. 97]'s ratio on every mode the lumping resolves"),
 ];
 
 /// The cross-section and lumped-beam parameters as numbers (SI); names and ranges are in
@@ -174,7 +178,8 @@ pub struct BeamParams {
     /// Sections of part II; 0 makes part II one rigid body.
     pub n2: usize,
     pub n3: usize,
-    /// Damping law of the joints: 0 per section (2.36-2.38), 1 structural, 2 modal (`boom.damping`).
+    /// Damping law of the joints: 0 per section (2.36-2.38), 1 structural, 2 modal, 3 converged-modal
+    /// (`boom.damping`).
     pub damping: usize,
 }
 
