@@ -52,7 +52,7 @@ from .model_exchange import run_me
 from .paths import OUT
 from .plots import plot
 from .result import COLUMNS, PLANT_OUT, Result, write_csv
-from .scenarios import controller_start, load_scenario, reference, variant_name
+from .scenarios import check_feedback_start, controller_start, load_scenario, positive, reference, variant_name
 
 
 def schedule(scenario: dict, step, stop_time, record_every, feedback_start):
@@ -61,14 +61,14 @@ def schedule(scenario: dict, step, stop_time, record_every, feedback_start):
     whichever is coarser."""
     t_end = scenario["stop_time"] if stop_time is None else stop_time
     step = scenario["step"] if step is None else step
+    positive("step", step, "s")
+    positive("stop_time", t_end, "s")
     n = int(round(t_end / step))
-    if abs(n * step - t_end) > 1e-9 * t_end:
-        raise ValueError(f"stop time {t_end} is not a multiple of the step {step}")
+    if n < 1 or abs(n * step - t_end) > 1e-9 * t_end:
+        raise UsageError(f"stop_time={t_end!r}: a whole multiple of the step {step!r} s")
     if record_every is None:
         record_every = max(1, int(round(1e-3 / step)))
-    fb_start = feedback_start or scenario["starts"][0]
-    if fb_start not in ("t0", "cbv_open"):
-        raise ValueError(f"feedback_start must be 't0' or 'cbv_open', got {fb_start!r}")
+    fb_start = check_feedback_start(feedback_start or scenario["starts"][0])
     return t_end, step, n, record_every, fb_start
 
 
@@ -88,6 +88,8 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
     switch = boom_switch(plant_f, boom)
     scenario, ctrl_params = with_params(scenario, plant_f, params)
     t_end, step, n, record_every, fb_start = schedule(scenario, step, stop_time, record_every, feedback_start)
+    if tolerance is not None:
+        positive("tolerance", tolerance, "1")
     enable = bool(scenario["controller"]["enable"])
     table = scenario["reference"]
 

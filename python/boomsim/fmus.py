@@ -271,7 +271,7 @@ def boom_switch(plant: FmuFile, boom: str):
             raise Skip("HydraulicBoom has the rigid boom only (no flexible-boom switch "
                        f"{' / '.join(FLEXIBLE_SWITCH)} in its modelDescription yet)")
         return name, (1 if plant.vars[name].type != "Boolean" else True)
-    raise ValueError(f"unknown boom {boom!r} (rigid or flexible)")
+    raise UsageError(f"boom={boom!r}: \"rigid\" or \"flexible\"")
 
 
 def release(*instances):
@@ -295,8 +295,38 @@ def initialize_plant(plant_f: FmuFile, plant, ctrl, scenario: dict, switch, tole
     plant.exitInitializationMode()
 
 
+def check_params(params: dict, *files: FmuFile) -> None:
+    """Every entry of `params` is a parameter of one of the FMUs `files` with a value its
+    modelDescription allows (a number within [min, max]; a whole number for an Integer, true or
+    false for a Boolean), or a UsageError naming the parameter, the value and what is allowed,
+    before any instance exists."""
+    import math
+
+    for name, value in params.items():
+        v = next((f.vars[name] for f in files if name in f.vars), None)
+        if v is None or v.causality not in ("parameter", "structuralParameter"):
+            what = "a variable that is not a parameter" if v is not None else "no such variable"
+            raise UsageError(f"params[{name!r}]: {what} of {' or '.join(f.md.modelName for f in files)} "
+                             "(docs/fmus.md lists the parameters)")
+        if v.type == "Boolean":
+            if value not in (True, False, 0, 1):
+                raise UsageError(f"params[{name!r}] = {value!r}: true or false")
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise UsageError(f"params[{name!r}] = {value!r}: a finite number")
+        lo, hi = (float(b) if b is not None else None for b in (v.min, v.max))
+        if (lo is not None and value < lo) or (hi is not None and value > hi):
+            raise UsageError(f"params[{name!r}] = {value!r} is outside its valid range [{v.min}, {v.max}]"
+                             + (f" {v.unit}" if getattr(v, "unit", None) not in (None, "", "1") else ""))
+        if v.type in ("Integer", "Int32", "Enumeration") and value != int(value):
+            raise UsageError(f"params[{name!r}] = {value!r}: a whole number")
+
+
 def with_params(scenario: dict, plant_f: FmuFile, params: dict | None) -> tuple[dict, dict]:
-    """The scenario with the plant's `params` among its start values, and the controller's."""
+    """The scenario with the plant's `params` among its start values, and the controller's; each
+    checked (`check_params`) against the plant and the PressureFeedbackController of the same
+    FMI version."""
     params = params or {}
+    check_params(params, plant_f, FmuFile.get("PressureFeedbackController", plant_f.fmi))
     plant = {k: v for k, v in params.items() if k in plant_f.vars}
     return {**scenario, "plant": {**scenario["plant"], **plant}}, {k: v for k, v in params.items() if k not in plant}

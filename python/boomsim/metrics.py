@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from .errors import UsageError
+
 BAR = 1e5
 #: Rated flow of the PVG32 spool per unit opening (thesis 2.2.1) and the cylinder areas
 #: (parameter list: bore 65 mm, rod 35 mm): the independent expectation of the lowering speed.
@@ -107,6 +109,9 @@ def compute(res) -> dict:
     """The regression metrics of one result (see docs/python.md)."""
     d = res.data
     t, p3, u_comp = d["time"], d["p3"], d["u_comp"]
+    if t[-1] - t[0] < WINDOW:
+        raise UsageError(f"metrics of a {t[-1] - t[0]:g} s record: they need at least {WINDOW:g} s (the peak-to-peak "
+                         "of p3 is taken in windows of that length); run longer (stop_time)")
     u_ss = float(res.scenario["reference"][-1, 1])
     v_exp = expected_velocity(u_ss)
     t_end = t[-1]

@@ -8,7 +8,7 @@ import numpy as np
 from .fmus import FmuFile, boom_switch, initialize_plant, release, with_params
 from .metrics import CBV_OPEN
 from .result import COLUMNS, PLANT_OUT, Result
-from .scenarios import controller_start, reference
+from .scenarios import check_feedback_start, controller_start, positive, reference
 
 
 #: fmi2Discard, fmi3Discard.
@@ -87,9 +87,10 @@ def run_me(scenario: dict, boom: str = "rigid", stop_time: float | None = None, 
     plant_f, ctrl_f = FmuFile.get("HydraulicBoom", fmi), FmuFile.get("PressureFeedbackController", fmi)
     switch = boom_switch(plant_f, boom)
     scenario, ctrl_params = with_params(scenario, plant_f, params)
-    t_end = scenario["stop_time"] if stop_time is None else stop_time
+    t_end = positive("stop_time", scenario["stop_time"] if stop_time is None else stop_time, "s")
+    positive("tolerance", tolerance, "1")
     ctrl_cfg = scenario["controller"]
-    fb_start = feedback_start or scenario["starts"][0]
+    fb_start = check_feedback_start(feedback_start or scenario["starts"][0])
     enable = bool(ctrl_cfg["enable"])
     table = scenario["reference"]
     plant = plant_f.model(f"{scenario['id']}.plant")

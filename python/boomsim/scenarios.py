@@ -70,6 +70,20 @@ def communication_references(table: np.ndarray, step: float, n: int) -> list[flo
     return [reference(table, 0.0)] + [reference(table, k * step + step) for k in range(n)]
 
 
+def check_feedback_start(value) -> str:
+    """`value` if it is a feedback start ("t0" or "cbv_open"), else a UsageError."""
+    if value not in ("t0", "cbv_open"):
+        raise UsageError(f"feedback_start={value!r}: \"t0\" (from the start) or \"cbv_open\" (from the CBV's opening)")
+    return value
+
+
+def positive(name: str, value, unit: str):
+    """`value` if it is a finite number > 0, else a UsageError naming the argument `name`."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < float("inf"):
+        raise UsageError(f"{name}={value!r}: a finite number > 0 [{unit}]")
+    return value
+
+
 def variant_name(scenario: dict, boom: str, feedback_start: str = "t0") -> str:
     """`<id>-<boom>`, with `-cbv` appended for feedback_start = cbv_open."""
     return f"{scenario['id']}-{boom}" + ("-cbv" if feedback_start == "cbv_open" else "")

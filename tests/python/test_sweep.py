@@ -59,15 +59,15 @@ def test_two_workers_give_the_serial_metrics_exactly(tmp_path):
     assert (tmp_path / "out" / "map-p3_pp_late.png").exists()
 
 
-def test_a_failing_point_is_a_row_with_fmpys_error(tmp_path):
-    """fluid.beta = 5e9 is above its range [1e8, 3e9]: fmi2SetReal answers fmi2Error, which fmpy
-    raises as FMICallException."""
+def test_a_failing_point_is_a_row_with_its_error(tmp_path):
+    """fluid.beta = 5e9 is above its range [1e8, 3e9] in the modelDescription: the run refuses it
+    with a UsageError naming the parameter, the value and the range, before any FMU is made."""
     f = sweep_file(tmp_path, '"fluid.beta" = {grid = [1.4e9, 5e9, 2.0e9]}\n')
     code, err = cli(f, "--workers", "1", "--out", tmp_path / "out")
     assert code == 0, err
     rows = sorted(sweep.read_rows(sweep.load(f), tmp_path / "out"), key=lambda r: r["fluid.beta"])
     assert [r["status"] for r in rows] == ["ok", "ok", "failed"]
-    assert rows[2]["error"] == "FMICallException: fmi2SetReal failed with status 3 (error)."
+    assert rows[2]["error"].startswith("UsageError: params['fluid.beta'] = 5000000000.0 is outside its valid range [")
     assert all(rows[2][m] is None for m in METRICS) and all(r["p3_pp_max"] > 0 for r in rows[:2])
     assert "1 failed" in err and "3 of 3 points run, 1 failed" in (tmp_path / "out" / "summary.md").read_text()
 
@@ -165,24 +165,25 @@ def test_the_communication_step_is_a_sweep_parameter(tmp_path):
         ref = metrics.compute(cosim.run(s["scenario"], "rigid", step=p["step"], stop_time=1.0))
         assert row["status"] == "ok" and {m: row[m] for m in METRICS} == {m: ref[m] for m in METRICS}
     assert rows[0]["p3_pp_max"] != rows[1]["p3_pp_max"]
-    assert rows[2]["status"] == "failed" and "not a multiple of the step 0.003" in rows[2]["error"]
+    assert rows[2]["status"] == "failed" and "stop_time=1.0: a whole multiple of the step 0.003 s" in rows[2]["error"]
 
 
 def test_reused_instances_give_the_fresh_results_bit_for_bit():
     """fmi2Reset returns an instance to its state after instantiation: every parameter a run set
     before (fluid.beta, cbv.mu_p, the filter) is back at its start value. A sequence of runs on
-    reused instances, a failing one (fmi2Error) and a timed-out one among them, against the same
-    runs on fresh instances: every recorded value equal."""
+    reused instances, a failing one (fmi2Error: a rod wider than the bore, which each parameter's
+    range allows and the model's cross-check refuses) and a timed-out one among them, against the
+    same runs on fresh instances: every recorded value equal."""
     sc = load_scenario("B")
     sequence = [{"fluid.beta": 1.4e9, "K_f": 1.0e-11}, {}, {"cbv.mu_p": 5.0, "omega_f": 50.0, "payload.m": 200.0},
-                {"fluid.beta": 5e9}, "timeout", {"u_max": 0.5}, {}]
+                {"cylinder.d_rod": 0.07}, "timeout", {"u_max": 0.5}, {}]
     for params in sequence:
         if params == "timeout":
             with pytest.raises(TimeoutError):
                 cosim.run(sc, stop_time=1.0, reuse=True, timeout=1e-4)
             continue
-        if params.get("fluid.beta") == 5e9:
-            with pytest.raises(Exception, match="fmi2SetReal failed"):
+        if "cylinder.d_rod" in params:
+            with pytest.raises(Exception, match="fmi2ExitInitializationMode failed"):
                 cosim.run(sc, stop_time=1.0, params=params, reuse=True)
             continue
         reused = cosim.run(sc, stop_time=1.0, params=params, reuse=True)
