@@ -1,5 +1,6 @@
 """Regression of the scenario catalogue: runs every scenario variant (scenario x boom x feedback
-start), computes the metrics, compares them with the committed baselines within the tolerances of
+start; the flexible boom under the default damping law and the thesis' law, `-flexible-thesis`),
+computes the metrics, compares them with the committed baselines within the tolerances of
 the package's baselines/tolerances.toml and writes a Markdown report with the plots.
 
     scripts/regress                 compare; exit 1 on a regression or a missing baseline
@@ -102,6 +103,20 @@ def variants(only=None):
                 yield sc, boom, fb
 
 
+#: The flexible arm's damping laws the regression keeps baselines for (issue 48): the default
+#: (modal) and the thesis' per-section law (eq. 2.36-2.38), whose variants are named
+#: <id>-flexible-thesis[-cbv].
+LAWS = {"": {}, "-thesis": {"boom.damping": 0}}
+
+
+def runs(only=None):
+    """(scenario, boom, feedback start, variant name, the law's parameters) of every variant the
+    regression runs: `variants`, the flexible ones under each of LAWS."""
+    for sc, boom, fb in variants(only):
+        for suffix, law in LAWS.items() if boom == "flexible" else [("", {})]:
+            yield sc, boom, fb, variant_name(sc, boom + suffix, fb), law
+
+
 def step_sweep(sid: str, steps, feedback_start: str) -> list[dict]:
     """Metrics of scenario `sid` (rigid) for each communication step, with a verdict: settles =
     p3 settles (2 %) and the steady velocity is within 2 % of the expected one (a limit cycle of
@@ -178,19 +193,18 @@ def main(argv=None) -> int:
 
     results, failures, skipped, lines = {}, [], [], []
     t_start = time.time()
-    todo = list(variants(only))
-    for k, (sc, boom, fb) in enumerate(todo, 1):
-        name = variant_name(sc, boom, fb)
+    todo = list(runs(only))
+    for k, (sc, boom, fb, name, law) in enumerate(todo, 1):
 
         def progress():
             """n of N and the elapsed time, for the line of a finished variant."""
             return f"[{k:2d}/{len(todo)} {time.time() - t_start:5.0f} s]"
 
         try:
-            res = cosim.run(sc, boom, feedback_start=fb, params=params)
+            res = cosim.run(sc, boom, feedback_start=fb, params={**law, **params})
         except Skip as e:
             skipped.append(f"{name}: {e}")
-            print(f"{progress()} {name:18s} skipped: {e}")
+            print(f"{progress()} {name:24s} skipped: {e}")
             continue
         m = mx.compute(res)
         results[name] = m
@@ -200,7 +214,7 @@ def main(argv=None) -> int:
         if args.update:
             base_file.write_text(json.dumps({"scenario": shown(pathlib.Path(sc["file"]), PACKAGE), "boom": boom,
                                              "feedback_start": fb, "step": res.step, "fmus": info,
-                                             "metrics": m}, indent=2) + "\n")
+                                             **({"params": law} if law else {}), "metrics": m}, indent=2) + "\n")
             verdict = "baselined"
         elif not base_file.exists():
             failures.append(f"{name}: no baseline {shown(base_file, PACKAGE)} (run scripts/regress --update)")
@@ -209,7 +223,7 @@ def main(argv=None) -> int:
             bad = compare(name, m, json.loads(base_file.read_text())["metrics"], tol)
             failures += bad
             verdict = "ok" if not bad else "REGRESSION"
-        print(f"{progress()} {name:18s} {verdict:10s} " + " ".join(f"{k}={fmt(m[k])}" for k in
+        print(f"{progress()} {name:24s} {verdict:10s} " + " ".join(f"{k}={fmt(m[k])}" for k in
                                                      ("p3_pp_max", "t_motion", "t_settle", "v_steady", "u_comp_rms")))
         lines.append((name, sc, res, m, verdict))
 
