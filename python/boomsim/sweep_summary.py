@@ -248,8 +248,10 @@ def draw(sweep, grid: Grid, m: str, region, rec, linear: dict, fine_xy, path: pa
         ax.set_xlabel(axis_label(grid.axes[0]))
     for ax in axs[:, 0]:
         ax.set_ylabel(axis_label(grid.axes[1]))
-    key = ("grey: not settled; red outline: every point settles; star: recommended; white dashed: linear "
-           "boundary")
+    drawn = [(True, "grey: not settled"), (region is not None and region.any(), "red outline: every point settles"),
+             (rec is not None, "star: recommended"),
+             (any(linear.get(p) for p in grid.panels), "white dashed: linear boundary")]
+    key = "; ".join(what for shown, what in drawn if shown)  # only what the panels show
     # About 15 characters of 8 pt text per inch of width.
     fig.suptitle(f"{sweep['scenario']['id']}-{sweep['boom']}, {sweep['stop_time']:g} s: worst {m}\n"
                  + textwrap.fill(key, int(15 * width)), fontsize=8)
