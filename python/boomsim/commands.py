@@ -4,15 +4,29 @@
 from __future__ import annotations
 
 import importlib
+import sys
 
 from .errors import cli
 
 
+#: The packages of the optional extras (pyproject.toml), by the module a command misses.
+EXTRAS = {"mujoco": "mujoco", "dask": "sweeps", "distributed": "sweeps", "pyarrow": "sweeps", "pandas": "pandas",
+          "libcosimpy": "ssp", "ecospy": "ssp"}
+
+
 def _command(module: str):
     def command() -> int:
-        return cli(importlib.import_module(f"{__package__}.{module}").main)
+        try:
+            return cli(lambda: importlib.import_module(f"{__package__}.{module}").main())
+        except ModuleNotFoundError as e:
+            top = (e.name or "").split(".")[0]
+            if top not in EXTRAS:
+                raise
+            print(f"boomsim.{module} needs {top}: pip install \"boomsim[{EXTRAS[top]}]\"", file=sys.stderr)
+            return 2
 
-    command.__doc__ = f"boomsim.{module}.main, its UsageError as one line and exit status 2"
+    command.__doc__ = (f"boomsim.{module}.main, its UsageError as one line and exit status 2, as is a missing "
+                       "optional dependency (the extra to install)")
     return command
 
 

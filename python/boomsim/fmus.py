@@ -85,10 +85,15 @@ class FmuFile:
     _cache: dict[tuple[str, int], "FmuFile"] = {}
 
     def __init__(self, identifier: str, fmi: int = 2):
+        import fmpy
         from fmpy import extract, read_model_description
 
         self.fmi = fmi
         self.path = str(fmu(identifier, fmi))
+        supported = fmpy.supported_platforms(self.path)
+        if fmpy.platform not in supported and fmpy.platform_tuple not in supported:
+            raise UsageError(f"{identifier} (FMI {fmi}.0) has no binary for this platform, {fmpy.platform_tuple}: "
+                             f"its binaries are for {', '.join(supported)} (docs/platforms.md)")
         self.md = read_model_description(self.path)
         self.dir = extract(self.path)
         self.vars = {v.name: v for v in self.md.modelVariables}

@@ -34,8 +34,8 @@ from .scenarios import reference
 
 try:
     import mujoco
-except ImportError as e:  # pragma: no cover - the extra is missing
-    raise ImportError("boomsim.mujoco needs MuJoCo: pip install boomsim[mujoco]") from e
+except ModuleNotFoundError as e:  # pragma: no cover - the extra is missing
+    raise ModuleNotFoundError("boomsim.mujoco needs MuJoCo: pip install boomsim[mujoco]", name="mujoco") from e
 
 #: Stability bound of a damper c on an effective mass m under an explicit integrator, on
 #: c dt / m: forward (semi-implicit) Euler's velocity update 1 - c dt / m stays within the unit

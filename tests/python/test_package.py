@@ -6,6 +6,7 @@ import ast
 import pathlib
 import re
 import subprocess
+import sys
 
 import pytest
 
@@ -152,3 +153,25 @@ def test_the_readme_is_read_in_five_minutes():
     assert [lines[k].split()[1] for k in commands[:2]] == ["scripts/demo", "scripts/test"]
     links = re.findall(r"\]\(([^)#]+)[^)]*\)", readme)
     assert links and [link for link in links if not (ROOT / link).exists()] == []
+
+
+def test_a_command_without_its_extra_names_the_extra():
+    """A console command whose optional dependency is missing (here mujoco, hidden from a fresh
+    interpreter) prints one line naming the extra and exits with status 2, not a traceback."""
+    code = ("import sys; sys.modules['mujoco'] = None; sys.argv = ['boomsim-mujoco', '--help']; "
+            "from boomsim import commands; sys.exit(commands.mujoco())")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and r.stderr.strip() == 'boomsim.mujoco needs mujoco: pip install "boomsim[mujoco]"', r.stderr
+
+
+def test_an_unsupported_platform_is_named(monkeypatch):
+    """On a platform the FMUs have no binary for (macOS here, faked in fmpy's platform names), an
+    FmuFile is a UsageError naming the platform and the ones the binaries are for."""
+    import fmpy
+
+    from boomsim.fmus import FmuFile
+
+    monkeypatch.setattr(fmpy, "platform", "darwin64")
+    monkeypatch.setattr(fmpy, "platform_tuple", "aarch64-darwin")
+    with pytest.raises(boomsim.UsageError, match="HydraulicBoom .FMI 2.0. has no binary for this platform, aarch64-darwin: its binaries are for linux64"):
+        FmuFile("HydraulicBoom")

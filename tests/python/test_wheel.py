@@ -124,3 +124,21 @@ def test_every_fmu_in_the_wheel_validates_and_instantiates(installed):
         print(json.dumps(out))
     """)
     assert len(problems) == 9 and all(p == [] for p in problems.values()), problems
+
+
+def test_every_console_script_answers_help(installed):
+    """Issue 50: every console script of pyproject.toml, run from the wheel's venv (the `sweeps`
+    extra only) outside the repository: `--help` prints its usage (exit 0), or, where the command
+    needs an extra this venv lacks (mujoco), one line naming the extra to install (exit 2)."""
+    import tomllib
+
+    python, cwd = installed
+    scripts = tomllib.loads((ROOT / "python" / "pyproject.toml").read_text())["project"]["scripts"]
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "BOOMSIM_FMU_DIR", "VIRTUAL_ENV")}
+    for name in scripts:
+        r = subprocess.run([str(python.parent / name), "--help"], cwd=cwd, env=env, capture_output=True, text=True)
+        lines = r.stderr.strip().splitlines()
+        if r.returncode == 0:
+            assert r.stdout.startswith("usage:"), (name, r.stdout[:200])
+        else:
+            assert r.returncode == 2 and len(lines) == 1 and 'pip install "boomsim[' in lines[0], (name, r.stderr)
