@@ -142,3 +142,22 @@ def test_every_console_script_answers_help(installed):
             assert r.stdout.startswith("usage:"), (name, r.stdout[:200])
         else:
             assert r.returncode == 2 and len(lines) == 1 and 'pip install "boomsim[' in lines[0], (name, r.stderr)
+
+
+def test_the_release_folder_has_every_fmu_and_checks_out():
+    """scripts/release (after scripts/wheel, so no build is left): dist/release-<version>/ holds
+    the five FMI 3.0 and four FMI 2.0 .fmu files with all three platforms' binaries, the wheel,
+    the docs and licences, and `sha256sum -c SHA256SUMS` verifies every file."""
+    import zipfile
+
+    subprocess.run(["bash", str(ROOT / "scripts" / "release")], check=True, capture_output=True)
+    out = ROOT / "dist" / f"release-{VERSION}"
+    fmus = sorted(p.relative_to(out).as_posix() for p in out.glob("fmi*/*.fmu"))
+    assert len([f for f in fmus if f.startswith("fmi2/")]) == 4 and len([f for f in fmus if f.startswith("fmi3/")]) == 5
+    for f in fmus:
+        names = zipfile.ZipFile(out / f).namelist()
+        platforms = {n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2}
+        assert len(platforms) == 3, (f, platforms)
+    assert (out / WHEEL.name).exists() and (out / "docs" / "mujoco.md").exists() and (out / "LICENSE-MIT").exists()
+    check = subprocess.run(["sha256sum", "-c", "--quiet", "SHA256SUMS"], cwd=out, capture_output=True, text=True)
+    assert check.returncode == 0, check.stdout + check.stderr
