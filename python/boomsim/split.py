@@ -4,6 +4,7 @@ HydraulicBoom), and the sweep of the communication step that finds each coupling
 
     boomsim-split U --coupling tlm [--boom rigid] [--step 1e-3]
     boomsim-split --sweep [--boom flexible]
+    boomsim-split --table                           docs/coupling.md's equivalence tables
 
 The couplings are boomsim.coupled's (docs/coupling.md); the mechanics is BoomMechanics through
 boomsim.mechanics. The controller is coupled to the circuit exactly as cosim.py couples it to
@@ -153,6 +154,31 @@ def compare(a: dict, b: dict, rel: float = 0.02) -> dict:
     return out
 
 
+#: The equivalence tables of docs/coupling.md: per scenario and boom, the couplings and steps
+#: against HydraulicBoom + controller at 1 ms.
+TABLES = {
+    ("U", "rigid"): [("tlm", 1e-3), ("plain", 1e-3), ("plain", 5e-4), ("plain", 2.5e-4), ("plain", 1e-4)],
+    ("B", "rigid"): [("tlm", 1e-3), ("plain", 1e-3)],
+    ("B", "flexible"): [("tlm", 1e-3), ("plain", 1e-3)],
+    ("U", "flexible"): [("tlm", 2e-3), ("tlm", 1e-3), ("tlm", 5e-4), ("tlm", 2.5e-4), ("tlm-jacobi", 1e-3)],
+}
+
+
+def print_tables() -> None:
+    """docs/coupling.md's equivalence tables: each metric of the monolithic run and of the split
+    one per coupling and step, (!) where it leaves 2 % + the metric's floor (`compare`)."""
+    for (sid, boom), cases in TABLES.items():
+        sc = load_scenario(sid)
+        mono = mx.compute(cosim.run(sc, boom, 1e-3))
+        got = [compare(mono, mx.compute(run(sc, boom, c, h))) for c, h in cases]
+        print(f"\n{sid}-{boom}:\n")
+        print("| metric | monolithic | " + " | ".join(f"{c} {h * 1e3:g} ms" for c, h in cases) + " |")
+        print("|---|---|" + "---|" * len(cases))
+        for k in got[0]:
+            cells = [f"{regress_fmt(g[k][1])}{'' if g[k][2] else ' (!)'}" for g in got]
+            print(f"| {k} | {regress_fmt(mono[k])} | " + " | ".join(cells) + " |", flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("scenario", nargs="?", default="U")
@@ -161,7 +187,11 @@ def main(argv=None):
     ap.add_argument("--step", type=float, default=None)
     ap.add_argument("--sweep", action="store_true", help="largest stable step of each coupling")
     ap.add_argument("--alpha", type=float, default=0.0, help="TLM wave damping port.alpha of the sweep")
+    ap.add_argument("--table", action="store_true", help="docs/coupling.md's equivalence tables (TABLES)")
     args = ap.parse_args(argv)
+    if args.table:
+        print_tables()
+        return
     sc = load_scenario(args.scenario)
     if args.sweep:
         couplings = COUPLINGS if args.alpha == 0 else ("tlm", "tlm-jacobi")
