@@ -168,7 +168,7 @@ def run(scenario: dict, boom: str = "rigid", step: float | None = None, stop_tim
         else:
             release(plant, ctrl)
     return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)}, fb_on_at,
-                  fb_start, counts={"rhs": int(rhs)})
+                  fb_start, counts={"rhs": int(rhs)}, interface=f"Co-Simulation FMI {fmi}.0, step {step * 1e3:g} ms")
 
 
 def main(argv=None):

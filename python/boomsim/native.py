@@ -46,4 +46,5 @@ def run_native(scenario: dict, boom: str = "rigid", step: float | None = None, s
     h = json.loads(head)
     data = np.frombuffer(body, dtype="<f8").reshape(h["rows"], h["columns"])
     return Result(scenario, boom, step, interpolate, {c: data[:, i] for i, c in enumerate(COLUMNS)},
-                  h["feedback_on_at"], fb_start, counts={"rhs": int(h["rhs"])})
+                  h["feedback_on_at"], fb_start, counts={"rhs": int(h["rhs"])},
+                  interface=f"native Co-Simulation FMI 2.0, step {step * 1e3:g} ms")

@@ -19,6 +19,10 @@ COLUMNS = ["time", "u_ref", "u_comp", "u_cmd"] + PLANT_OUT
 
 @dataclasses.dataclass
 class Result:
+    """One run of a scenario variant: its recorded columns (`data`, COLUMNS, SI units: pressures in
+    Pa gauge, strokes in m, velocities in m/s), how it ran (boom, step, interface, the feedback's
+    start) and, on demand, its regression `metrics` (their units: `metric_units`)."""
+
     scenario: dict
     boom: str
     step: float
@@ -30,7 +34,8 @@ class Result:
     #: Work counts: `rhs`, the plant's right-hand-side evaluations (CS: its solver's; ME: CVode's
     #: fmi2GetDerivatives calls).
     counts: dict = dataclasses.field(default_factory=dict)
-    #: "CS 1 ms" (fmi2DoStep at the step) or "Model Exchange, CVode rtol ..." (`run_me`).
+    #: How it ran: "Co-Simulation FMI 2.0, step 1 ms", "native Co-Simulation ..." or "Model Exchange,
+    #: CVode rtol ..." (`run_me`).
     interface: str = ""
 
     @property
@@ -45,6 +50,11 @@ class Result:
     def __getitem__(self, column: str) -> np.ndarray:
         """A recorded column by name (COLUMNS: SI units, pressures in Pa gauge)."""
         return self.data[column]
+
+    @property
+    def metric_units(self) -> dict:
+        """The unit of each of `metrics` (bar, s, mm/s, Hz, ...: the regression's, docs/python.md)."""
+        return {k: unit for k, (unit, _) in mx.DEFINITIONS.items()}
 
     @functools.cached_property
     def metrics(self) -> dict:

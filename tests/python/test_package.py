@@ -175,3 +175,14 @@ def test_an_unsupported_platform_is_named(monkeypatch):
     monkeypatch.setattr(fmpy, "platform_tuple", "aarch64-darwin")
     with pytest.raises(boomsim.UsageError, match="HydraulicBoom .FMI 2.0. has no binary for this platform, aarch64-darwin: its binaries are for linux64"):
         FmuFile("HydraulicBoom")
+
+
+def test_a_result_says_how_it_ran_and_its_metrics_units():
+    """Issue 50: `interface` names the interface, FMI version and step of a Co-Simulation run (it
+    was empty), and `metric_units` gives every metric's unit: pressures' peak-to-peak in bar,
+    times in s, speeds in mm/s, the dominant frequency in Hz (metrics.DEFINITIONS)."""
+    r = boomsim.run("B", stop_time=1.0)
+    assert r.interface == "Co-Simulation FMI 2.0, step 1 ms"
+    units = r.metric_units
+    assert set(units) == set(r.metrics)
+    assert (units["p3_pp_max"], units["t_settle"], units["v_mean"], units["f_dom"]) == ("bar", "s", "mm/s", "Hz")
