@@ -4,6 +4,8 @@ boom switch, and the set-up of a plant and its controller before a run of either
 
 from __future__ import annotations
 
+import functools
+
 from .errors import Skip, UsageError
 from .paths import fmu
 from .scenarios import plant_start
@@ -128,8 +130,8 @@ class FmuFile:
         kind = "Slave" if interface == "CoSimulation" else "Model"
         cls = getattr(fmi3, f"FMU3{kind}") if self.fmi == 3 else getattr(fmi2, f"FMU2{kind}")
         description = self.md.coSimulation if interface == "CoSimulation" else self.md.modelExchange
-        i = cls(guid=self.md.guid, unzipDirectory=self.dir,
-                modelIdentifier=description.modelIdentifier, instanceName=name)
+        i = tracked(cls)(guid=self.md.guid, unzipDirectory=self.dir,
+                         modelIdentifier=description.modelIdentifier, instanceName=name)
         i.instantiate(**instantiate)
         return Fmi3(i) if self.fmi == 3 else i
 
@@ -279,13 +281,39 @@ def boom_switch(plant: FmuFile, boom: str):
     raise UsageError(f"boom={boom!r}: \"rigid\" or \"flexible\"")
 
 
+@functools.cache
+def tracked(base):
+    """The fmpy instance class `base` remembering whether the instance has left Initialization
+    Mode since it was instantiated or reset (`initialized`): only then is Terminate legal (FMI 2.0
+    state tables, 4.3.1 and 3.2.3: not in Instantiated or Initialization Mode; FMI 3.0 likewise),
+    so `release` frees the others without the call that their FMU refuses with an error message."""
+
+    class Tracked(base):
+        initialized = False
+
+        def exitInitializationMode(self):
+            out = super().exitInitializationMode()
+            self.initialized = True
+            return out
+
+        def reset(self):
+            out = super().reset()
+            self.initialized = False
+            return out
+
+    Tracked.__name__ = Tracked.__qualname__ = base.__name__
+    return Tracked
+
+
 def release(*instances):
-    """Terminates (where the state allows) and frees FMU instances."""
+    """Terminates where the state allows it (an instance of `FmuFile` that left Initialization
+    Mode; any other is tried) and frees FMU instances."""
     for m in instances:
-        try:
-            m.terminate()
-        except Exception:  # noqa: BLE001 - terminate after an error may be refused
-            pass
+        if getattr(m, "initialized", True):
+            try:
+                m.terminate()
+            except Exception:  # noqa: BLE001 - terminate after an error may be refused
+                pass
         m.freeInstance()
 
 

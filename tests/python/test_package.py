@@ -186,3 +186,17 @@ def test_a_result_says_how_it_ran_and_its_metrics_units():
     units = r.metric_units
     assert set(units) == set(r.metrics)
     assert (units["p3_pp_max"], units["t_settle"], units["v_mean"], units["f_dom"]) == ("bar", "s", "mm/s", "Hz")
+
+
+def test_a_run_refused_in_initialization_logs_only_its_error(capfd):
+    """A run the plant refuses at fmi2ExitInitializationMode (a rod wider than the bore: each
+    parameter's range allows it, the model's cross-check does not) fails with that error, and
+    releasing its instances does not call fmi2Terminate, which the FMI 2.0 state table forbids in
+    Initialization Mode (the plants would log a second, misleading error)."""
+    from fmpy.fmi1 import FMICallException
+
+    with pytest.raises(FMICallException, match="fmi2ExitInitializationMode"):
+        boomsim.run("B", stop_time=0.1, params={"cylinder.d_rod": 0.07})
+    err = capfd.readouterr()
+    logged = err.out + err.err
+    assert "must be less than cylinder.d_piston" in logged and "fmi2Terminate" not in logged, logged
