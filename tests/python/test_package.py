@@ -188,15 +188,29 @@ def test_a_result_says_how_it_ran_and_its_metrics_units():
     assert (units["p3_pp_max"], units["t_settle"], units["v_mean"], units["f_dom"]) == ("bar", "s", "mm/s", "Hz")
 
 
-def test_a_run_refused_in_initialization_logs_only_its_error(capfd):
-    """A run the plant refuses at fmi2ExitInitializationMode (a rod wider than the bore: each
-    parameter's range allows it, the model's cross-check does not) fails with that error, and
-    releasing its instances does not call fmi2Terminate, which the FMI 2.0 state table forbids in
-    Initialization Mode (the plants would log a second, misleading error)."""
-    from fmpy.fmi1 import FMICallException
+def test_release_terminates_only_instances_past_initialization():
+    """fmi2Terminate is illegal in Instantiated and Initialization Mode (FMI 2.0 state table):
+    `release` frees such an instance without it (its FMU would refuse it with a second, misleading
+    error after a run refused at initialisation), terminates one that left Initialization Mode,
+    and after fmi2Reset (back to Instantiated) again does not."""
+    from boomsim.fmus import FmuFile, release
 
-    with pytest.raises(FMICallException, match="fmi2ExitInitializationMode"):
-        boomsim.run("B", stop_time=0.1, params={"cylinder.d_rod": 0.07})
-    err = capfd.readouterr()
-    logged = err.out + err.err
-    assert "must be less than cylinder.d_piston" in logged and "fmi2Terminate" not in logged, logged
+    f = FmuFile.get("PressureFeedbackController")
+    calls = []
+
+    def made(initialize: bool, reset: bool = False):
+        s = f.slave("release-test")
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        if initialize:
+            s.exitInitializationMode()
+        if reset:
+            s.reset()
+        terminate = s.terminate
+        s.terminate = lambda: (calls.append(initialize and not reset), terminate())[1]
+        return s
+
+    for initialize, reset in ((False, False), (True, False), (True, True)):
+        calls.clear()
+        release(made(initialize, reset))
+        assert calls == ([True] if initialize and not reset else []), (initialize, reset, calls)
