@@ -34,9 +34,11 @@ RAMPED = {"tlm": "port.c_m", "plain": "cylinder.v", "controller": "p"}
 #: Circuit outputs recorded (PLANT_OUT without the stroke and velocity, which come from
 #: the mechanics).
 CIRCUIT_OUT = [c for c in PLANT_OUT if not c.startswith("cylinder.")]
-#: The columns of a recorded row: COLUMNS and the circuit's force on the rod (plain: to the
-#: mechanics; TLM: pressure forces - friction at the circuit's rod).
-RECORDED = [*COLUMNS, "cylinder.F"]
+#: What the loop reads from a circuit after each step, in one call: CIRCUIT_OUT, the TLM wave
+#: c_h, the force on the rod (the plain port's input to the mechanics) and the cylinder's friction.
+READ = [*CIRCUIT_OUT, "port.c_h", "cylinder.F", "cylinder.F_fr"]
+#: The columns of a recorded row: COLUMNS and the circuit's friction force (for energy balances).
+RECORDED = [*COLUMNS, "cylinder.F_fr"]
 
 
 class Unstable(Exception):
@@ -91,13 +93,13 @@ def start_controller(controller_f, controller, config: dict, p4: float, u_ref: f
 
 
 class _Calls:
-    """One drive's FMU calls of the loop, bound once (boomsim.fmus.Direct): per step one read of
-    the outputs with the port's c_h and F, one write of the inputs before the step, one of their
+    """One drive's FMU calls of the loop, bound once (boomsim.fmus.Direct): per step one read
+    (READ), one write of the inputs before the step, one of their
     ramp and the doStep."""
 
     def __init__(self, d: Drive, port: str):
         vh, c = d.circuit_f.vr, Direct(d.circuit)
-        self.read = c.getter([vh[k] for k in CIRCUIT_OUT] + [vh["port.c_h"], vh["cylinder.F"]])
+        self.read = c.getter([vh[k] for k in READ])
         # TLM: the command and the mechanics' wave together; plain: the command, and after the
         # mechanics' step its stroke and rate
         self.inputs = c.setter([vh["valve.u_ref"]] + ([vh["port.c_m"]] if port == "tlm" else []))
@@ -123,10 +125,10 @@ def loop(drives: list[Drive], mechanics, coupling: str, step: float, n: int, rec
     tlm, gauss_seidel = coupling.startswith("tlm"), coupling in ("plain", "tlm")
     calls = [_Calls(d, "tlm" if tlm else "plain") for d in drives]
     x, v = mechanics.motion()
-    # a read holds CIRCUIT_OUT, c_h, F; a recorded row takes PLANT_OUT from it and the motion
-    read = [*CIRCUIT_OUT, "port.c_h", "cylinder.F", "cylinder.x", "cylinder.v"]
+    # a recorded row takes its columns from a read and the mechanics' motion
+    read = [*READ, "cylinder.x", "cylinder.v"]
     i_p4, i_c_h, i_force = (read.index(c) for c in ("p4", "port.c_h", "cylinder.F"))
-    order = [read.index(c) for c in (*PLANT_OUT, "cylinder.F")]
+    order = [read.index(c) for c in RECORDED[4:]]
     y = [c.read()[:] for c in calls]
     stroke = [d.circuit.getReal([d.circuit_f.vr["cylinder.stroke"]])[0] for d in drives]
     refs = [communication_references(d.table, step, n) for d in drives]

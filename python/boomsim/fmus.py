@@ -5,6 +5,7 @@ boom switch, and the set-up of a plant and its controller before a run of either
 from __future__ import annotations
 
 import functools
+import math
 
 from .errors import Skip, UsageError
 from .paths import fmu
@@ -333,8 +334,6 @@ def check_params(params: dict, *files: FmuFile) -> None:
     modelDescription allows (a number within [min, max]; a whole number for an Integer, true or
     false for a Boolean), or a UsageError naming the parameter, the value and what is allowed,
     before any instance exists."""
-    import math
-
     for name, value in params.items():
         v = next((f.vars[name] for f in files if name in f.vars), None)
         if v is None or v.causality not in ("parameter", "structuralParameter"):

@@ -518,20 +518,13 @@ def main(argv=None):
         print("| circuit steps, RHS | | " + " | ".join(f"{g[2]['steps']}, {g[2]['rhs_evals']}" for g in got.values()) + " |")
 
 
-if __name__ == "__main__":
-    import sys
-
-    from .errors import cli
-
-    sys.exit(cli(main))
-
 
 def render(model, qpos, width: int = 900, height: int = 500) -> np.ndarray:
     """MuJoCo's offscreen picture (RGB, height x width) of the compiled `model` at `qpos`, seen
     along the hinges' axis, the cylinders (tendons) red, boxes orange, planes see-through, the rest
-    grey. It needs an
-    offscreen OpenGL that MuJoCo picks when it is imported: MUJOCO_GL=osmesa (Debian's libosmesa6,
-    which scripts/setup installs) or egl (a GPU's driver); without one, a UsageError."""
+    grey. It needs an offscreen OpenGL that MuJoCo picks when it is imported: MUJOCO_GL=osmesa
+    (Debian's libosmesa6, which scripts/setup installs) or egl (a GPU's driver); without one, a
+    UsageError."""
     import copy
 
     m = copy.copy(model)
@@ -583,3 +576,11 @@ def draw(ax, model, qpos, color="0.3") -> None:
         sites = [model.wrap_objid[w] for w in wraps if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_SITE]
         points = data.site_xpos[sites]
         ax.plot(points[:, 0], points[:, 2], color="tab:red", lw=2)
+
+
+if __name__ == "__main__":
+    import sys
+
+    from .errors import cli
+
+    sys.exit(cli(main))

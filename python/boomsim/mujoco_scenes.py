@@ -177,14 +177,15 @@ def pressure_force(run, cylinder) -> np.ndarray:
 
 def powers(run) -> tuple[np.ndarray, np.ndarray]:
     """(hydraulic, friction) power of all cylinders over a run [W]: the pressure forces' power
-    on the pistons, sum of pressure_force v, and the cylinders' friction's, sum of F_fr v with
-    F_fr = pressure force - cylinder.F (the circuit's force on the rod)."""
+    on the pistons, sum of pressure_force v, and the cylinders' friction's, sum of F_fr v
+    (HydraulicCircuit's cylinder.F_fr, eq. 2.65). The circuit's own force balance holds by its
+    construction (its rod force is the pressure force less F_fr), so a balance of these against
+    MuJoCo's energy checks what crosses the port: the TLM line's exchange and MuJoCo's integration."""
     hydraulic = friction = 0.0
     for c in run.cylinders:
         r = run.results[c.name]
-        force = pressure_force(run, c)
-        hydraulic = hydraulic + force * r["cylinder.v"]
-        friction = friction + (force - r["cylinder.F"]) * r["cylinder.v"]
+        hydraulic = hydraulic + pressure_force(run, c) * r["cylinder.v"]
+        friction = friction + r["cylinder.F_fr"] * r["cylinder.v"]
     return hydraulic, friction
 
 

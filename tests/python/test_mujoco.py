@@ -187,8 +187,10 @@ def test_knuckle_boom_moves_both_cylinders_and_balances_energy(tmp_path):
     - Each cylinder moves the way its valve is commanded: over every phase of a nonzero command
       its stroke changes by more than 20 mm with the command's sign (the lifts move about 77 mm;
       20 mm is far beyond the few-mm lag at a phase's start).
-    - Energy: the pressure forces' work on the pistons equals the cylinders' friction work plus
-      the change of MuJoCo's kinetic + potential energy (the rods' mass is the circuits' only),
+    - Energy: the pressure forces' work on the pistons equals the cylinders' friction work (the
+      circuits' cylinder.F_fr) plus the change of MuJoCo's kinetic + potential energy (the rods'
+      mass is the circuits' only). The circuit balances its own rod by construction, so this
+      checks what crosses the port: the TLM line's exchange and MuJoCo's integration,
       within 1e-4 of the hydraulic throughput (the integral of |power|). The TLM line (alpha = 0)
       is lossless and holds nothing once both sides rest, so what remains is the trapezoid rule on
       0.5 ms samples of power that oscillates at a few Hz, (omega h)^2 / 12 ~ 1e-5 relative; a

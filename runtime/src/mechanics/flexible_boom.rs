@@ -228,7 +228,7 @@ fn lift<T: Scalar>(v: Vector2<f64>) -> Vector2<T> {
 /// Series combination of two springs or dampers (2.35, 2.38); infinity is a rigid side.
 /// The converged-modal law's damping ratio at `ratio` = omega / omega_c: `zeta` up to 1, then a
 /// C1 smoothstep in log2(ratio) to [`QUASI_STATIC`] at 2 (one octave), at least `zeta`.
-pub fn converged_ratio(zeta: f64, ratio: f64) -> f64 {
+fn converged_ratio(zeta: f64, ratio: f64) -> f64 {
     let s = ratio.log2().clamp(0.0, 1.0);
     zeta + (QUASI_STATIC - zeta).max(0.0) * s * s * (3.0 - 2.0 * s)
 }

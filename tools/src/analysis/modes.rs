@@ -293,8 +293,8 @@ mod tests {
     /// damped more, and the fifth on (beyond an octave above the cutoff between the third and the
     /// fourth) critically. The cutoff's placement by the lumping's own convergence is the law's
     /// definition; the ratios are what the plant's eigenvalues give, a second computation. At the
-    /// default 4 + 5 sections the first two locked modes move 1.1 % and 2.9 % to 8 + 10
-    /// (docs/models.md's figures, to their digits).
+    /// default 4 + 5 sections the first two locked modes move more than 1 % to 8 + 10 (the
+    /// figures docs/models.md gives).
     #[test]
     fn converged_modal_damping_gives_the_resolved_modes_xi() {
         let moved = |(n2, n3), (m2, m3)| -> Vec<f64> {
@@ -303,9 +303,13 @@ mod tests {
         };
         let at_8_10 = moved((8, 10), (16, 16));
         assert!(at_8_10[..3].iter().all(|&e| e < 0.01) && at_8_10[3] > 0.02, "{at_8_10:?}");
-        // docs/models.md: at the default 4 + 5 sections not even the first bending mode (1.1 %).
+        // At the default 4 + 5 sections not even the first bending mode counts as converged, and
+        // docs/models.md's note gives both figures as computed here.
         let at_4_5 = moved((4, 5), (8, 10));
-        assert!((at_4_5[0] * 100.0 - 1.1).abs() < 0.05 && (at_4_5[1] * 100.0 - 2.9).abs() < 0.05, "{at_4_5:?}");
+        assert!(at_4_5[0] > 0.01 && at_4_5[1] > 0.01, "{at_4_5:?}");
+        let note = model_note("- **Flexible arm");
+        let (first, second) = (format!("{:.1} % to 8 + 10", at_4_5[0] * 100.0), format!("the second {:.1} %", at_4_5[1] * 100.0));
+        assert!(note.contains(&first) && note.contains(&second), "docs/models.md: {first}, {second}");
         for xi in [0.005, 0.02, 0.05] {
             let mut changes = STIFF_OIL.to_vec();
             changes.extend([
