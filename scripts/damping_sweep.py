@@ -1,7 +1,7 @@
 """The arm's damping laws over a swept parameter (issue 48's jump test): `boomsim eigen` with
-boom.m_arm from 1 to 1000 kg in 50 steps under the thesis' law (0), the modal law (2) and the
-converged-modal law (3); prints, per law and mode (the five lowest of the plant), the largest
-change of the damping ratio between neighbouring steps and where it is. A critically damped mode
+boom.m_arm from 1 to 1000 kg in 50 steps under the thesis' law, the modal law and the
+converged-modal law (`boom.damping` thesis, modal, converged_modal); prints, per law and mode
+(the five lowest of the plant), the largest change of the damping ratio between neighbouring steps and where it is. A critically damped mode
 is not oscillating and leaves `boomsim eigen`'s list: its place is empty. A few seconds.
 
     .venv/bin/python scripts/damping_sweep.py [--param boom.m_arm --from 1 --to 1000 --steps 50]
@@ -19,7 +19,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 MODES = 5
 
 
-def modes(law: int, name: str, value: float) -> np.ndarray:
+def modes(law: str, name: str, value: float) -> np.ndarray:
     """(frequency [Hz], damping ratio) of the plant's MODES lowest modes, NaN where fewer."""
     out = subprocess.run([str(ROOT / "target/release/boomsim"), "eigen", "--json", "--count", str(MODES),
                           "--set", f"{name}={value}", "--set", f"boom.damping={law}"],
@@ -38,7 +38,7 @@ def main(argv=None):
     values = np.linspace(args.lo, args.hi, args.steps)
     print(f"| law | mode | largest change of zeta between steps of {args.param} | at {args.param} |")
     print("|---|---|---|---|")
-    for law in (0, 2, 3):
+    for law in ("thesis", "modal", "converged_modal"):
         zeta = np.array([modes(law, args.param, v)[:, 1] for v in values])
         step = np.abs(np.diff(zeta, axis=0))
         for k in range(MODES):

@@ -19,11 +19,11 @@ from boomsim.scenarios import variant_name
 
 #: (column heading, the parameters of its runs).
 LAWS = [
-    ("thesis (0)", {"boom.damping": 0}),
-    ("converged-modal (3), xi 0.5 %", {"boom.damping": 3, "boom.xi": 0.005}),
-    ("converged-modal (3), xi 2 %", {"boom.damping": 3, "boom.xi": 0.02}),
-    ("converged-modal (3), xi 5 %", {"boom.damping": 3, "boom.xi": 0.05}),
-    ("modal (2), default", {"boom.damping": 2}),
+    ("thesis (0)", {"boom.damping": "thesis"}),
+    ("converged-modal (3), xi 0.5 %", {"boom.damping": "converged_modal", "boom.xi": 0.005}),
+    ("converged-modal (3), xi 2 %", {"boom.damping": "converged_modal", "boom.xi": 0.02}),
+    ("converged-modal (3), xi 5 %", {"boom.damping": "converged_modal", "boom.xi": 0.05}),
+    ("modal (2), default", {"boom.damping": "modal"}),
 ]
 
 

@@ -78,15 +78,7 @@ pub fn forbidden(op: &Op3, view: &View, m: &Description) -> Option<String> {
         Op3::GetClock { vr, .. } => not_clocks(vr, m),
         Op3::DoStep { t, h, .. } => do_step(*t, *h, view, m),
         Op3::SetTime { t } => set_time(*t, view, m),
-        Op3::GetFloat64 { vr, .. }
-        | Op3::GetInt32 { vr, .. }
-        | Op3::GetBoolean { vr, .. }
-        | Op3::GetString { vr, .. }
-        | Op3::SetFloat64 { vr, .. }
-        | Op3::SetInt32 { vr, .. }
-        | Op3::SetBoolean { vr, .. }
-        | Op3::SetString { vr, .. } => inactive(vr, view, m),
-        _ => None,
+        _ => op.access().and_then(|a| inactive(a.vr, view, m)),
     }
 }
 

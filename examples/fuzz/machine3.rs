@@ -2,7 +2,10 @@
 //! state machines of Co-Simulation (section 4.2.4) and Model Exchange (3.2.4), the variables
 //! fmi3Set* may set in each state (2.3.3 and the `initial`/`causality`/`variability` rules of
 //! 2.4.7), and the calls whose arguments cannot be right (unknown value references, a variable
-//! of another type, nValues other than the number of scalars, NULL with elements announced).
+//! of another type, nValues other than the number of scalars, NULL with elements announced, an
+//! Enumeration set to a value that is no item, 2.4.7.4). Enumerations are read and written with
+//! fmi3GetInt64 and fmi3SetInt64 only: fmi3GetInt32 on one is a call on another type, and so is
+//! fmi3GetInt64 on an Int32.
 //! A call forbidden here must return fmi3Error. Where the text leaves room, nothing is claimed.
 //! Issue 25 adds: counts larger than the model allows (`oversized`, in any state), fmi3SetTime
 //! in Continuous-Time Mode only and not before the startTime (`View::set_time_refusal`), and
@@ -11,7 +14,7 @@
 
 use crate::model_description::{Description, Type};
 use crate::ops::Arr;
-use crate::ops3::Op3;
+use crate::ops3::{Access, Op3, OTHER_TYPES};
 use crate::oversized::{too_many_refs, wrong_size};
 use crate::view::{Phase, View};
 
@@ -30,12 +33,6 @@ fn count_error(op: &Op3, me: bool, m: &Description) -> Option<String> {
     let states = |n: usize| if me { wrong_size(n, m.states, "continuous states") } else { None };
     match op {
         Op3::Oversized(o) => Some(o.why(m)),
-        Op3::GetFloat64 { vr, .. } | Op3::GetInt32 { vr, .. } | Op3::GetBoolean { vr, .. } | Op3::GetString { vr, .. } => {
-            too_many_refs(vr.len(), m)
-        }
-        Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. } => {
-            too_many_refs(vr.len(), m)
-        }
         Op3::Derivative { unknowns, knowns, .. } => too_many_refs(unknowns.len(), m).or_else(|| too_many_refs(knowns.len(), m)),
         Op3::SetDebugLogging { categories, .. } => crate::machine2::too_many_categories(categories.len(), m),
         Op3::SetContinuousStates { x } => states(x.len()),
@@ -43,7 +40,7 @@ fn count_error(op: &Op3, me: bool, m: &Description) -> Option<String> {
         | Op3::GetContinuousStates { n, .. }
         | Op3::GetNominalsOfContinuousStates { n, .. } => states(*n),
         Op3::GetEventIndicators { n, .. } if me => wrong_size(*n, m.event_indicators, "event indicators"),
-        _ => None,
+        _ => op.access().and_then(|a| too_many_refs(a.vr.len(), m)),
     }
 }
 
@@ -64,7 +61,11 @@ fn state_error(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Descri
     let state = |allowed: bool| (!allowed).then(|| format!("not allowed in {phase_name}"));
     let me_only = |allowed: bool| if me { state(allowed) } else { Some("a Model Exchange function on a Co-Simulation instance".into()) };
     let cs_only = |allowed: bool| if me { Some("a Co-Simulation function on a Model Exchange instance".into()) } else { state(allowed) };
-    let values = || argument_error(op, m).or_else(|| setter_error(op, phase, m));
+    if let Some(a) = op.access() {
+        let allowed = if a.set { phase != Terminated } else { phase != Instantiated };
+        let values = || argument_error(&a, m).or_else(|| setter_error(&a, phase, m)).or_else(|| item_error(op, m));
+        return state(allowed).or_else(values);
+    }
     match op {
         Op3::EnterInitializationMode(_) => state(phase == Instantiated),
         Op3::ExitInitializationMode => state(phase == Initialization),
@@ -73,15 +74,9 @@ fn state_error(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Descri
         Op3::EnterEventMode if !me => state(phase == StepComplete),
         Op3::EnterEventMode => state(!matches!(phase, Instantiated | Initialization | Terminated)),
         Op3::Terminate => state(matches!(phase, EventMode | ContinuousTime) || step),
-        Op3::GetFloat64 { .. } | Op3::GetInt32 { .. } | Op3::GetBoolean { .. } | Op3::GetString { .. } => {
-            state(phase != Instantiated).or_else(values)
-        }
-        Op3::SetFloat64 { .. } | Op3::SetInt32 { .. } | Op3::SetBoolean { .. } | Op3::SetString { .. } => {
-            state(phase != Terminated).or_else(values)
-        }
         Op3::OtherType { ty, vr, .. } => {
-            let known = vr.len() > 0 && *ty < 8;
-            known.then(|| format!("no variable is a {}", crate::ops3::OTHER_TYPES[*ty]))
+            let known = vr.len() > 0 && !matches!(OTHER_TYPES[*ty], "Binary" | "Clock");
+            known.then(|| format!("no variable is a {}", OTHER_TYPES[*ty]))
         }
         Op3::Refused { .. } => Some("not provided by this FMU (modelDescription.xml)".into()),
         Op3::SetClock { .. } => state(phase != Terminated),
@@ -105,18 +100,7 @@ fn state_error(op: &Op3, view: &View, (me, event_mode): (bool, bool), m: &Descri
 }
 
 /// Get and set arguments that cannot be right in any state.
-fn argument_error(op: &Op3, m: &Description) -> Option<String> {
-    let (vr, n_values, ty) = match op {
-        Op3::GetFloat64 { vr, n_values, .. } => (vr, *n_values, Type::Real),
-        Op3::GetInt32 { vr, n_values, .. } => (vr, *n_values, Type::Integer),
-        Op3::GetBoolean { vr, n_values, .. } => (vr, *n_values, Type::Boolean),
-        Op3::GetString { vr, n_values, .. } => (vr, *n_values, Type::String),
-        Op3::SetFloat64 { vr, values } => (vr, values.len(), Type::Real),
-        Op3::SetInt32 { vr, values } => (vr, values.len(), Type::Integer),
-        Op3::SetBoolean { vr, values } => (vr, values.len(), Type::Boolean),
-        Op3::SetString { vr, values } => (vr, values.len(), Type::String),
-        _ => return None,
-    };
+fn argument_error(&Access { vr, n_values, ty, .. }: &Access, m: &Description) -> Option<String> {
     if n_values != vr.len() {
         return Some(format!("nValues = {n_values} for {} scalar variables", vr.len()));
     }
@@ -134,12 +118,8 @@ fn argument_error(op: &Op3, m: &Description) -> Option<String> {
 /// constants always, but continuous-time states in Continuous-Time Mode (FMI 3.0.2, 3.2.4);
 /// after initialisation fixed parameters; in Continuous-Time Mode all but continuous inputs and
 /// continuous-time states.
-fn setter_error(op: &Op3, phase: Phase, m: &Description) -> Option<String> {
-    let vr = match op {
-        Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. } => vr,
-        _ => return None,
-    };
-    let Arr::Items(refs) = vr else { return None };
+fn setter_error(a: &Access, phase: Phase, m: &Description) -> Option<String> {
+    let (Arr::Items(refs), true) = (a.vr, a.set) else { return None };
     let initialised = !matches!(phase, Phase::Instantiated | Phase::Initialization);
     refs.iter().filter_map(|&r| m.variable(r)).find_map(|v| {
         let calculated = v.initial.as_deref().map_or(matches!(v.causality.as_str(), "output" | "local" | "calculatedParameter"), |i| i == "calculated");
@@ -149,5 +129,15 @@ fn setter_error(op: &Op3, phase: Phase, m: &Description) -> Option<String> {
         let continuous_input = v.causality == "input" && v.variability == "continuous";
         let not_now = phase == Phase::ContinuousTime && !continuous_input && !state;
         (never || fixed || not_now).then(|| format!("{} cannot be set in this state", v.name))
+    })
+}
+
+/// An Enumeration set to a value that is no item of its type: outside its [min, max] (FMI 3.0
+/// 2.4.7.4), such as one beyond the Int32 range or one that only truncates to an item.
+fn item_error(op: &Op3, m: &Description) -> Option<String> {
+    let Op3::SetInt64 { vr: Arr::Items(refs), values: Arr::Items(values) } = op else { return None };
+    refs.iter().zip(values).find_map(|(&r, &x)| {
+        let v = m.variable(r).filter(|v| v.ty == Type::Enumeration && !v.holds(x as f64))?;
+        Some(format!("{} = {x} is no item (outside [{}, {}])", v.name, v.min, v.max))
     })
 }

@@ -10,19 +10,23 @@ use std::collections::{BTreeMap, HashMap};
 use std::os::raw::c_int;
 use std::path::Path;
 
-/// A variable's base type (FMI 3.0: Float64, Int32, Boolean, String).
+/// A variable's base type (FMI 3.0: Float64, Int32, Boolean, String, Enumeration; FMI 2.0 reads
+/// and writes its Enumerations as Integers, 2.2.7, and so has no Enumeration here).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Type {
     Real,
     Integer,
     Boolean,
     String,
+    /// FMI 3.0: read and written with fmi3GetInt64 and fmi3SetInt64 only (2.4.7.4).
+    Enumeration,
 }
 
-/// Every base type, in the order of `Description::by_type`.
-pub const TYPES: [Type; 4] = [Type::Real, Type::Integer, Type::Boolean, Type::String];
+/// Every base type, in the order of `Description::by_type`; FMI 2.0 has the first four.
+pub const TYPES: [Type; 5] = [Type::Real, Type::Integer, Type::Boolean, Type::String, Type::Enumeration];
 
-/// One ScalarVariable. The range is ±Inf (Real) or the C int range (Integer) when not declared.
+/// One ScalarVariable. The range is ±Inf (Real) or the C int range (Integer, Enumeration) when
+/// not declared (these model descriptions declare every Enumeration's).
 pub struct Variable {
     pub name: String,
     pub vr: u32,
@@ -64,7 +68,8 @@ impl Variable {
             .ok_or_else(|| format!("{name}: no valid valueReference"))?;
         let (ty, lo, hi) = match tag {
             "Real" | "Float64" => (Type::Real, f64::NEG_INFINITY, f64::INFINITY),
-            "Integer" | "Enumeration" | "Int32" => (Type::Integer, c_int::MIN as f64, c_int::MAX as f64),
+            "Integer" | "Int32" => (Type::Integer, c_int::MIN as f64, c_int::MAX as f64),
+            "Enumeration" => (Type::Enumeration, c_int::MIN as f64, c_int::MAX as f64),
             "Boolean" => (Type::Boolean, 0.0, 1.0),
             _ => (Type::String, 0.0, 1.0),
         };
@@ -99,6 +104,11 @@ impl Variable {
         }
     }
 
+    /// Whether `x` is inside the range (for an Enumeration: one of its items).
+    pub fn holds(&self, x: f64) -> bool {
+        self.min <= x && x <= self.max
+    }
+
     /// A finite interval to draw values from: the range, or around the start where unbounded.
     pub fn span(&self) -> (f64, f64) {
         let start = self.start.unwrap_or(0.0);
@@ -112,7 +122,7 @@ impl Variable {
     }
 
     /// A value inside the range: mostly the start value or near it, sometimes anywhere in the
-    /// range or at a bound (Integer rounded, Boolean 0 or 1).
+    /// range or at a bound (Integer and Enumeration rounded, Boolean 0 or 1).
     pub fn plausible(&self, rng: &mut Rng) -> f64 {
         if self.ty == Type::Boolean {
             return if rng.chance(0.6) { self.start.unwrap_or(0.0) } else { rng.below(2) as f64 };
@@ -127,7 +137,7 @@ impl Variable {
             _ => hi,
         }
         .clamp(lo, hi);
-        if self.ty == Type::Integer {
+        if matches!(self.ty, Type::Integer | Type::Enumeration) {
             x.round()
         } else {
             x
@@ -179,7 +189,7 @@ pub struct Description {
     pub categories: Vec<String>,
     pub variables: Vec<Variable>,
     /// Value references per type, in the order of `TYPES`.
-    by_type: [Vec<u32>; 4],
+    by_type: [Vec<u32>; 5],
     /// Value references of the Real outputs.
     pub outputs: Vec<u32>,
     /// Value references of the Reals read after every step that succeeded (`step_outputs`):
@@ -266,19 +276,22 @@ impl Description {
                             let section = if tag == "InitialUnknown" { "InitialUnknowns" } else { "Derivatives" };
                             structure.extend(a.get("valueReference").and_then(|s| s.parse().ok()).map(|r| (section.into(), r)));
                         }
-                        tag @ ("Float64" | "Int32" | "Boolean" | "String") if fmi3 => {
+                        tag @ ("Float64" | "Int32" | "Boolean" | "String" | "Enumeration") if fmi3 => {
                             states += usize::from(tag == "Float64" && a.contains_key("derivative"));
                             variables.push(Variable::new(&a, tag, &a)?);
                         }
                         "Clock" if fmi3 && clock.is_none() => clock = Some(Clock::new(&a)?),
                         tag @ ("Float32" | "Int8" | "UInt8" | "Int16" | "UInt16" | "UInt32" | "Int64" | "UInt64"
-                        | "Enumeration" | "Binary" | "Clock")
+                        | "Binary" | "Clock")
                             if fmi3 =>
                         {
-                            return Err(format!("a {tag} variable: the fuzzer knows Float64, Int32, Boolean, String, a Clock"));
+                            let known = "Float64, Int32, Boolean, String, Enumeration, a Clock";
+                            return Err(format!("a {tag} variable: the fuzzer knows {known}"));
                         }
                         tag @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration") => {
                             states += usize::from(tag == "Real" && a.contains_key("derivative"));
+                            // FMI 2.0 reads and writes Enumerations as Integers (2.2.7), in their range.
+                            let tag = if tag == "Enumeration" { "Integer" } else { tag };
                             if let Some(s) = scalar.take() {
                                 variables.push(Variable::new(&s, tag, &a)?);
                             }
@@ -364,6 +377,11 @@ impl Description {
 
     pub fn of_type(&self, ty: Type) -> &[u32] {
         &self.by_type[ty as usize]
+    }
+
+    /// The base types of the version's get and set functions (FMI 2.0: no Enumeration).
+    pub fn types(&self) -> &'static [Type] {
+        &TYPES[..if self.fmi3 { 5 } else { 4 }]
     }
 }
 

@@ -2,6 +2,7 @@
 //! C arrays, strings and FMU state arguments are those of `ops` and `fmu_states`.
 
 use crate::fmu_states::StateCall;
+use crate::model_description::Type;
 use crate::ops::{Arr, Text};
 use crate::planner::Experiment;
 use crate::sequence::Call;
@@ -50,9 +51,10 @@ pub enum Interface3 {
 }
 
 /// The get and set functions of the types no variable of these FMUs has: the function, whether
-/// it sets, and its value references (values are scratch buffers of the call).
-pub const OTHER_TYPES: [&str; 10] =
-    ["Float32", "Int8", "UInt8", "Int16", "UInt16", "UInt32", "Int64", "UInt64", "Binary", "Clock"];
+/// it sets, and its value references (values are scratch buffers of the call). Int64 is not
+/// among them: fmi3GetInt64 and fmi3SetInt64 read and write the Enumerations.
+pub const OTHER_TYPES: [&str; 9] =
+    ["Float32", "Int8", "UInt8", "Int16", "UInt16", "UInt32", "UInt64", "Binary", "Clock"];
 
 /// Functions these FMUs do not provide (modelDescription: no clocks, no structural parameters,
 /// no Scheduled Execution, no per-element dependencies, no evaluateDiscreteStates, output
@@ -91,10 +93,13 @@ pub enum Op3 {
     Reset,
     GetFloat64 { vr: Arr<u32>, n_values: usize, null_values: bool },
     GetInt32 { vr: Arr<u32>, n_values: usize, null_values: bool },
+    /// Of the Enumerations (FMI 3.0 2.4.7.4), as of any other variable.
+    GetInt64 { vr: Arr<u32>, n_values: usize, null_values: bool },
     GetBoolean { vr: Arr<u32>, n_values: usize, null_values: bool },
     GetString { vr: Arr<u32>, n_values: usize, null_values: bool },
     SetFloat64 { vr: Arr<u32>, values: Arr<f64> },
     SetInt32 { vr: Arr<u32>, values: Arr<i32> },
+    SetInt64 { vr: Arr<u32>, values: Arr<i64> },
     /// Bytes, so that values other than 0 and 1 can be passed.
     SetBoolean { vr: Arr<u32>, values: Arr<u8> },
     SetString { vr: Arr<u32>, values: Arr<Text> },
@@ -141,7 +146,33 @@ impl Call for Op3 {
     }
 }
 
+/// A get or set of variable values: its value references, nValues, the base type of the
+/// function (`Type::Enumeration`: Int64) and whether it sets.
+pub struct Access<'a> {
+    pub vr: &'a Arr<u32>,
+    pub n_values: usize,
+    pub ty: Type,
+    pub set: bool,
+}
+
 impl Op3 {
+    /// The fmi3Get<type> and fmi3Set<type> of the types variables have, as an `Access`.
+    pub fn access(&self) -> Option<Access<'_>> {
+        let (vr, n_values, ty, set) = match self {
+            Op3::GetFloat64 { vr, n_values, .. } => (vr, *n_values, Type::Real, false),
+            Op3::GetInt32 { vr, n_values, .. } => (vr, *n_values, Type::Integer, false),
+            Op3::GetInt64 { vr, n_values, .. } => (vr, *n_values, Type::Enumeration, false),
+            Op3::GetBoolean { vr, n_values, .. } => (vr, *n_values, Type::Boolean, false),
+            Op3::GetString { vr, n_values, .. } => (vr, *n_values, Type::String, false),
+            Op3::SetFloat64 { vr, values } => (vr, values.len(), Type::Real, true),
+            Op3::SetInt32 { vr, values } => (vr, values.len(), Type::Integer, true),
+            Op3::SetInt64 { vr, values } => (vr, values.len(), Type::Enumeration, true),
+            Op3::SetBoolean { vr, values } => (vr, values.len(), Type::Boolean, true),
+            Op3::SetString { vr, values } => (vr, values.len(), Type::String, true),
+            _ => return None,
+        };
+        Some(Access { vr, n_values, ty, set })
+    }
 
     /// The call for the trace: the FMI 3.0 name and the arguments.
     pub fn describe(&self) -> String {

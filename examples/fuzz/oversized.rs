@@ -53,7 +53,7 @@ impl Oversized {
     /// Any such call of FMI 2.0 or (`fmi3`) FMI 3.0.
     pub fn draw(rng: &mut Rng, m: &Description, fmi3: bool) -> Self {
         use Counted::*;
-        let ty = *rng.pick(&crate::model_description::TYPES);
+        let ty = *rng.pick(m.types());
         let counted = match rng.below(if fmi3 { 10 } else { 12 }) {
             0..=1 => Get(ty),
             2..=3 => Set(ty),
@@ -76,8 +76,9 @@ impl Oversized {
         let ty = |t: Type| match (t, fmi3) {
             (Type::Real, false) => "Real",
             (Type::Real, true) => "Float64",
-            (Type::Integer, false) => "Integer",
+            (Type::Integer | Type::Enumeration, false) => "Integer",
             (Type::Integer, true) => "Int32",
+            (Type::Enumeration, true) => "Int64",
             (Type::Boolean, _) => "Boolean",
             (Type::String, _) => "String",
         };
@@ -164,11 +165,12 @@ impl Oversized {
         let (v, xp, ip, sp) = (vr.as_ptr(), x.as_mut_ptr(), ints.as_mut_ptr(), strings.as_mut_ptr());
         match self.counted {
             Get(Type::Real) => f.fmi2GetReal(c, v, n, xp),
-            Get(Type::Integer) => f.fmi2GetInteger(c, v, n, ip),
+            // FMI 2.0's Enumerations are Integers (`model_description`): no Enumeration here.
+            Get(Type::Integer | Type::Enumeration) => f.fmi2GetInteger(c, v, n, ip),
             Get(Type::Boolean) => f.fmi2GetBoolean(c, v, n, ip),
             Get(Type::String) => f.fmi2GetString(c, v, n, sp),
             Set(Type::Real) => f.fmi2SetReal(c, v, n, xp),
-            Set(Type::Integer) => f.fmi2SetInteger(c, v, n, ip),
+            Set(Type::Integer | Type::Enumeration) => f.fmi2SetInteger(c, v, n, ip),
             Set(Type::Boolean) => f.fmi2SetBoolean(c, v, n, ip),
             Set(Type::String) => f.fmi2SetString(c, v, n, sp),
             Derivative { known: false, .. } => f.fmi2GetDirectionalDerivative(c, v, n, v, 1, xp, xp),
@@ -196,6 +198,7 @@ impl Oversized {
         use Counted::*;
         let (n, len) = (self.n, self.len());
         let (mut x, mut ints, mut flags, ty) = (vec![0.0f64; len], vec![0i32; len], vec![0u8; len], self.ty());
+        let mut longs = vec![0i64; len];
         let vr = self.refs(m, ty);
         let text = std::ffi::CString::new("fuzz").expect("no NUL");
         let mut strings: Vec<*const c_char> = vec![text.as_ptr(); len];
@@ -204,10 +207,12 @@ impl Oversized {
         match self.counted {
             Get(Type::Real) => f.fmi3GetFloat64(c, v, n, xp, n),
             Get(Type::Integer) => f.fmi3GetInt32(c, v, n, ip, n),
+            Get(Type::Enumeration) => f.fmi3GetInt64(c, v, n, longs.as_mut_ptr(), n),
             Get(Type::Boolean) => f.fmi3GetBoolean(c, v, n, bp.cast(), n),
             Get(Type::String) => f.fmi3GetString(c, v, n, sp, n),
             Set(Type::Real) => f.fmi3SetFloat64(c, v, n, xp, n),
             Set(Type::Integer) => f.fmi3SetInt32(c, v, n, ip, n),
+            Set(Type::Enumeration) => f.fmi3SetInt64(c, v, n, longs.as_ptr(), n),
             Set(Type::Boolean) => f.fmi3SetBoolean(c, v, n, bp.cast(), n),
             Set(Type::String) => f.fmi3SetString(c, v, n, sp, n),
             Derivative { adjoint, known } => {

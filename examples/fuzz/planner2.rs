@@ -136,7 +136,8 @@ impl Planned for Op {
         let ints = |f: fn(f64) -> c_int| Arr::Items(values.iter().map(|&x| f(x)).collect());
         Some(match ty {
             Type::Real => Op::SetReal { vr, values: Arr::Items(values.clone()) },
-            Type::Integer => Op::SetInteger { vr, values: ints(|x| x as c_int) },
+            // FMI 2.0's Enumerations are Integers (`model_description`): no Enumeration here.
+            Type::Integer | Type::Enumeration => Op::SetInteger { vr, values: ints(|x| x as c_int) },
             Type::Boolean => Op::SetBoolean { vr, values: ints(|x| c_int::from(x != 0.0)) },
             Type::String => {
                 Op::SetString { vr, values: Arr::Items(values.iter().map(|_| Text::new("fuzz")).collect()) }

@@ -55,7 +55,7 @@ impl Phases<Session3<'_>, Op3> for Planner<Op3> {
             45..=62 => Op3::set(rng, m, &m.step_settable).unwrap_or_else(|| Op3::get_reals(rng, m)),
             63..=80 => Op3::get_reals(rng, m),
             81..=84 => {
-                let ty = *rng.pick(&[Type::Integer, Type::Boolean, Type::String]);
+                let ty = *rng.pick(&[Type::Integer, Type::Boolean, Type::String, Type::Enumeration]);
                 get_all(m, ty)
             }
             85..=89 => state_op(rng, s),
@@ -124,7 +124,7 @@ impl Planned for Op3 {
         }
     }
 
-    /// fmi3Set<type>.
+    /// fmi3Set<type> (fmi3SetInt64 for Enumerations).
     fn set(rng: &mut Rng, m: &Description, candidates: &[usize]) -> Option<Op3> {
         let (ty, vr, values) = plausible_values(rng, m, candidates)?;
         let vr = Arr::Items(vr);
@@ -132,6 +132,7 @@ impl Planned for Op3 {
         Some(match ty {
             Type::Real => Op3::SetFloat64 { vr, values: Arr::Items(values) },
             Type::Integer => Op3::SetInt32 { vr, values: Arr::Items(values.iter().map(|&x| x as i32).collect()) },
+            Type::Enumeration => Op3::SetInt64 { vr, values: Arr::Items(values.iter().map(|&x| x as i64).collect()) },
             Type::Boolean => Op3::SetBoolean { vr, values: Arr::Items(bytes(values)) },
             Type::String => {
                 Op3::SetString { vr, values: Arr::Items(values.iter().map(|_| Text::new("fuzz")).collect()) }
@@ -194,6 +195,7 @@ fn get_all(m: &Description, ty: Type) -> Op3 {
     let vr = Arr::Items(vr);
     match ty {
         Type::Integer => Op3::GetInt32 { vr, n_values, null_values: false },
+        Type::Enumeration => Op3::GetInt64 { vr, n_values, null_values: false },
         Type::Boolean => Op3::GetBoolean { vr, n_values, null_values: false },
         Type::String => Op3::GetString { vr, n_values, null_values: false },
         Type::Real => Op3::GetFloat64 { vr, n_values, null_values: false },

@@ -11,8 +11,9 @@
 //! - an instantiation with the model description's token and valid arguments returns an
 //!   instance, one with a wrong token NULL; fmi3InstantiateScheduledExecution returns NULL;
 //! - after fmi3OK or fmi3Warning: Float64 outputs of every function finite (nominals positive,
-//!   too), fmi3Boolean outputs 0 or 1, strings non-NULL, the numbers of continuous states and
-//!   event indicators those of the XML; fmi3DoStep without early return or event handling and
+//!   too), fmi3Boolean outputs 0 or 1, fmi3GetInt64's values items of their Enumerations
+//!   (inside [min, max]), strings non-NULL, the numbers of continuous states and event
+//!   indicators those of the XML; fmi3DoStep without early return or event handling and
 //!   with lastSuccessfulTime = currentCommunicationPoint + communicationStepSize (Discard: in
 //!   [currentCommunicationPoint, + communicationStepSize]); a Discard leaves the instance as it
 //!   was (Step Mode, the same time) and a retry with a smaller step from that time is no error;
@@ -54,6 +55,8 @@ enum Output {
     Text(*const c_char),
     Instance(Instance),
     Reals(Vec<f64>),
+    /// fmi3GetInt64's values.
+    Int64s(Vec<i64>),
     /// fmi3Boolean outputs, as bytes.
     Flags(Vec<u8>),
     Strings(Vec<*const c_char>),
@@ -217,6 +220,11 @@ impl<'a> Session3<'a> {
                 let mut v = vec![0; *n_values];
                 status(f.fmi3GetInt32(c, vr.ptr(), vr.len(), out(&mut v, *null_values), *n_values))
             }
+            Op3::GetInt64 { vr, n_values, null_values } => {
+                let mut v = vec![0; *n_values];
+                let s = f.fmi3GetInt64(c, vr.ptr(), vr.len(), out(&mut v, *null_values), *n_values);
+                (Some(s), Output::Int64s(if *null_values { Vec::new() } else { v }))
+            }
             Op3::GetBoolean { vr, n_values, null_values } => {
                 let mut v = vec![0u8; *n_values];
                 let s = f.fmi3GetBoolean(c, vr.ptr(), vr.len(), out(&mut v, *null_values).cast(), *n_values);
@@ -229,6 +237,7 @@ impl<'a> Session3<'a> {
             }
             Op3::SetFloat64 { vr, values } => status(f.fmi3SetFloat64(c, vr.ptr(), vr.len(), values.ptr(), values.len())),
             Op3::SetInt32 { vr, values } => status(f.fmi3SetInt32(c, vr.ptr(), vr.len(), values.ptr(), values.len())),
+            Op3::SetInt64 { vr, values } => status(f.fmi3SetInt64(c, vr.ptr(), vr.len(), values.ptr(), values.len())),
             Op3::SetBoolean { vr, values } => {
                 status(f.fmi3SetBoolean(c, vr.ptr(), vr.len(), values.ptr().cast(), values.len()))
             }
@@ -306,9 +315,7 @@ impl<'a> Session3<'a> {
                 self.view.phase = Phase::Broken
             }
             (_, _) if !ok => {}
-            (Op3::SetFloat64 { vr, .. } | Op3::SetInt32 { vr, .. } | Op3::SetBoolean { vr, .. } | Op3::SetString { vr, .. }, _)
-                if required::tunes(&vr, self.model) =>
-            {
+            (op, _) if op.access().is_some_and(|a| a.set && required::tunes(a.vr, self.model)) => {
                 self.view.tuned = true
             }
             (Op3::SetDebugLogging { logging_on, categories }, _) => self.debug_logging(logging_on, &categories),
@@ -342,6 +349,12 @@ impl<'a> Session3<'a> {
                 }
             }
             (op, Output::Reals(v)) => finite(&v, &op.describe())?,
+            (Op3::GetInt64 { vr, .. }, Output::Int64s(v)) => {
+                let no_item = |(r, x): (&u32, &i64)| self.model.variable(*r).is_some_and(|e| !e.holds(*x as f64));
+                if let Some((r, x)) = vr.items().iter().zip(&v).find(|&p| no_item(p)) {
+                    return Err(format!("fmi3GetInt64 returned fmi3OK with vr {r} = {x}, outside its range (no item)"));
+                }
+            }
             (op, Output::Flags(v)) if v.iter().any(|&b| b > 1) => {
                 return Err(format!("{} returned an fmi3Boolean {v:?}, not false (0) or true (1)", op.describe()));
             }

@@ -11,7 +11,7 @@ use crate::callbacks::Callbacks;
 use crate::fmi2::{CO_SIMULATION, MODEL_EXCHANGE};
 use crate::fmu_states::{FmuState, FmuStates, StateCall};
 use crate::view::View;
-use crate::model_description::{Description, Type, Variable, TYPES};
+use crate::model_description::{Description, Type, Variable};
 use crate::ops::{Arr, Blob, Instantiation, Op, Slot, Text};
 use crate::oversized::Oversized;
 use crate::planner::Experiment;
@@ -64,7 +64,7 @@ pub fn wild(rng: &mut Rng, s: &Session) -> Op {
         11 => Op::GetBoolean { vr: vrs(rng, m, Type::Boolean), null_values: rng.chance(0.05) },
         12 => Op::GetString { vr: vrs(rng, m, Type::String), null_values: rng.chance(0.05) },
         13..=16 => {
-            let ty = *rng.pick(&TYPES);
+            let ty = *rng.pick(m.types());
             wild_set(rng, m, ty)
         }
         17..=22 => Op::State(wild_state_call(rng, &s.states)),
@@ -278,7 +278,8 @@ fn wild_set(rng: &mut Rng, m: &Description, ty: Type) -> Op {
     let vars = variables_of(m, &vr);
     match ty {
         Type::Real => Op::SetReal { values: wild_values(rng, &vars, wild_real), vr },
-        Type::Integer => Op::SetInteger { values: wild_values(rng, &vars, wild_integer), vr },
+        // FMI 2.0's Enumerations are Integers (`model_description`): no Enumeration here.
+        Type::Integer | Type::Enumeration => Op::SetInteger { values: wild_values(rng, &vars, wild_integer), vr },
         Type::Boolean => Op::SetBoolean { values: array(rng, vars.len(), wild_boolean), vr },
         Type::String => Op::SetString { values: array(rng, vars.len(), |r| wild_text(r, m)), vr },
     }

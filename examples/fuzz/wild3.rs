@@ -1,12 +1,13 @@
 //! FMI 3.0 calls an importer can get wrong: the value generators of `wild` (unknown value
 //! references, wrong types, out-of-range values, NaN, ±Inf, NULL arrays, freed and foreign FMU
 //! states, damaged serialized states, any step) through the FMI 3.0 functions, plus nValues that
-//! differ from the number of value references, fmi3Boolean bytes other than 0 and 1, the types
-//! no variable has, the functions the FMUs do not provide, any function in any state, and
-//! instantiations with a wrong token, name, eventModeUsed or intermediate variables; counts far
-//! larger than the arrays (`oversized`); a Clock set or read with any values and references.
+//! differ from the number of value references, fmi3Boolean bytes other than 0 and 1, Int64
+//! values of Enumerations that are no item (beyond the Int32 range, too), the types no variable
+//! has, the functions the FMUs do not provide, any function in any state, and instantiations
+//! with a wrong token, name, eventModeUsed or intermediate variables; counts far larger than the
+//! arrays (`oversized`); a Clock set or read with any values and references.
 
-use crate::model_description::{Description, Type, Variable, TYPES};
+use crate::model_description::{Description, Type, Variable};
 use crate::ops::{Arr, Text};
 use crate::ops3::{Instantiation3, Interface3, Op3, OTHER_TYPES, REFUSED};
 use crate::oversized::Oversized;
@@ -32,13 +33,14 @@ pub fn wild3(rng: &mut Rng, s: &Session3) -> Op3 {
         6 => Op3::Terminate,
         7 => Op3::Reset,
         8..=11 => {
-            let (ty, of) = (*rng.pick(&TYPES), *rng.pick(&TYPES));
+            let (ty, of) = (*rng.pick(m.types()), *rng.pick(m.types()));
             let vr = vrs(rng, m, of);
             let n_values = n_values(rng, vr.len());
             let null_values = rng.chance(0.05);
             match ty {
                 Type::Real => Op3::GetFloat64 { vr, n_values, null_values },
                 Type::Integer => Op3::GetInt32 { vr, n_values, null_values },
+                Type::Enumeration => Op3::GetInt64 { vr, n_values, null_values },
                 Type::Boolean => Op3::GetBoolean { vr, n_values, null_values },
                 Type::String => Op3::GetString { vr, n_values, null_values },
             }
@@ -117,7 +119,7 @@ fn n_values(rng: &mut Rng, n: usize) -> usize {
 
 /// fmi3Set<type> of any type with any value references, values and nValues.
 fn wild_set3(rng: &mut Rng, m: &Description) -> Op3 {
-    let ty = *rng.pick(&TYPES);
+    let ty = *rng.pick(m.types());
     let refs = (0..rng.range(0, 4)).map(|_| any_vr(rng, m, ty)).collect();
     let vr = maybe_null(rng, refs);
     let n = n_values(rng, vr.len());
@@ -126,8 +128,21 @@ fn wild_set3(rng: &mut Rng, m: &Description) -> Op3 {
     match ty {
         Type::Real => Op3::SetFloat64 { values: wild_values(rng, &vars, wild_real), vr },
         Type::Integer => Op3::SetInt32 { values: wild_values(rng, &vars, wild_integer), vr },
+        Type::Enumeration => Op3::SetInt64 { values: wild_values(rng, &vars, wild_int64), vr },
         Type::Boolean => Op3::SetBoolean { values: array(rng, n, |r| *r.pick(&[0, 1, 0, 1, 2, 255])), vr },
         Type::String => Op3::SetString { values: array(rng, n, |r| wild_text(r, m)), vr },
+    }
+}
+
+/// Any Int64: those of `wild_integer`, an item (for an Enumeration) or its range's bound ± 1, an
+/// item ± 2^32 or 2^31 (beyond the Int32 range; truncated, an item again), or the Int64 extremes.
+fn wild_int64(rng: &mut Rng, var: Option<&Variable>) -> i64 {
+    match (rng.below(6), var) {
+        (0..=1, _) => i64::from(wild_integer(rng, var)),
+        (2, Some(v)) => v.plausible(rng) as i64,
+        (3, Some(v)) => *rng.pick(&[(v.min as i64).saturating_sub(1), (v.max as i64).saturating_add(1)]),
+        (4, Some(v)) => (v.plausible(rng) as i64).wrapping_add(*rng.pick(&[1 << 32, -(1 << 32), 1 << 31])),
+        _ => *rng.pick(&[i64::MAX, i64::MIN, i64::from(i32::MAX) + 1, i64::from(i32::MIN) - 1]),
     }
 }
 

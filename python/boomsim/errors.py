@@ -25,9 +25,15 @@ def cli(main) -> int:
 
 
 def parse_params(ap, pairs: list[str]) -> dict:
-    """The FMU parameters of a command's repeatable `--param NAME=VALUE` as {name: float}; a pair
-    that is not one ends the command through `ap.error` with one line."""
+    """The FMU parameters of a command's repeatable `--param NAME=VALUE` as {name: number, or
+    the name of an Enumeration's item}; a pair that is not one ends the command through
+    `ap.error` with one line."""
+    def value(text: str):
+        try:
+            return float(text)
+        except ValueError:
+            return text
     try:
-        return {k: float(v) for k, v in (p.split("=", 1) for p in pairs)}
+        return {k: value(v) for k, v in (p.split("=", 1) for p in pairs)}
     except ValueError:
-        ap.error(f"--param {' '.join(pairs)}: expected NAME=VALUE with a number")
+        ap.error(f"--param {' '.join(pairs)}: expected NAME=VALUE")

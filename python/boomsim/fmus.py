@@ -152,13 +152,17 @@ class FmuFile:
         return self._instance("ModelExchange", name)
 
     def set(self, slave, name: str, value):
+        """Sets variable `name` of instance `slave`; an Enumeration's by its item's name or value
+        (FMI 3.0 writes Enumerations with fmi3SetInt64)."""
         v = self.vars[name]
         if v.type in ("Real", "Float64"):
             slave.setReal([v.valueReference], [float(value)])
         elif v.type == "Boolean":
             slave.setBoolean([v.valueReference], [bool(value)])
-        elif v.type in ("Integer", "Int32", "Enumeration"):
+        elif v.type in ("Integer", "Int32"):
             slave.setInteger([v.valueReference], [int(value)])
+        elif v.type == "Enumeration":
+            (slave.setInt64 if self.fmi == 3 else slave.setInteger)([v.valueReference], [item_value(name, v, value)])
         else:
             raise TypeError(f"{name}: unsupported type {v.type}")
 
@@ -329,11 +333,23 @@ def initialize_plant(plant_f: FmuFile, plant, ctrl, scenario: dict, switch, tole
     plant.exitInitializationMode()
 
 
+def item_value(name: str, v, value) -> int:
+    """The value of the item `value` (its name, or its value) of Enumeration variable `v`, or a
+    UsageError naming the parameter, the value and the items."""
+    items = {i.name: int(i.value) for i in v.declaredType.items}
+    if isinstance(value, str) and value in items:
+        return items[value]
+    if not isinstance(value, (bool, str)) and value in items.values():
+        return int(value)
+    listed = ", ".join(f"{n!r} ({k})" for n, k in items.items())
+    raise UsageError(f"params[{name!r}] = {value!r} is no item of {v.declaredType.name}: {listed}")
+
+
 def check_params(params: dict, *files: FmuFile) -> None:
     """Every entry of `params` is a parameter of one of the FMUs `files` with a value its
     modelDescription allows (a number within [min, max]; a whole number for an Integer, true or
-    false for a Boolean), or a UsageError naming the parameter, the value and what is allowed,
-    before any instance exists."""
+    false for a Boolean, an item's name or value for an Enumeration), or a UsageError naming the
+    parameter, the value and what is allowed, before any instance exists."""
     for name, value in params.items():
         v = next((f.vars[name] for f in files if name in f.vars), None)
         if v is None or v.causality not in ("parameter", "structuralParameter"):
@@ -344,13 +360,16 @@ def check_params(params: dict, *files: FmuFile) -> None:
             if value not in (True, False, 0, 1):
                 raise UsageError(f"params[{name!r}] = {value!r}: true or false")
             continue
+        if v.type == "Enumeration":
+            item_value(name, v, value)
+            continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise UsageError(f"params[{name!r}] = {value!r}: a finite number")
         lo, hi = (float(b) if b is not None else None for b in (v.min, v.max))
         if (lo is not None and value < lo) or (hi is not None and value > hi):
             raise UsageError(f"params[{name!r}] = {value!r} is outside its valid range [{v.min}, {v.max}]"
                              + (f" {v.unit}" if getattr(v, "unit", None) not in (None, "", "1") else ""))
-        if v.type in ("Integer", "Int32", "Enumeration") and value != int(value):
+        if v.type in ("Integer", "Int32") and value != int(value):
             raise UsageError(f"params[{name!r}] = {value!r}: a whole number")
 
 

@@ -106,7 +106,7 @@ def variants(only=None):
 #: The flexible arm's damping laws the regression keeps baselines for (issue 48): the default
 #: (modal) and the thesis' per-section law (eq. 2.36-2.38), whose variants are named
 #: <id>-flexible-thesis[-cbv].
-LAWS = {"": {}, "-thesis": {"boom.damping": 0}}
+LAWS = {"": {}, "-thesis": {"boom.damping": "thesis"}}
 
 
 def runs(only=None):

@@ -37,7 +37,7 @@ import numpy as np
 
 from . import cosim
 from .errors import UsageError, cli
-from .fmus import FmuFile
+from .fmus import FmuFile, item_value
 from .paths import OUT
 from .result import Result
 from .scenarios import load_scenario
@@ -59,7 +59,8 @@ for _r in RECORD.values():
 PARAMETER_SET = "scenario"
 NAMES = {"monolithic": "BoomSystem", "split": "BoomSystemSplit"}
 #: SSP 1.0 type of an FMI variable type (SystemStructureParameterValues.xsd has Real, Integer,
-#: Boolean, String, Enumeration, Binary: FMI 3.0's Float64 and Int32 are Real and Integer there).
+#: Boolean, String, Enumeration, Binary: FMI 3.0's Float64 and Int32 are Real and Integer there;
+#: an Enumeration's value is its item's name).
 SSP_TYPE = {"Float64": "Real", "Int32": "Integer"}
 
 
@@ -128,6 +129,17 @@ def start_force(mech: dict, fmi: int = 2) -> float:
     return value
 
 
+def ssv_text(var, ty: str, v) -> str:
+    """The value `v` of FMU variable `var` as the text of its SSV element of type `ty`: an
+    Enumeration's item by its name."""
+    if ty == "Boolean":
+        return str(v).lower()
+    if ty == "Enumeration":
+        value = item_value(var.name, var, v)
+        return next(i.name for i in var.declaredType.items if int(i.value) == value)
+    return repr(int(v) if ty == "Integer" else float(v))
+
+
 def ssd(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> str:
     """SystemStructure.ssd of `system` for scenario `sc` with the FMI `fmi` .fmu files."""
     comps, conns = components(system, sc, boom, coupling, fmi)
@@ -153,7 +165,7 @@ def ssd(system: str, sc: dict, boom: str, coupling: str, fmi: int = 2) -> str:
                   f'              <ssv:ParameterSet version="1.0" name="{PARAMETER_SET}">', "                <ssv:Parameters>"]
         for k, v in params.items():
             ty = SSP_TYPE.get(md.vars[k].type, md.vars[k].type)
-            text = str(v).lower() if ty == "Boolean" else repr(int(v) if ty == "Integer" else float(v))
+            text = ssv_text(md.vars[k], ty, v)
             lines.append(f"                  <ssv:Parameter name={quoteattr(k)}><ssv:{ty} value=\"{text}\"/></ssv:Parameter>")
         lines += ["                </ssv:Parameters>", "              </ssv:ParameterSet>", "            </ssd:ParameterValues>",
                   "          </ssd:ParameterBinding>", "        </ssd:ParameterBindings>", "      </ssd:Component>"]
@@ -209,13 +221,20 @@ def run_fmpy(path, system: str, stop: float, step: float) -> dict:
     apply its parameter bindings, so they go in as its `parameter_set` (names <component>.<var>,
     Booleans as 0/1)."""
     from fmpy.ssp.simulation import simulate_ssp
-    from fmpy.ssp.ssd import Parameter, ParameterSet
+    from fmpy.ssp.ssd import Parameter, ParameterSet, read_ssd
 
-    # its set_value writes a Boolean as `value != 0.0`, so a literal "false" would set true
-    def number(v):
+    sources = {c.name: pathlib.Path(c.source).stem for c in read_ssd(str(path)).system.elements}
+
+    # its set_value writes a Boolean as `value != 0.0`, so a literal "false" would set true, and
+    # an Enumeration as int(value), so an item's name goes in as its value
+    def number(c, k, v):
+        var = FmuFile.get(sources[c]).vars[k]
+        if var.type == "Enumeration":
+            return item_value(k, var, v)
         return {"true": 1.0, "false": 0.0}.get(str(v).lower(), v)
 
-    params = [Parameter(name=f"{c}.{k}", value=number(v)) for c, kv in bindings(path).items() for k, v in kv.items()]
+    params = [Parameter(name=f"{c}.{k}", value=number(c, k, v))
+              for c, kv in bindings(path).items() for k, v in kv.items()]
     r = simulate_ssp(str(path), stop_time=stop, step_size=step, parameter_set=ParameterSet(parameters=params))
     # each row holds the outputs after the step that starts at its time
     data = {"time": r["time"] + step}

@@ -62,7 +62,7 @@ fn probe<M: Model>(setup: &[(u32, Value)], steps: usize, deps: &mut Deps) {
         }
         let before = unknowns(&mut i);
         let Value::Real(x) = *i.core.values.at(i.core.values.position(input.vr).unwrap()) else { unreachable!() };
-        i.set(&[input.vr], vec![Value::Real(perturbed(input.kind, x))]).unwrap();
+        i.set(&[input.vr], BaseType::Real, vec![Value::Real(perturbed(input.kind, x))]).unwrap();
         for ((name, a), (_, b)) in before.iter().zip(unknowns(&mut i)) {
             if (a - b).abs() > 1e-12 * a.abs().max(b.abs()).max(1e-300) {
                 deps.entry(name).or_default().insert(input.name);

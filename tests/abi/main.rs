@@ -4,6 +4,7 @@
 mod common;
 mod clocks;
 mod dependencies;
+mod enumerations;
 mod early_return;
 mod directional_derivatives;
 mod fmi2_api;

@@ -232,7 +232,7 @@ pub fn in_initialization<M: Model>(setup: &[(u32, boomsim::fmu::Value)]) -> boom
     i.setup_experiment(None, 0.0, None).unwrap();
     i.enter_initialization_mode();
     for (r, x) in setup {
-        i.set(&[*r], vec![x.clone()]).unwrap();
+        i.set(&[*r], x.base_type(), vec![x.clone()]).unwrap();
     }
     i
 }

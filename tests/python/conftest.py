@@ -106,11 +106,15 @@ class Fmu:
         self.dir = extract(self.path, unzipdir=str(tmp_path_factory.mktemp(identifier)))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.type = {v.name: v.type for v in self.md.modelVariables}
+        #: The items of each Enumeration by name: {variable: {item: value}}.
+        self.items = {v.name: {i.name: int(i.value) for i in v.declaredType.items}
+                      for v in self.md.modelVariables if v.type == "Enumeration"}
 
     def slave(self, name="instance", guid=None, tolerance=None, **start):
         """An instantiated slave, set up (with the relative tolerance `tolerance`, None: the
         FMU's default) and initialised with the given start values (unless guid is given: then
-        only instantiated). Structured names go in as **{"start.x": 0.3}."""
+        only instantiated). Structured names go in as **{"start.x": 0.3}, an Enumeration's value
+        by its item's name (fmi2SetInteger of its value, FMI 2.0, 2.2.7)."""
         rec = Recorder()
         s = FMU2Slave(guid=guid or self.md.guid, unzipDirectory=self.dir,
                       modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
@@ -120,6 +124,9 @@ class Fmu:
             s.setupExperiment(tolerance=tolerance, startTime=0.0)
             s.enterInitializationMode()
             for k, v in start.items():
+                if k in self.items:
+                    s.setInteger([self.vr[k]], [self.items[k][v]])
+                    continue
                 setter = {"Real": s.setReal, "Integer": s.setInteger, "Boolean": s.setBoolean}[self.type[k]]
                 setter([self.vr[k]], [v])
             s.exitInitializationMode()

@@ -240,6 +240,28 @@ def test_inline_parameter_sets_validate_against_the_ssv_schema(ssp_files, tmp_pa
 
 
 
+
+def test_an_enumeration_is_bound_by_its_items_name(tmp_path):
+    """SSP 1.0's ssv:Enumeration carries the item's name (SystemStructureParameterValues.xsd):
+    the plant's friction law set by its value (1) or its name is written as "ottestad", and the
+    parameter set validates against the schema."""
+    import zipfile
+
+    import fmpy
+    from lxml import etree
+
+    xsd = pathlib.Path(fmpy.__file__).parent / "ssp" / "schema" / "SystemStructureParameterValues.xsd"
+    schema = etree.XMLSchema(etree.parse(str(xsd)))
+    for law in (1, "ottestad"):
+        sc = load_scenario("U")
+        sc["plant"] = {**sc["plant"], "friction.model": law}
+        path = ssp.write("monolithic", sc, "rigid", "tlm", tmp_path / str(law))
+        root = etree.fromstring(zipfile.ZipFile(path).read("SystemStructure.ssd"))
+        bound = root.find(f".//{{{ssp.SSV}}}Parameter[@name='friction.model']/{{{ssp.SSV}}}Enumeration")
+        assert bound is not None and bound.get("value") == "ottestad"
+        assert all(schema.validate(s) for s in root.findall(f".//{{{ssp.SSV}}}ParameterSet")), schema.error_log
+
+
 @pytest.mark.parametrize("tool", list(ssp.IMPORTERS))
 def test_ssp_with_fmi3_fmus(ssp_files, tmp_path, tool):
     """Both SSPs of U and B with the FMI 3.0 .fmu files (`ssp.py --fmi 3`). An importer that reads

@@ -62,8 +62,8 @@ def test_free_vibration_matches_the_lowest_linearised_mode(boom, eigen):
 
 
 def test_structural_damping_decays_as_the_linearised_mode(boom):
-    """`boom.damping = 1` (the arm's Rayleigh damping, xi at its first bending mode) in the
-    nonlinear FMU against the linearisation of `boomsim eigen --set boom.damping=1`: after the
+    """`boom.damping = structural` (the arm's Rayleigh damping, xi at its first bending mode) in
+    the nonlinear FMU against the linearisation of `boomsim eigen --set boom.damping=structural`: after the
     pulse of the test above, the envelope of p3's oscillation decays as exp(-zeta omega_n t) with
     the lowest mode's zeta (0.8 %, against 0.01 % under the thesis' per-section law). The decay
     rate is a line fitted to the log of one peak per period over 8 s (some 20 periods, to e^-1
@@ -72,11 +72,11 @@ def test_structural_damping_decays_as_the_linearised_mode(boom):
     above), which moves the mode towards the arm, whose damping it carries; 20 % covers that and
     still tells the two laws apart by a factor of 60."""
     out = subprocess.run([str(ROOT / "target" / "release" / "boomsim"), "eigen", "--json", "--set",
-                          "boom.damping=1"], capture_output=True, text=True, check=True)
+                          "boom.damping=structural"], capture_output=True, text=True, check=True)
     linear = json.loads(out.stdout)
     mode = linear["modes"][0]
     start = {"start.x": linear["stroke_mm"] / 1e3, "friction.c_p_bak": 0.0, "friction.p_static": 0.0,
-             "boom.damping": 1}
+             "boom.damping": "structural"}
     t, p3 = run(boom, lambda t: 0.03 if t < 0.6 else 0.0, 10.0, **start)
     window = t > 2.0
     t, y = t[window], p3[window] - p3[window].mean()
@@ -104,7 +104,7 @@ def test_flexible_boom_lowers_the_oscillation_frequency(boom, eigen):
 
 
 def test_the_modal_law_makes_the_feedback_independent_of_the_lumping():
-    """Why the modal damping law (`boom.damping` = 2) is the default: scenario B with the
+    """Why the modal damping law (`boom.damping` = modal) is the default: scenario B with the
     feedback started at the CBV's opening, u_comp_rms (the regression metric the law moves most),
     with the arm in 4 + 5 and in 8 + 10 sections. Under the modal law the two agree within 5 %
     (a converged lumping: at 4 + 5 the first bending frequency is within 1.4 % of 16 + 16
@@ -120,7 +120,7 @@ def test_the_modal_law_makes_the_feedback_independent_of_the_lumping():
         run = cosim.run(load_scenario("B"), "flexible", feedback_start="cbv_open", params=params)
         return metrics.compute(run)["u_comp_rms"]
 
-    modal = u_comp_rms(2, 4, 5), u_comp_rms(2, 8, 10)
-    thesis = u_comp_rms(0, 4, 5), u_comp_rms(0, 8, 10)
+    modal = u_comp_rms("modal", 4, 5), u_comp_rms("modal", 8, 10)
+    thesis = u_comp_rms("thesis", 4, 5), u_comp_rms("thesis", 8, 10)
     assert modal[1] == pytest.approx(modal[0], rel=0.05), modal
     assert thesis[1] > 2 * thesis[0], thesis

@@ -13,7 +13,7 @@ fn boomsim(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn wrong_arguments_get_one_clear_line() {
-    let cases: [(&[&str], &[&str]); 20] = [
+    let cases: [(&[&str], &[&str]); 21] = [
         (&["analyze", "--xc", "-10"], &["x_c = -10 mm is outside the stroke [0, 500] mm"]),
         (&["analyze", "--p4", "-5"], &["p4 = -5 bar must be >= 0"]),
         (&["bench", "--duration", "0"], &["0 is not a positive number of seconds"]),
@@ -25,7 +25,8 @@ fn wrong_arguments_get_one_clear_line() {
         (&["eigen", "--set", "boom.xi=-0.1"], &["boom.xi = -0.1 is outside its valid range [0, 1]"]),
         (&["eigen", "--set", "p3=1"], &["HydraulicBoom has no parameter \"p3\""]),
         (&["eigen", "--set", "boom.n2"], &["expected NAME=VALUE"]),
-        (&["bench", "--set", "boom.damping=4"], &["boom.damping = 4 is outside its valid range [0, 3]"]),
+        (&["bench", "--set", "boom.damping=4"], &["boom.damping = 4 is no item of DampingLaw; valid: 0 (thesis), 1"]),
+        (&["eigen", "--set", "boom.damping=viscous"], &["boom.damping = viscous is no item of DampingLaw", "3 (converged_modal)"]),
         (&["bench", "--set", "boom.damping=1", "--json"], &["does not go with --json"]),
         (&["bench", "--realtime", "--set", "boom.damping=1"], &["does not go with --realtime"]),
         (&["linearize", "--u-ref", "-2"], &["--u-ref -2 is outside [-1, 1]"]),

@@ -35,6 +35,8 @@ fn start_values<M: Model>(values: &Map<String, Json>) -> Result<Vec<(u32, Value)
                 Value::Integer(n.as_f64().map(|x| x as i32).ok_or_else(bad)?) // int() of cosim.FmuFile.set
             }
             (BaseType::Boolean, Json::Bool(b)) => Value::Boolean(*b),
+            (BaseType::Enumeration, Json::String(s)) => Value::Integer(v.item_value(s)?),
+            (BaseType::Enumeration, Json::Number(n)) => Value::Integer(v.item_value(&n.to_string())?),
             _ => return Err(bad()),
         };
         out.push((v.vr, x));

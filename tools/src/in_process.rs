@@ -37,7 +37,7 @@ impl<M: Model> InProcess<M> {
         i.setup_experiment(rtol, t0, stop)?;
         i.enter_initialization_mode();
         for (r, x) in start {
-            i.set(&[*r], vec![x.clone()])?;
+            i.set(&[*r], x.base_type(), vec![x.clone()])?;
         }
         Ok(InProcess(i))
     }
@@ -90,7 +90,7 @@ impl<M: Model> InProcess<M> {
 
 impl<M: Model> Slave for InProcess<M> {
     fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
-        match self.0.set(&[vr], vec![Value::Real(x)])? {
+        match self.0.set(&[vr], BaseType::Real, vec![Value::Real(x)])? {
             Some(why) => Err(why),
             None => Ok(()),
         }

@@ -111,6 +111,10 @@ fn row(v: &Variable) -> String {
             ("Real", shown(start), unit, range)
         }
         Kind::Integer { start, min, max } => ("Integer", start.to_string(), String::new(), format!("[{min}, {max}]")),
+        Kind::Enumeration { start, ty } => {
+            let name = ty.item(i64::from(start)).map_or("", |i| i.name);
+            ("Enumeration", format!("{start} ({name})"), String::new(), ty.listed())
+        }
         Kind::Boolean { start } => ("Boolean", start.to_string(), String::new(), String::new()),
         Kind::String { start } => ("String", start.to_owned(), String::new(), String::new()),
         Kind::Clock { interval, shift } => {

@@ -4,7 +4,7 @@
 //! name and its rule of [`allowed`].
 #![allow(clippy::missing_safety_doc)]
 
-use super::machine::{allowed, Interface, Rule, Mode};
+use super::machine::{allowed, Interface, Mode, Rule};
 use super::types::*;
 use crate::fmu::calls::{self, call, slice, Call};
 use crate::fmu::guid::guid;
@@ -159,15 +159,18 @@ pub unsafe fn get_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, v
 }
 
 pub unsafe fn set_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const f64) -> fmi2Status {
-    calls::set::<M, f64>(c, at("fmi2SetReal", allowed::SET_REAL), vr, n, value, |x| Ok(Value::Real(x)))
+    let f = at("fmi2SetReal", allowed::SET_REAL);
+    calls::set::<M, f64>(c, f, (vr, n, value), BaseType::Real, |x| Ok(Value::Real(x)))
 }
 
 pub unsafe fn set_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
-    calls::set::<M, c_int>(c, at("fmi2SetInteger", allowed::SET_DISCRETE), vr, n, value, |x| Ok(Value::Integer(x)))
+    let f = at("fmi2SetInteger", allowed::SET_DISCRETE);
+    calls::set::<M, c_int>(c, f, (vr, n, value), BaseType::Integer, |x| Ok(Value::Integer(x)))
 }
 
 pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> fmi2Status {
-    calls::set::<M, c_int>(c, at("fmi2SetBoolean", allowed::SET_DISCRETE), vr, n, value, |x| match x {
+    let f = at("fmi2SetBoolean", allowed::SET_DISCRETE);
+    calls::set::<M, c_int>(c, f, (vr, n, value), BaseType::Boolean, |x| match x {
         FMI2_FALSE => Ok(Value::Boolean(false)),
         FMI2_TRUE => Ok(Value::Boolean(true)),
         _ => Err(format!("{x} is not an fmi2Boolean; valid values are fmi2False (0) and fmi2True (1)")),
@@ -175,7 +178,8 @@ pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, 
 }
 
 pub unsafe fn set_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const fmi2String) -> fmi2Status {
-    calls::set::<M, fmi2String>(c, at("fmi2SetString", allowed::SET_DISCRETE), vr, n, value, |p| calls::string_value(p))
+    let f = at("fmi2SetString", allowed::SET_DISCRETE);
+    calls::set::<M, fmi2String>(c, f, (vr, n, value), BaseType::String, |p| calls::string_value(p))
 }
 
 pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {

@@ -4,7 +4,7 @@
 //! [`crate::fmu::calls`], called with the function's FMI 3.0 name and its rule of [`allowed`].
 #![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
 
-use super::machine::{allowed, Interface, Rule, Mode};
+use super::machine::{allowed, Interface, Mode, Rule};
 use super::types::*;
 use crate::fmu::calls::{self, call, slice, slice_mut, Call};
 use crate::fmu::guid::token;
@@ -271,12 +271,13 @@ unsafe fn set<M: Model, T: Copy>(
     c: fmi3Instance,
     f: Call,
     (vr, n, value, n_values): (*const u32, usize, *const T, usize),
+    wanted: BaseType,
     convert: impl Fn(T) -> Result<Value, String>,
 ) -> fmi3Status {
     if let Err(e) = scalar_count(n, n_values) {
         return call::<M>(c, f, |_| Err(e));
     }
-    calls::set::<M, T>(c, f, vr, n, value, convert)
+    calls::set::<M, T>(c, f, (vr, n, value), wanted, convert)
 }
 
 pub unsafe fn get_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut f64, nv: usize) -> fmi3Status {
@@ -285,6 +286,13 @@ pub unsafe fn get_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v
 
 pub unsafe fn get_int32<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut i32, nv: usize) -> fmi3Status {
     get::<M, i32>(c, at("fmi3GetInt32", allowed::GET), (vr, n, v, nv), BaseType::Integer, calls::integer)
+}
+
+/// fmi3GetInt64: the Enumerations (FMI 3.0, 2.4.7.4), the only Int64 variables.
+pub unsafe fn get_int64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut i64, nv: usize) -> fmi3Status {
+    get::<M, i64>(c, at("fmi3GetInt64", allowed::GET), (vr, n, v, nv), BaseType::Enumeration, |v| {
+        i64::from(calls::integer(v))
+    })
 }
 
 pub unsafe fn get_boolean<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *mut bool, nv: usize) -> fmi3Status {
@@ -308,17 +316,26 @@ pub unsafe fn get_string<M: Model>(
 }
 
 pub unsafe fn set_float64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const f64, nv: usize) -> fmi3Status {
-    set::<M, f64>(c, at("fmi3SetFloat64", allowed::SET_FLOAT64), (vr, n, v, nv), |x| Ok(Value::Real(x)))
+    set::<M, f64>(c, at("fmi3SetFloat64", allowed::SET_FLOAT64), (vr, n, v, nv), BaseType::Real, |x| Ok(Value::Real(x)))
 }
 
 pub unsafe fn set_int32<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const i32, nv: usize) -> fmi3Status {
-    set::<M, i32>(c, at("fmi3SetInt32", allowed::SET_DISCRETE), (vr, n, v, nv), |x| Ok(Value::Integer(x)))
+    set::<M, i32>(c, at("fmi3SetInt32", allowed::SET_DISCRETE), (vr, n, v, nv), BaseType::Integer, |x| {
+        Ok(Value::Integer(x))
+    })
+}
+
+/// fmi3SetInt64: the Enumerations. A value beyond the Int32 range is no item of any of them.
+pub unsafe fn set_int64<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const i64, nv: usize) -> fmi3Status {
+    set::<M, i64>(c, at("fmi3SetInt64", allowed::SET_DISCRETE), (vr, n, v, nv), BaseType::Enumeration, |x| {
+        i32::try_from(x).map(Value::Integer).map_err(|_| format!("{x} is no item of an Enumeration (each starts at 0)"))
+    })
 }
 
 /// fmi3SetBoolean: the C `bool`s are read as bytes, so a value other than 0 or 1 is refused
 /// instead of being undefined behaviour.
 pub unsafe fn set_boolean<M: Model>(c: fmi3Instance, vr: *const u32, n: usize, v: *const u8, nv: usize) -> fmi3Status {
-    set::<M, u8>(c, at("fmi3SetBoolean", allowed::SET_DISCRETE), (vr, n, v, nv), |x| {
+    set::<M, u8>(c, at("fmi3SetBoolean", allowed::SET_DISCRETE), (vr, n, v, nv), BaseType::Boolean, |x| {
         c_bool(x, "an fmi3Boolean", ("false", "true")).map(Value::Boolean)
     })
 }
@@ -338,7 +355,8 @@ pub unsafe fn set_string<M: Model>(
     v: *const fmi3String,
     nv: usize,
 ) -> fmi3Status {
-    set::<M, fmi3String>(c, at("fmi3SetString", allowed::SET_DISCRETE), (vr, n, v, nv), |p| calls::string_value(p))
+    let f = at("fmi3SetString", allowed::SET_DISCRETE);
+    set::<M, fmi3String>(c, f, (vr, n, v, nv), BaseType::String, |p| calls::string_value(p))
 }
 
 /// The get and set functions of the types no variable has (Float32, Int8 ... UInt64, Binary,
@@ -394,10 +412,17 @@ pub unsafe fn get_interval_decimal<M: Model>(
     qualifiers: *mut fmi3IntervalQualifier,
 ) -> fmi3Status {
     let f = at("fmi3GetIntervalDecimal", allowed::GET_INTERVAL);
-    clock_timings::<M>(c, f, (vr, n), (intervals, "intervals"), |(interval, _)| interval, |limit| {
-        slice_mut(qualifiers, n, limit, "qualifiers")?.fill(INTERVAL_UNCHANGED);
-        Ok(())
-    })
+    clock_timings::<M>(
+        c,
+        f,
+        (vr, n),
+        (intervals, "intervals"),
+        |(interval, _)| interval,
+        |limit| {
+            slice_mut(qualifiers, n, limit, "qualifiers")?.fill(INTERVAL_UNCHANGED);
+            Ok(())
+        },
+    )
 }
 
 /// A getter of the Clocks' constant timing: `pick` of (interval, shift) for each value reference
@@ -595,7 +620,9 @@ pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi3Instance) -> fmi3Statu
 unsafe fn leave_event_mode<M: Model>(c: fmi3Instance, f: Call, mode: Mode) -> fmi3Status {
     call::<M>(c, f, |inst| {
         if inst.clock_active() {
-            return Err("the Clock is active: end the instant with fmi3UpdateDiscreteStates first (FMI 3.0, 2.3.5)".into());
+            return Err(
+                "the Clock is active: end the instant with fmi3UpdateDiscreteStates first (FMI 3.0, 2.3.5)".into()
+            );
         }
         inst.core.mode = mode;
         Ok(fmi3Status::OK)

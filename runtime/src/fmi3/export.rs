@@ -21,7 +21,6 @@ macro_rules! export_fmi3 {
                 fmi3GetInt16, fmi3SetInt16, i16, "Int16";
                 fmi3GetUInt16, fmi3SetUInt16, u16, "UInt16";
                 fmi3GetUInt32, fmi3SetUInt32, u32, "UInt32";
-                fmi3GetInt64, fmi3SetInt64, i64, "Int64";
                 fmi3GetUInt64, fmi3SetUInt64, u64, "UInt64";
             }
 
@@ -32,6 +31,7 @@ macro_rules! export_fmi3 {
             $crate::__fmi3_values! {
                 fmi3GetFloat64 => get_float64, fmi3SetFloat64 => set_float64: f64, f64;
                 fmi3GetInt32 => get_int32, fmi3SetInt32 => set_int32: i32, i32;
+                fmi3GetInt64 => get_int64, fmi3SetInt64 => set_int64: i64, i64;
                 fmi3GetBoolean => get_boolean, fmi3SetBoolean => set_boolean: bool, u8;
                 fmi3GetString => get_string, fmi3SetString => set_string: fmi3String, fmi3String;
             }

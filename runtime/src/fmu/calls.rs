@@ -6,17 +6,17 @@
 //! failures through the logger with the instance name (ARCHITECTURE.md, principle 4).
 #![allow(clippy::missing_safety_doc)]
 
-use super::snapshot;
 use super::driver::Intermediate;
 use super::instance::{Core, Instance, Master, Step, Warning};
 use super::log::{Logger, Status, GENERIC_CATEGORIES, LOG_FMI_CALLS};
+use super::machine::{describe, Interface, Mode, Rule};
 use super::model::{Log, Model};
-use super::machine::{describe, Interface, Rule, Mode};
+use super::snapshot;
 use super::variables::{BaseType, Value, Values};
 use super::version::Version;
 use std::ffi::{CStr, CString};
-use std::os::raw::{c_char, c_void};
 use std::marker::PhantomData;
+use std::os::raw::{c_char, c_void};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// An instance pointer as both versions pass it (fmi2Component, fmi3Instance).
@@ -328,20 +328,22 @@ pub unsafe fn get_string<M: Model>(c: Handle, f: Call, vr: *const u32, n: usize,
     })
 }
 
-/// Shared body of the setters: `convert` checks and wraps one C value.
+/// Shared body of the setters of variables of type `wanted`: `convert` checks and wraps one C
+/// value.
 pub unsafe fn set<M: Model, T: Copy>(
     c: Handle,
     f: Call,
-    vr: *const u32,
-    n: usize,
-    value: *const T,
+    (vr, n, value): (*const u32, usize, *const T),
+    wanted: BaseType,
     convert: impl Fn(T) -> Result<Value, String>,
 ) -> Status {
     call::<M>(c, f, |inst| {
         let vrs = slice(vr, n, references::<M>(inst.version), "vr")?;
-        let values =
-            slice(value, n, references::<M>(inst.version), "value")?.iter().map(|&x| convert(x)).collect::<Result<Vec<_>, _>>()?;
-        Ok(inst.set(vrs, values)?.map_or(Status::OK, |why| discard(inst, f, &why)))
+        let values = slice(value, n, references::<M>(inst.version), "value")?
+            .iter()
+            .map(|&x| convert(x))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(inst.set(vrs, wanted, values)?.map_or(Status::OK, |why| discard(inst, f, &why)))
     })
 }
 

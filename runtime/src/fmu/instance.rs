@@ -637,7 +637,7 @@ impl<M: Model> Instance<M> {
     /// Looks up a value reference and checks its type.
     fn lookup(&self, vr: u32, wanted: BaseType) -> Result<(usize, &'static Variable), String> {
         let (i, v) = self.variable(vr)?;
-        if v.base_type() != wanted {
+        if self.version.accessed_as(v.base_type()) != wanted {
             return Err(self.type_mismatch(vr, self.version.type_name(wanted)));
         }
         Ok((i, v))
@@ -712,11 +712,11 @@ impl<M: Model> Instance<M> {
     /// Writes values, all or nothing: every value is checked (type, settability, range) before
     /// any is stored. `Some(why)`: continuous states set by their value references are outside
     /// the model's domain ([`Model::outside_domain`]), and nothing is stored (Discard).
-    pub fn set(&mut self, vrs: &[u32], new: Vec<Value>) -> Result<Option<String>, String> {
+    pub fn set(&mut self, vrs: &[u32], wanted: BaseType, new: Vec<Value>) -> Result<Option<String>, String> {
         let mut checked = Vec::with_capacity(vrs.len());
         let mut states: Option<Vec<f64>> = None;
         for (&vr, value) in vrs.iter().zip(new) {
-            let (i, v) = self.lookup(vr, value.base_type())?;
+            let (i, v) = self.lookup(vr, wanted)?;
             self.clocked_access(v)?;
             let state = M::STATES.iter().position(|s| s.state == vr);
             match self.core.mode {
@@ -1247,6 +1247,11 @@ pub fn in_range(v: &Variable, value: &Value) -> Result<(), String> {
         (Kind::Integer { min, max, .. }, Value::Integer(x)) => {
             if *x < min || *x > max {
                 return Err(format!("{} = {x} is outside its valid range [{min}, {max}]", v.name));
+            }
+        }
+        (Kind::Enumeration { ty, .. }, Value::Integer(x)) => {
+            if ty.item(i64::from(*x)).is_none() {
+                return Err(format!("{} = {x} is no item of {}; valid: {}", v.name, ty.name, ty.listed()));
             }
         }
         _ => {}

@@ -1,7 +1,7 @@
 //! The variable table: the one source of truth for get/set, range checks, the GUID and
 //! modelDescription.xml (ARCHITECTURE.md, principle 2).
 
-use crate::params::ParamSpec;
+use crate::params::{Enumeration, ParamSpec};
 
 /// FMI 2.0 causality (section 2.2.7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,14 +34,37 @@ pub enum Initial {
 /// Type, start value and type-specific attributes of a variable.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Kind {
-    Real { start: f64, unit: &'static str, display_unit: &'static str, min: f64, max: f64 },
-    Integer { start: i32, min: i32, max: i32 },
-    Boolean { start: bool },
-    String { start: &'static str },
+    Real {
+        start: f64,
+        unit: &'static str,
+        display_unit: &'static str,
+        min: f64,
+        max: f64,
+    },
+    Integer {
+        start: i32,
+        min: i32,
+        max: i32,
+    },
+    /// One of the items of `ty`, its value the item's index (FMI 2.0, 2.2.3 and 2.2.7: accessed
+    /// with fmi2Get/SetInteger; FMI 3.0, 2.4.7.4: with fmi3Get/SetInt64).
+    Enumeration {
+        start: i32,
+        ty: &'static Enumeration,
+    },
+    Boolean {
+        start: bool,
+    },
+    String {
+        start: &'static str,
+    },
     /// An FMI 3.0 input Clock with a constant interval (`intervalVariability="constant"`,
     /// FMI 3.0, 2.2.8.2): the importer activates it every `interval` seconds from the start time
     /// plus `shift`. Its value is whether it is active.
-    Clock { interval: f64, shift: f64 },
+    Clock {
+        interval: f64,
+        shift: f64,
+    },
 }
 
 /// The FMI base types, for messages and type checks.
@@ -49,6 +72,7 @@ pub enum Kind {
 pub enum BaseType {
     Real,
     Integer,
+    Enumeration,
     Boolean,
     String,
     Clock,
@@ -186,6 +210,18 @@ impl Variable {
         Self::new(name, vr, Causality::Parameter, Variability::Fixed, Initial::Exact, kind, description)
     }
 
+    /// A fixed Enumeration parameter: a choice among the items of `ty`.
+    pub const fn enum_param(
+        name: &'static str,
+        vr: u32,
+        start: i32,
+        ty: &'static Enumeration,
+        description: &'static str,
+    ) -> Self {
+        let kind = Kind::Enumeration { start, ty };
+        Self::new(name, vr, Causality::Parameter, Variability::Fixed, Initial::Exact, kind, description)
+    }
+
     /// An input Clock with a constant interval and shift [s] (FMI 3.0 `<Clock causality="input"
     /// variability="discrete" intervalVariability="constant">`); inactive at the start.
     pub const fn clock(name: &'static str, vr: u32, (interval, shift): (f64, f64), description: &'static str) -> Self {
@@ -237,6 +273,7 @@ impl Variable {
         match self.kind {
             Kind::Real { .. } => BaseType::Real,
             Kind::Integer { .. } => BaseType::Integer,
+            Kind::Enumeration { .. } => BaseType::Enumeration,
             Kind::Boolean { .. } => BaseType::Boolean,
             Kind::String { .. } => BaseType::String,
             Kind::Clock { .. } => BaseType::Clock,
@@ -248,11 +285,22 @@ impl Variable {
         self.initial != Initial::Calculated || self.causality == Causality::Input
     }
 
+    /// For an Enumeration: the value of the item named `text`, or `text` read as the value of an
+    /// item (so a command line takes `thesis` or `0`); otherwise why not, naming the items.
+    pub fn item_value(&self, text: &str) -> Result<i32, String> {
+        let Kind::Enumeration { ty, .. } = self.kind else { return Err(format!("{} is not an Enumeration", self.name)) };
+        let value = ty.value(text).map(|k| k as i64).or_else(|| text.parse().ok());
+        match value.and_then(|x| ty.item(x).map(|_| x as i32)) {
+            Some(x) => Ok(x),
+            None => Err(format!("{} = {text} is no item of {}; valid: {}", self.name, ty.name, ty.listed())),
+        }
+    }
+
     /// The start value as a [`Value`].
     pub fn start_value(&self) -> Value {
         match self.kind {
             Kind::Real { start, .. } => Value::Real(start),
-            Kind::Integer { start, .. } => Value::Integer(start),
+            Kind::Integer { start, .. } | Kind::Enumeration { start, .. } => Value::Integer(start),
             Kind::Boolean { start } => Value::Boolean(start),
             Kind::String { start } => Value::String(start.to_owned()),
             Kind::Clock { .. } => Value::Clock(false),
@@ -272,7 +320,7 @@ pub enum Value {
 }
 
 impl Value {
-    /// The value's base type.
+    /// The type of the FMI 2.0 setter that writes the value (an Enumeration's is Integer).
     pub fn base_type(&self) -> BaseType {
         match self {
             Value::Real(_) => BaseType::Real,
@@ -282,6 +330,20 @@ impl Value {
             Value::Clock(_) => BaseType::Clock,
         }
     }
+}
+
+/// The Enumeration types of a table's variables, each once, in table order (the
+/// TypeDefinitions of modelDescription.xml).
+pub fn enumerations(table: &[Variable]) -> Vec<&'static Enumeration> {
+    let mut types: Vec<&'static Enumeration> = Vec::new();
+    for v in table {
+        if let Kind::Enumeration { ty, .. } = v.kind {
+            if !types.iter().any(|t| t.name == ty.name) {
+                types.push(ty);
+            }
+        }
+    }
+    types
 }
 
 /// The current values of all variables of one instance, in table order.

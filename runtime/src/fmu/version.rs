@@ -39,6 +39,16 @@ impl Version {
         }
     }
 
+    /// The type of the get and set functions that access a variable of type `t`: FMI 2.0 reads
+    /// and writes an Enumeration with fmi2GetInteger and fmi2SetInteger (2.2.7, "fmi2Integer ...
+    /// Enumeration"); FMI 3.0 has fmi3GetInt64 and fmi3SetInt64 for it (2.4.7.4).
+    pub fn accessed_as(self, t: BaseType) -> BaseType {
+        match (self, t) {
+            (Version::Fmi2, BaseType::Enumeration) => BaseType::Integer,
+            _ => t,
+        }
+    }
+
     /// The name of a base type in this version (FMI 3.0: Float64, Int32).
     pub fn type_name(self, t: BaseType) -> &'static str {
         match (self, t) {
@@ -46,6 +56,7 @@ impl Version {
             (Version::Fmi2, BaseType::Integer) => "Integer",
             (Version::Fmi3, BaseType::Real) => "Float64",
             (Version::Fmi3, BaseType::Integer) => "Int32",
+            (_, BaseType::Enumeration) => "Enumeration",
             (_, BaseType::Boolean) => "Boolean",
             (_, BaseType::String) => "String",
             (_, BaseType::Clock) => "Clock",

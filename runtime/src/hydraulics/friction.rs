@@ -6,6 +6,7 @@
 //! a `tanh` of the velocity, so the force is smooth (C1) through `v = 0` and zero at rest.
 
 use super::cylinder::Cylinder;
+use crate::params::{Choice, Enumeration, Item};
 use crate::scalar::{tanh, Scalar};
 
 /// Which friction law [`Friction::force`] uses.
@@ -21,19 +22,20 @@ pub enum FrictionModel {
     Fitted,
 }
 
-impl FrictionModel {
-    /// All models in the order of their index (the value of the parameter `friction.model`).
-    pub const ALL: [FrictionModel; 3] = [FrictionModel::Bak, FrictionModel::Ottestad, FrictionModel::Fitted];
-
-    /// The model with index `i` (0 Bak, 1 Ottestad, 2 fitted), `None` otherwise.
-    pub fn from_index(i: usize) -> Option<Self> {
-        Self::ALL.get(i).copied()
-    }
-
-    /// Index of the model in [`FrictionModel::ALL`].
-    pub fn index(self) -> usize {
-        self as usize
-    }
+impl Choice for FrictionModel {
+    const ENUMERATION: &'static Enumeration = &Enumeration {
+        name: "FrictionModel",
+        description: "Cylinder friction law (section 2.2.3, 5.1.2)",
+        items: &[
+            Item { name: "bak", description: "Bak, eq. 2.65-2.67, the thesis' simulation model (5.2)" },
+            Item {
+                name: "ottestad",
+                description: "Ottestad et al., eq. 2.63-2.64: Coulomb, Stribeck, viscous, pressure",
+            },
+            Item { name: "fitted", description: "The thesis' fit to the rig, eq. 5.4 and Table 5.3" },
+        ],
+    };
+    const ALL: &'static [Self] = &[FrictionModel::Bak, FrictionModel::Ottestad, FrictionModel::Fitted];
 }
 
 /// Friction parameters (SI).
@@ -110,7 +112,7 @@ mod tests {
     /// one-sided slopes agree.
     #[test]
     fn continuous_through_zero() {
-        for m in FrictionModel::ALL {
+        for &m in FrictionModel::ALL {
             let (f, cyl) = with(m);
             let (x, p3, p4) = (0.25, bar(80.0), bar(5.0));
             assert_eq!(f.force(&cyl, 0.0, x, p3, p4), 0.0, "{m:?}");
@@ -152,12 +154,14 @@ mod tests {
         assert!((f.force(&cyl, v, x, p3, p4) - ott).abs() < 1e-9 * ott);
     }
 
+    /// Every law is one item of the Enumeration, named, the item's value its index.
     #[test]
-    fn model_index_roundtrip() {
+    fn every_law_is_an_item() {
+        let e = FrictionModel::ENUMERATION;
+        assert_eq!(e.items.len(), FrictionModel::ALL.len());
         for (i, m) in FrictionModel::ALL.iter().enumerate() {
-            assert_eq!(FrictionModel::from_index(i), Some(*m));
             assert_eq!(m.index(), i);
+            assert_eq!(e.value(&format!("{m:?}").to_lowercase()), Some(i));
         }
-        assert_eq!(FrictionModel::from_index(3), None);
     }
 }

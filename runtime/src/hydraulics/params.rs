@@ -11,7 +11,6 @@ use super::line::{Fluid, Lines};
 use super::pcv::Pcv;
 use super::supply::Supply;
 use crate::param;
-use crate::params::ParamSpec;
 use crate::units::{BAR, CM3, LPM, MM};
 use std::f64::consts::FRAC_PI_4;
 
@@ -291,25 +290,9 @@ pub const PARAMS: &[Param] = &[
         "End-stop contact damping",
         "not in the thesis: about critical for 100 kg"
     ),
-    Param {
-        spec: ParamSpec {
-            name: "friction.model",
-            default: 0.0,
-            unit: "1",
-            display_unit: "",
-            min: 0.0,
-            max: 2.0,
-            description: "Friction model: 0 Bak (2.65), 1 Ottestad et al. (2.63), 2 fitted (5.4); rounded",
-            source: "2.2.3, 5.1.2; Bak is the thesis' simulation model",
-            integer: true,
-        },
-        get: |c| c.friction.model.index() as f64,
-        set: |c, v| {
-            if let Some(m) = FrictionModel::from_index(v.round() as usize) {
-                c.friction.model = m;
-            }
-        },
-    },
+    param!(choice "friction.model", friction.model, FrictionModel::Bak,
+        "Friction law: bak (eq. 2.65), ottestad (Ottestad et al., eq. 2.63) or fitted (eq. 5.4)",
+        "2.2.3, 5.1.2; Bak is the thesis' simulation model"),
     param!(
         "friction.c_p_bak",
         friction.c_p_bak,

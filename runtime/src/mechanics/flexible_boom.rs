@@ -20,12 +20,12 @@
 //!   omega gets xi omega / omega_sec, and omega_sec grows with n^2. So the arm's modal damping
 //!   falls as the lumping is refined (the 47.5 Hz mode: 1.4 % at 1 + 2 sections, 0.21 % at
 //!   4 + 5, 0.023 % at 12 + 15; the frequencies converge) and its first bending mode, the one
-//!   that [3, p. 97]'s 1-2 % for steel structures is about, keeps 0.01 %. `boom.damping` = 1
-//!   ([`STRUCTURAL_DAMPING`], not in the thesis) anchors beta instead at the arm's first bending
-//!   frequency omega_b ([`FlexibleBoom::bending_frequency`], 3.4 Hz for the rig), beta =
+//!   that [3, p. 97]'s 1-2 % for steel structures is about, keeps 0.01 %. `boom.damping` =
+//!   `structural` ([`DampingLaw::Structural`], not in the thesis) anchors beta instead at the
+//!   arm's first bending frequency omega_b ([`FlexibleBoom::bending_frequency`], 3.4 Hz for the rig), beta =
 //!   2 xi / omega_b: that mode gets xi whatever the sections, higher modes xi omega / omega_b.
-//!   `boom.damping` = 2 ([`MODAL_DAMPING`], not in the thesis; the default) is modal damping:
-//!   each mode of the arm with the cylinder locked ([`FlexibleBoom::locked_modes`]) below the
+//!   `boom.damping` = `modal` ([`DampingLaw::Modal`], not in the thesis; the default) is modal
+//!   damping: each mode of the arm with the cylinder locked ([`FlexibleBoom::locked_modes`]) below the
 //!   band of interest ([`BAND`], 50 Hz: the first bending mode, 3.4 Hz) keeps the damping ratio
 //!   the thesis' law gives it, and every mode above it is damped at least critically
 //!   ([`QUASI_STATIC`]). Those modes (70 Hz to 10 kHz at 4 + 5 sections) are the lumping's:
@@ -102,17 +102,10 @@
 use nalgebra::{DMatrix, DVector, Vector2};
 
 use super::kinematics::{law_of_cosines, Triangle};
-use super::params::{BeamParams, BoomParams};
+use super::params::{BeamParams, BoomParams, DampingLaw};
 use super::rigid_boom::RigidBoom;
-use super::{Mechanics, Energy, Equilibrium, Kinetics, MechanicsError};
+use super::{Energy, Equilibrium, Kinetics, Mechanics, MechanicsError};
 use crate::scalar::Scalar;
-
-/// `boom.damping` of the structural law: c = beta k with beta = 2 xi / omega_b (module doc).
-pub const STRUCTURAL_DAMPING: usize = 1;
-
-/// `boom.damping` of the modal law: the thesis' damping in the band of interest, the modes above
-/// it quasi-static (module doc).
-pub const MODAL_DAMPING: usize = 2;
 
 /// The modal law's band of interest (rad/s): 50 Hz, numerics issue 27's "the boom's dynamics of
 /// interest are below 50 Hz" (the rig's mode is 2.85 Hz, thesis 5.1.3; the feedback's filter
@@ -122,10 +115,6 @@ pub const BAND: f64 = 50.0 * std::f64::consts::TAU;
 /// The modal law's least damping ratio above [`BAND`]: critical, the fastest decay without
 /// oscillation.
 pub const QUASI_STATIC: f64 = 1.0;
-
-/// `boom.damping` of the converged-modal law: every locked mode that the lumping has converged
-/// keeps the damping ratio `boom.xi`, the modes beyond are damped up to critical (module doc).
-pub const CONVERGED_MODAL_DAMPING: usize = 3;
 
 /// A locked mode is converged when its frequency moves less than this from the chain's section
 /// counts to twice them (issue 48).
@@ -158,7 +147,7 @@ pub struct FlexibleBoom {
     c: Column,
     /// The damping law (`boom.damping`) and, for the modal law, the joints' damping matrix
     /// (rows of MAX_SECTIONS, the first n - 1 of each).
-    damping: usize,
+    damping: DampingLaw,
     modal: [f64; MAX_SECTIONS * MAX_SECTIONS],
     /// Upper cylinder pin, in the frame of the last section of part II.
     pin: Vector2<f64>,
@@ -314,17 +303,22 @@ impl FlexibleBoom {
         }
         let (w1, phi2) = (triangle.w1, triangle.phi2);
         boom.pin = Vector2::new(w1 * phi2.cos() - boom.start[n_ii - 1], -w1 * phi2.sin());
-        if beam.damping == STRUCTURAL_DAMPING {
+        if beam.damping == DampingLaw::Structural {
             let beta = 2.0 * beam.xi / boom.bending_frequency()?;
             for i in 0..n - 1 {
                 boom.c[i] = beta * boom.k[i];
             }
         }
-        if beam.damping == MODAL_DAMPING {
+        if beam.damping == DampingLaw::Modal {
             boom.modal_damping()?;
         }
-        if beam.damping == CONVERGED_MODAL_DAMPING {
-            let refined = BeamParams { n2: (2 * beam.n2).min(16), n3: (2 * beam.n3).min(16), damping: 0, ..*beam };
+        if beam.damping == DampingLaw::ConvergedModal {
+            let refined = BeamParams {
+                n2: (2 * beam.n2).min(16),
+                n3: (2 * beam.n3).min(16),
+                damping: DampingLaw::Thesis,
+                ..*beam
+            };
             let reference = Self::new(p, &refined, stroke)?.locked_frequencies()?;
             boom.converged_modal_damping(beam.xi, &reference)?;
         }
@@ -372,7 +366,8 @@ impl FlexibleBoom {
     /// The arm's first bending frequency (rad/s): the lowest of [`Self::locked_modes`]. The
     /// gravity-loaded rest shape and gravity's geometric stiffness are left out (together 0.03 %
     /// against the whole plant linearised with a rigid oil column, `boomsim_tools`' test
-    /// `structural_damping_sits_at_the_arms_bending_mode`). `boom.damping` = 1 sets beta at it.
+    /// `structural_damping_sits_at_the_arms_bending_mode`). `boom.damping` = `structural` sets
+    /// beta at it.
     pub fn bending_frequency(&self) -> Result<f64, MechanicsError> {
         Ok(self.locked_modes()?.0.min().sqrt())
     }
@@ -410,7 +405,7 @@ impl FlexibleBoom {
         Ok((eigen.eigenvalues, z * l_inv.transpose() * eigen.eigenvectors))
     }
 
-    /// `boom.damping` = 2, the modal law (module doc): each locked mode keeps the per-section law's
+    /// `boom.damping` = `modal`, the modal law (module doc): each locked mode keeps the per-section law's
     /// own damping below [`BAND`], at least [`QUASI_STATIC`] above it ([`Self::set_modal_damping`]).
     fn modal_damping(&mut self) -> Result<(), MechanicsError> {
         let c = self.c;
@@ -420,7 +415,7 @@ impl FlexibleBoom {
         })
     }
 
-    /// `boom.damping` = 3, the converged-modal law: each locked mode j whose frequency is within
+    /// `boom.damping` = `converged_modal`, the converged-modal law: each locked mode j whose frequency is within
     /// [`CONVERGED`] of the refined chain's (`reference`: omega^2 of the chain with twice the
     /// sections, ascending) gets the damping ratio `zeta`, a steel structure's (the thesis' 2 %,
     /// [3, p. 97]); above the frequency omega_c where the relative difference reaches
@@ -465,7 +460,7 @@ impl FlexibleBoom {
     /// Torque of the damper of joint i (between sections i and i + 1): its own rate's under the
     /// per-section and structural laws (2.36-2.38), every joint's under the modal law.
     fn damper<T: Scalar>(&self, qd: &[T], i: usize) -> T {
-        if self.damping == MODAL_DAMPING || self.damping == CONVERGED_MODAL_DAMPING {
+        if matches!(self.damping, DampingLaw::Modal | DampingLaw::ConvergedModal) {
             let row = &self.modal[i * MAX_SECTIONS..][..self.n - 1];
             row.iter().enumerate().fold(T::from(0.0), |tau, (j, &c)| tau + (qd[j + 1] - qd[j]) * c)
         } else {
@@ -680,8 +675,7 @@ impl<T: Scalar> Kinetics<T> for FlexibleBoom {
             let f = self.first[j];
             let (sx, sy) = (c * f.x - s * f.y, s * f.x + c * f.y);
             let w2 = qd[j] * qd[j];
-            let tau_in =
-                if j > 0 { (q[j] - q[j - 1]) * self.k[j - 1] + self.damper(qd, j - 1) } else { zero };
+            let tau_in = if j > 0 { (q[j] - q[j - 1]) * self.k[j - 1] + self.damper(qd, j - 1) } else { zero };
             // K perp(r); d = J + perp(r)^T K perp(r) from the squares (off the K -> d path).
             let (kpx, kpy) = (kxy * x - kxx * y, kyy * x - kxy * y);
             let mut d = (y * y) * kxx + self.second[j] + ((x * x) * kyy - (x * 2.0 * y) * kxy);
@@ -814,7 +808,7 @@ mod tests {
         let p = BoomParams { m_arm: 0.0, m_pl: 1.0, x_pl_inboard: 0.0, h_pl: 0.0, ..BoomParams::default() };
         for n in [1, 2, 5, 15] {
             // The thesis' damping law: the modal law's modes need the arm's mass (statics ignore damping).
-            let beam = BeamParams { n2: 0, n3: n, damping: 0, ..BeamParams::default() };
+            let beam = BeamParams { n2: 0, n3: n, damping: DampingLaw::Thesis, ..BeamParams::default() };
             let boom = build(&p, &beam);
             let l_cyl = horizontal(&boom);
             let q = boom.equilibrium_at(l_cyl).unwrap().q;
@@ -906,7 +900,7 @@ mod tests {
     fn energy_is_conserved_without_damping() {
         let p = BoomParams::default();
         // xi = 0 under the thesis' law: no damper at all (the modal law damps the high modes whatever xi).
-        let boom = build(&p, &BeamParams { xi: 0.0, damping: 0, ..BeamParams::default() });
+        let boom = build(&p, &BeamParams { xi: 0.0, damping: DampingLaw::Thesis, ..BeamParams::default() });
         let n = boom.sections();
         let f_rest = boom.equilibrium_at(0.93).unwrap().f_cyl;
         let force = |t: f64| f_rest + 3000.0 * (2.0 * std::f64::consts::PI * t / 0.02).sin();
@@ -1070,4 +1064,3 @@ mod tests {
         println!("accelerations, 4 + 5 sections: {:.0} ns per call", start.elapsed().as_nanos() as f64 / calls as f64);
     }
 }
-

@@ -2,7 +2,55 @@
 //! section 2.1 and chapter 3.1), each described once in [`BOOM_PARAMS`] and [`BEAM_PARAMS`].
 
 use crate::param;
-use crate::params::{build, Param};
+use crate::params::{build, Choice, Enumeration, Item, Param};
+
+/// The damping law of the arm's joints (`boom.damping`, module doc of
+/// [`crate::mechanics::flexible_boom`]). Only [`DampingLaw::Thesis`] is the thesis'.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DampingLaw {
+    /// Per section, eq. 2.36-2.38: `c = 2 xi sqrt(k J)` of each section; its modal damping falls
+    /// with the number of sections.
+    Thesis,
+    /// Not in the thesis: stiffness-proportional, `c = beta k` with `beta = 2 xi / omega_b`.
+    Structural,
+    /// Not in the thesis: the locked arm's modes below 50 Hz keep the thesis' damping, those
+    /// above are damped critically (quasi-static).
+    Modal,
+    /// Not in the thesis: every locked mode the lumping has converged keeps the ratio `xi`, the
+    /// others up to critical, smoothly in frequency.
+    ConvergedModal,
+}
+
+impl Choice for DampingLaw {
+    const ENUMERATION: &'static Enumeration = &Enumeration {
+        name: "DampingLaw",
+        description: "Damping law of the flexible arm's joints; only 'thesis' is the thesis' (eq. 2.36-2.38)",
+        items: &[
+            Item {
+                name: "thesis",
+                description: "The thesis' law, eq. 2.36-2.38: c = 2 xi sqrt(k J) per section (its modal damping falls \
+                              with the number of sections)",
+            },
+            Item {
+                name: "structural",
+                description: "Not in the thesis: stiffness-proportional c = beta k, the ratio xi at the arm's first \
+                              bending mode",
+            },
+            Item {
+                name: "modal",
+                description: "Not in the thesis: the locked arm's modes below 50 Hz keep the thesis' damping, those \
+                              above are damped critically (quasi-static)",
+            },
+            Item {
+                name: "converged_modal",
+                description: "Not in the thesis: every locked mode within 1 % of its frequency with twice the \
+                              sections gets the ratio xi, the others up to critical, smoothly in frequency",
+            },
+        ],
+    };
+    const ALL: &'static [Self] =
+        &[DampingLaw::Thesis, DampingLaw::Structural, DampingLaw::Modal, DampingLaw::ConvergedModal];
+}
 
 /// The retracted pin-to-pin cylinder length, which the thesis does not give.
 ///
@@ -140,9 +188,9 @@ pub const BEAM_PARAMS: &[Param<BeamParams>] = &[
     param!("boom.E", e, 210e9, "Pa", "MPa", [1e9, 1e12],
         "Young's modulus of the arm", NOMENCLATURE),
     param!("boom.xi", xi, 0.02, "1", "%", [0.0, 1.0],
-        "Damping ratio of the arm: of each section's torsional damper (boom.damping = 0, eq. 2.36-2.38, and 2 \
-         below its band), of the arm's first bending mode (boom.damping = 1) or of each converged mode \
-         (boom.damping = 3)", "section 2.1.4, [3, p. 97]"),
+        "Damping ratio of the arm: of each section's torsional damper (boom.damping = thesis, eq. 2.36-2.38, and \
+         modal below its band), of the arm's first bending mode (structural) or of each converged mode \
+         (converged_modal)", "section 2.1.4, [3, p. 97]"),
     param!("boom.x_mount", x_mount, 0.590, "m", "mm", [0.01, 3.0],
         "Joint B to the boundary between beam parts II and III at the upper cylinder mount",
         "section 3.1.2, Table 3.1 (the pin itself is at x1 = w1 cos(phi2), eq. 2.25)"),
@@ -150,19 +198,20 @@ pub const BEAM_PARAMS: &[Param<BeamParams>] = &[
         "Sections of beam part II, joint B to the cylinder mount (0: rigid)", "section 3.1.2, experiment III"),
     param!(int "boom.n3", n3, 5.0, [1.0, 16.0],
         "Sections of beam part III, cylinder mount to the arm's end", "section 3.1.2, experiment II"),
-    param!(int "boom.damping", damping, 2.0, [0.0, 3.0],
-        "Damping law of the arm's joints: 0 per section as the thesis (c = 2 xi sqrt(k J) of each section, its \
-         modal damping falls with the number of sections), 1 structural (stiffness-proportional, c = beta k \
+    param!(choice "boom.damping", damping, DampingLaw::Modal,
+        "Damping law of the arm's joints: thesis (the thesis' law, c = 2 xi sqrt(k J) of each section, its \
+         modal damping falls with the number of sections), structural (stiffness-proportional, c = beta k \
          with beta = 2 xi / omega_b: the damping ratio xi at the arm's first bending mode omega_b, whatever \
-         the sections), 2 modal, the default (the arm's modes with the cylinder locked below 50 Hz keep the \
-         damping of law 0, those above it are damped critically: quasi-static), 3 converged-modal (each \
+         the sections), modal, the default (the arm's modes with the cylinder locked below 50 Hz keep the \
+         thesis' damping, those above it are damped critically: quasi-static), converged_modal (each \
          locked mode within 1 % of its frequency with twice the sections gets the damping ratio xi, the \
-         others up to critical, smoothly in frequency)",
-        "eq. 2.36-2.38; 1: not in the thesis, Rayleigh stiffness-proportional damping (Clough & Penzien, \
-         Dynamics of Structures, 3rd ed., sec. 12-5) anchored where [3, p. 97]'s 1-2 % for steel structures \
-         applies; 2: not in the thesis, the damping matrix of modal damping ratios (ibid., same section) with \
-         the modes above the band quasi-static as in a modal truncation with static correction; 3: not in the \
-         thesis, the same matrix with [3, p. 97]'s ratio on every mode the lumping resolves"),
+         others up to critical, smoothly in frequency). Only thesis is the thesis'",
+        "thesis: eq. 2.36-2.38; structural: not in the thesis, Rayleigh stiffness-proportional damping \
+         (Clough & Penzien, Dynamics of Structures, 3rd ed., sec. 12-5) anchored where [3, p. 97]'s 1-2 % for \
+         steel structures applies; modal: not in the thesis, the damping matrix of modal damping ratios (ibid., \
+         same section) with the modes above the band quasi-static as in a modal truncation with static \
+         correction; converged_modal: not in the thesis, the same matrix with [3, p. 97]'s ratio on every mode \
+         the lumping resolves"),
 ];
 
 /// The cross-section and lumped-beam parameters as numbers (SI); names and ranges are in
@@ -178,16 +227,24 @@ pub struct BeamParams {
     /// Sections of part II; 0 makes part II one rigid body.
     pub n2: usize,
     pub n3: usize,
-    /// Damping law of the joints: 0 per section (2.36-2.38), 1 structural, 2 modal, 3 converged-modal
-    /// (`boom.damping`).
-    pub damping: usize,
+    /// Damping law of the joints (`boom.damping`).
+    pub damping: DampingLaw,
 }
 
 impl BeamParams {
     /// The parameters with `value(k)` for [`BEAM_PARAMS`]`[k]`; `n2`, `n3` are rounded.
     pub fn from_values(value: impl Fn(usize) -> f64) -> Self {
-        let unset =
-            BeamParams { w_arm: 0.0, h_arm: 0.0, t_arm: 0.0, e: 0.0, xi: 0.0, x_mount: 0.0, n2: 0, n3: 0, damping: 0 };
+        let unset = BeamParams {
+            w_arm: 0.0,
+            h_arm: 0.0,
+            t_arm: 0.0,
+            e: 0.0,
+            xi: 0.0,
+            x_mount: 0.0,
+            n2: 0,
+            n3: 0,
+            damping: DampingLaw::Thesis,
+        };
         build(unset, BEAM_PARAMS, value)
     }
 
@@ -221,22 +278,31 @@ impl Default for BeamParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::ParamType;
 
-    /// Every field is one parameter: set parameter k to k + 0.5 (a count rounds to k + 1), and
-    /// each reads back what was set, and no field is left at the zero it starts from.
+    /// Every field is one parameter: set parameter k to k + 0.5 (a count to k + 1, a choice to
+    /// its last item, away from the first that `from_values` starts from), and each reads back
+    /// what was set, and no field is left at the zero it starts from.
     #[test]
     fn every_field_is_one_parameter() {
+        fn value<T>(params: &[Param<T>], k: usize) -> f64 {
+            match params[k].spec.ty {
+                ParamType::Real => k as f64 + 0.5,
+                ParamType::Count => k as f64 + 1.0,
+                ParamType::Choice(e) => (e.items.len() - 1) as f64,
+            }
+        }
         fn check<T: std::fmt::Debug>(params: &[Param<T>], built: T) {
             for (k, p) in params.iter().enumerate() {
-                let set = if p.spec.integer { (k as f64 + 0.5).round() } else { k as f64 + 0.5 };
-                assert_eq!((p.get)(&built), set, "{}", p.spec.name);
+                assert_eq!((p.get)(&built), value(params, k), "{}", p.spec.name);
             }
             let shown = format!("{built:?}");
             let zeros = shown.split(|c: char| !(c.is_ascii_digit() || c == '.')).filter(|t| *t == "0.0" || *t == "0");
             assert_eq!(zeros.count(), 0, "a field no parameter sets: {shown}");
         }
-        check(BOOM_PARAMS, BoomParams::from_values(|k| k as f64 + 0.5));
-        check(BEAM_PARAMS, BeamParams::from_values(|k| k as f64 + 0.5));
+        check(BOOM_PARAMS, BoomParams::from_values(|k| value(BOOM_PARAMS, k)));
+        check(BEAM_PARAMS, BeamParams::from_values(|k| value(BEAM_PARAMS, k)));
+        assert_eq!(BeamParams::from_values(|k| value(BEAM_PARAMS, k)).damping, DampingLaw::ConvergedModal);
     }
 
     /// (2.26) for the 150x100x6 section by hand: (0.1 * 0.15^3 - 0.088 * 0.138^3) / 12

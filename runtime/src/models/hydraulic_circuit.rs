@@ -23,7 +23,7 @@ use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::params::ParamSpec;
+use crate::params::{ParamSpec, ParamType};
 use crate::scalar::Dual64;
 use crate::solver::{OdeSystem, SecondOrder};
 
@@ -46,7 +46,7 @@ const PORT_MASS: ParamSpec = ParamSpec {
     max: 1e5,
     description: "TLM port: mass the circuit integrates at the rod (rod + piston); the mechanics keeps its own",
     source: "cylinder.m_rod, 5 kg (thesis nomenclature); 0.03 % of the rigid boom's 16.9 t effective mass at 480 mm",
-    integer: false,
+    ty: ParamType::Real,
 };
 
 /// Default: the rigid boom's holding force at the 480 mm start stroke (23 751 N; test
@@ -60,7 +60,7 @@ const START_FORCE: ParamSpec = ParamSpec {
     max: 1e7,
     description: "Load on the rod at the start, held by the closed CBV (the mechanics' static force at start.x: BoomMechanics' start.F)",
     source: "rigid boom of the thesis at start.x = 480 mm (flexible: 23 819 N)",
-    integer: false,
+    ty: ParamType::Real,
 };
 
 #[rustfmt::skip]

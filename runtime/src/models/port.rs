@@ -18,7 +18,7 @@
 //!   both relative errors equal to omega h.
 
 use crate::fmu::{StepStart, Value, Values, Variable};
-use crate::params::ParamSpec;
+use crate::params::{ParamSpec, ParamType};
 
 /// Value references of the port (the same in both FMUs; 80-99, after the section angles 41-72).
 pub mod vr {
@@ -132,7 +132,7 @@ pub const Z_C: ParamSpec = ParamSpec {
     max: 1e9,
     description: "TLM characteristic impedance: line stiffness Z_c/h and mass Z_c h per communication step h",
     source: "sqrt(k_oil m_eff) at the start stroke (boomsim: port module); equal stiffness and mass errors omega h",
-    integer: false,
+    ty: ParamType::Real,
 };
 
 /// Wave damping: the emitted wave is `c_k+1 = alpha c_k + (1 - alpha) (F + Z_c v)`.
@@ -145,7 +145,7 @@ pub const ALPHA: ParamSpec = ParamSpec {
     max: 0.9,
     description: "TLM wave damping (low-pass factor of each emitted wave per step); > 0 damps the numerical line mode at half the communication frequency",
     source: "signal damping of TLM wave variables (Hopsan C-type components); see docs/coupling.md",
-    integer: false,
+    ty: ParamType::Real,
 };
 
 impl Coupling {

@@ -11,10 +11,10 @@
 
 use super::port::Ramp;
 use crate::control::{HighPassFeedback, FEEDBACK_PARAMS};
-use crate::params::build;
-use crate::fmu::instance::bounded_slope;
 use crate::fmu::driver::Step;
+use crate::fmu::instance::bounded_slope;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, StepError, StepStart, Values, Variable};
+use crate::params::build;
 
 /// Value references (stable across releases).
 pub mod vr {
@@ -50,7 +50,7 @@ pub(super) mod row {
     use super::{vr, P_RANGE};
     use crate::control::FEEDBACK_PARAMS;
     use crate::fmu::Variable;
-    use crate::params::ParamSpec;
+    use crate::params::{ParamSpec, ParamType};
 
     pub const U_REF: Variable = Variable::real_input(
         "u_ref",
@@ -90,7 +90,7 @@ pub(super) mod row {
             max: 1.0,
             description: "Lower limit of the spool command",
             source: "Full spool opening in the lowering direction (eq. 2.44)",
-            integer: false,
+            ty: ParamType::Real,
         },
     );
     pub const U_MAX: Variable = Variable::param(
@@ -104,7 +104,7 @@ pub(super) mod row {
             max: 1.0,
             description: "Upper limit of the spool command",
             source: "Full spool opening in the lifting direction (eq. 2.44)",
-            integer: false,
+            ty: ParamType::Real,
         },
     );
     pub const P_LP: Variable = Variable::real_local(

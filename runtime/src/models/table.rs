@@ -7,7 +7,7 @@ use crate::fmu::{Values, Variable};
 use crate::hydraulics::Circuit;
 use crate::mechanics::flexible_boom::MAX_SECTIONS;
 use crate::mechanics::params::{BEAM_PARAMS, BOOM_PARAMS};
-use crate::params::{Param, ParamSpec};
+use crate::params::{Param, ParamSpec, ParamType};
 
 /// A continuous Real output.
 pub(crate) const fn out(
@@ -74,7 +74,7 @@ pub(crate) const START_STROKE: ParamSpec = ParamSpec {
     max: 10.0,
     description: "Initial stroke; the load starts at rest, held by the closed CBV, pressures in equilibrium",
     source: "Start stroke of the experiments, 480 mm (sections 6.2, chapter 7)",
-    integer: false,
+    ty: ParamType::Real,
 };
 
 pub(crate) const START_P4: ParamSpec = ParamSpec {
@@ -86,7 +86,7 @@ pub(crate) const START_P4: ParamSpec = ParamSpec {
     max: 100e5,
     description: "Initial rod-side pressure (line 4), gauge, trapped by the closed spool; p3 carries the load on top of it (eq. 2.85). Above tank pressure it bleeds to tank through the spool's leakage (eq. 2.47), over about a minute",
     source: "0: tank pressure, the valve's leakage equilibrium; the thesis' simulations of section 6.2 start at p4 = 1 bar",
-    integer: false,
+    ty: ParamType::Real,
 };
 
 /// The trapped rod-side pressure of `start.p4`: `None` at 0 (tank pressure, the leakage
@@ -174,21 +174,23 @@ pub(crate) const fn param_index(name: &str) -> usize {
     k
 }
 
-/// The FMU variable of a physical parameter: fixed, an Integer where it counts or selects.
+/// The FMU variable of a physical parameter: fixed; an Integer where it counts, an Enumeration
+/// where it chooses.
 const fn param(r: u32, p: ParamSpec) -> Variable {
-    if p.integer {
-        Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
-    } else {
-        Variable::param(r, p).fixed()
+    match p.ty {
+        ParamType::Real => Variable::param(r, p).fixed(),
+        ParamType::Count => {
+            Variable::int_param(p.name, r, p.default as i32, (p.min as i32, p.max as i32), p.description)
+        }
+        ParamType::Choice(ty) => Variable::enum_param(p.name, r, p.default as i32, ty, p.description),
     }
 }
 
 /// The value of parameter `p` with value reference `r`, as a number.
 pub(crate) fn param_value(values: &Values, r: u32, p: &ParamSpec) -> f64 {
-    if p.integer {
-        values.integer(r) as f64
-    } else {
-        values.real(r)
+    match p.ty {
+        ParamType::Real => values.real(r),
+        ParamType::Count | ParamType::Choice(_) => values.integer(r) as f64,
     }
 }
 

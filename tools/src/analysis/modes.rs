@@ -71,6 +71,7 @@ pub fn parameter_change(arg: &str) -> Result<(&'static Variable, Value), String>
         BaseType::Real => Value::Real(text.parse().map_err(|_| bad())?),
         BaseType::Integer => Value::Integer(text.parse().map_err(|_| bad())?),
         BaseType::Boolean => Value::Boolean(text.parse().map_err(|_| bad())?),
+        BaseType::Enumeration => Value::Integer(v.item_value(text).map_err(|e| format!("--set {arg}: {e}"))?),
         BaseType::String | BaseType::Clock => return Err(bad()),
     };
     in_range(v, &value).map_err(|e| format!("--set {arg}: {e}"))?;
@@ -308,7 +309,8 @@ mod tests {
         let at_4_5 = moved((4, 5), (8, 10));
         assert!(at_4_5[0] > 0.01 && at_4_5[1] > 0.01, "{at_4_5:?}");
         let note = model_note("- **Flexible arm");
-        let (first, second) = (format!("{:.1} % to 8 + 10", at_4_5[0] * 100.0), format!("the second {:.1} %", at_4_5[1] * 100.0));
+        let (first, second) =
+            (format!("{:.1} % to 8 + 10", at_4_5[0] * 100.0), format!("the second {:.1} %", at_4_5[1] * 100.0));
         assert!(note.contains(&first) && note.contains(&second), "docs/models.md: {first}, {second}");
         for xi in [0.005, 0.02, 0.05] {
             let mut changes = STIFF_OIL.to_vec();

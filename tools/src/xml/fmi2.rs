@@ -2,13 +2,13 @@
 //! (the parts FMI 3.0 writes alike are in [`crate::xml`]).
 
 use crate::xml::{
-    default_experiment, document, element, flag, initial_unknowns, log_categories, real_attrs, root_attrs,
-    unit_definitions, variable_attrs, Attrs, Xml,
+    default_experiment, document, element, enumeration_attrs, enumeration_items, flag, initial_unknowns,
+    log_categories, real_attrs, root_attrs, unit_definitions, variable_attrs, Attrs, Xml,
 };
 use boomsim::fmu::guid::guid;
 use boomsim::fmu::model::Model;
 use boomsim::fmu::structure::probe;
-use boomsim::fmu::variables::{Causality, Kind, Variable};
+use boomsim::fmu::variables::{enumerations, Causality, Kind, Variable};
 use std::io;
 
 pub use crate::xml::{dependencies, initial_dependencies};
@@ -26,10 +26,32 @@ fn type_attrs(v: &Variable) -> (&'static str, Attrs) {
             }
             ("Integer", a)
         }
+        Kind::Enumeration { start: s, ty } => ("Enumeration", enumeration_attrs(ty, start.then_some(s))),
         Kind::Boolean { start: s } => ("Boolean", if start { vec![("start", s.to_string())] } else { vec![] }),
         Kind::String { start: s } => ("String", if start { vec![("start", s.into())] } else { vec![] }),
         Kind::Clock { .. } => unreachable!("FMI 2.0 has no Clocks: a model with one is packed as FMI 3.0 only"),
     }
+}
+
+/// `<TypeDefinitions>`: a `<SimpleType>` per Enumeration type (2.2.3), none without one.
+fn type_definitions<M: Model>(w: &mut Xml) -> io::Result<()> {
+    let types = enumerations(M::VARIABLES);
+    if types.is_empty() {
+        return Ok(());
+    }
+    w.create_element("TypeDefinitions").write_inner_content(|w| {
+        for ty in types {
+            let a: Attrs = vec![("name", ty.name.into()), ("description", ty.description.into())];
+            w.create_element("SimpleType")
+                .with_attributes(a.iter().map(|(k, v)| (*k, v.as_str())))
+                .write_inner_content(|w| {
+                    w.create_element("Enumeration").write_inner_content(|w| enumeration_items(w, ty))?;
+                    Ok(())
+                })?;
+        }
+        Ok(())
+    })?;
+    Ok(())
 }
 
 /// 1-based ModelVariables indices of value references, space separated.
@@ -75,6 +97,7 @@ fn write<M: Model>() -> io::Result<String> {
         ]);
         element(w, "CoSimulation", &cs)?;
         unit_definitions::<M>(w, &[])?;
+        type_definitions::<M>(w)?;
         log_categories::<M>(w, str::to_owned)?;
         default_experiment::<M>(w)?;
         w.create_element("ModelVariables").write_inner_content(|w| {

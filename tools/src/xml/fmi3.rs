@@ -1,5 +1,5 @@
 //! The FMI 3.0 modelDescription.xml, generated with quick-xml from the same variable table as
-//! FMI 2.0 (shared parts in [`crate::xml`]): `<Float64>`/`<Int32>`/`<Boolean>`/`<String>`
+//! FMI 2.0 (shared parts in [`crate::xml`]): `<Float64>`/`<Int32>`/`<Enumeration>`/`<Boolean>`/`<String>`
 //! variables with the same value references, ModelStructure by value reference.
 //!
 //! Units are declared as `<Float64Type>`s, one per unit and display unit, which the variables
@@ -12,15 +12,15 @@
 //! the unused sections beyond `boom.n2 + boom.n3` need no structural parameter for an array size.
 
 use crate::xml::{
-    default_experiment, dependencies, document, element, flag, initial_unknowns, log_categories, range_attrs,
-    root_attrs, unit_attrs, unit_definitions, variable_attrs, Attrs, Xml,
+    default_experiment, dependencies, document, element, enumeration_attrs, enumeration_items, flag, initial_unknowns,
+    log_categories, range_attrs, root_attrs, unit_attrs, unit_definitions, variable_attrs, Attrs, Xml,
 };
 use boomsim::fmu::guid::token;
 use boomsim::fmu::instance::INDEPENDENT_VR;
 use boomsim::fmu::log::num;
 use boomsim::fmu::model::{clock_row, has_event_mode, Model};
 use boomsim::fmu::structure::probe;
-use boomsim::fmu::variables::{Causality, Kind, Variable};
+use boomsim::fmu::variables::{enumerations, Causality, Kind, Variable};
 use std::io;
 
 /// The complete FMI 3.0 modelDescription.xml of model `M`.
@@ -46,7 +46,7 @@ fn type_name(unit: &str, display_unit: &str) -> String {
 }
 
 /// `<TypeDefinitions>`: a `<Float64Type>` per unit and display unit of the table (first use
-/// order), and the independent variable's seconds.
+/// order), and the independent variable's seconds; an `<EnumerationType>` per Enumeration type.
 fn type_definitions<M: Model>(w: &mut Xml) -> io::Result<()> {
     let mut pairs: Vec<(&str, &str)> = vec![("s", "")];
     for v in M::VARIABLES {
@@ -60,6 +60,12 @@ fn type_definitions<M: Model>(w: &mut Xml) -> io::Result<()> {
         for (unit, display_unit) in pairs {
             let a: Attrs = [vec![("name", type_name(unit, display_unit))], unit_attrs(unit, display_unit)].concat();
             element(w, "Float64Type", &a)?;
+        }
+        for ty in enumerations(M::VARIABLES) {
+            let a: Attrs = vec![("name", ty.name.into()), ("description", ty.description.into())];
+            w.create_element("EnumerationType")
+                .with_attributes(a.iter().map(|(k, v)| (*k, v.as_str())))
+                .write_inner_content(|w| enumeration_items(w, ty))?;
         }
         Ok(())
     })?;
@@ -90,6 +96,10 @@ fn variable<M: Model>(v: &Variable) -> (&'static str, Attrs, Option<String>) {
                 a.push(("start", s.to_string()));
             }
             ("Int32", None)
+        }
+        Kind::Enumeration { start: s, ty } => {
+            a.extend(enumeration_attrs(ty, start.then_some(s)));
+            ("Enumeration", None)
         }
         Kind::Boolean { start: s } => {
             if start {

@@ -12,6 +12,7 @@ use boomsim::fmu::log::{num, GENERIC_CATEGORIES};
 use boomsim::fmu::model::{initial_unknown, Model};
 use boomsim::fmu::structure::Structure;
 use boomsim::fmu::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
+use boomsim::params::Enumeration;
 use boomsim::units::{self, BASE_NAMES};
 use quick_xml::Writer;
 use std::collections::BTreeMap;
@@ -38,9 +39,7 @@ pub fn flag(b: bool) -> String {
 pub fn document(name: &str, root: &Attrs, body: impl FnOnce(&mut Xml) -> io::Result<()>) -> io::Result<String> {
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
     w.write_event(quick_xml::events::Event::Decl(quick_xml::events::BytesDecl::new("1.0", Some("UTF-8"), None)))?;
-    w.create_element(name)
-        .with_attributes(root.iter().map(|(k, v)| (*k, v.as_str())))
-        .write_inner_content(body)?;
+    w.create_element(name).with_attributes(root.iter().map(|(k, v)| (*k, v.as_str()))).write_inner_content(body)?;
     let mut s = String::from_utf8(w.into_inner()).map_err(io::Error::other)?;
     s.push('\n');
     Ok(s)
@@ -94,6 +93,26 @@ pub fn unit_definitions<M: Model>(w: &mut Xml, extra: &[&str]) -> io::Result<()>
         Ok(())
     })?;
     Ok(())
+}
+
+/// The `<Item>`s of an Enumeration type (FMI 2.0, 2.2.3; FMI 3.0, 2.4.6): value k for the k-th.
+pub fn enumeration_items(w: &mut Xml, ty: &Enumeration) -> io::Result<()> {
+    for (k, item) in ty.items.iter().enumerate() {
+        let a: Attrs =
+            vec![("name", item.name.into()), ("value", k.to_string()), ("description", item.description.into())];
+        element(w, "Item", &a)?;
+    }
+    Ok(())
+}
+
+/// The attributes of an Enumeration variable: its type, its items' range and its start value.
+pub fn enumeration_attrs(ty: &Enumeration, start: Option<i32>) -> Attrs {
+    let mut a: Attrs =
+        vec![("declaredType", ty.name.into()), ("min", "0".into()), ("max", (ty.items.len() - 1).to_string())];
+    if let Some(s) = start {
+        a.push(("start", s.to_string()));
+    }
+    a
 }
 
 /// `<LogCategories>`; `describe` adapts a description to the version (status names).
