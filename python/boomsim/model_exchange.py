@@ -27,8 +27,9 @@ class Integrator:
 
         class Solver(CVodeSolver):
             def f(self, t, y, ydot, user_data):
-                """fmpy's right-hand side, with an FMU's Discard (states outside its domain, FMI 2.0
-                2.1.3: retry with a smaller step) passed to CVode as a recoverable failure, which
+                """fmpy's right-hand side, with an FMU's Discard (FMI 2.0, 2.1.3: retry with a
+                smaller step; the plants answer non-finite derivatives so, and take every finite
+                state, issue 49) passed to CVode as a recoverable failure, which
                 it answers with a smaller step, instead of fmpy's default: the exception lost in
                 the callback and the derivatives left as they were. Any other failure is
                 unrecoverable (-1: CVode stops with an error), not an exception, which ctypes

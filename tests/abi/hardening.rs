@@ -305,7 +305,7 @@ fn an_input_stopped_at_its_bound_serialises() {
     let c = Slave::<Pfc>::initialized("p", &[(pfc::P, 40e5)]);
     assert_eq!(c.set_slope(pfc::P, -1e12), OK);
     assert_eq!(c.step(0.0, 0.3), WARN);
-    assert_eq!(c.real(pfc::P), -101325.0, "p stops at its declared minimum");
+    assert_eq!(c.real(pfc::P), -1e8, "p stops at its declared minimum");
     let bytes = common::serialized(&c);
     let mut st = null_mut();
     let status = unsafe { api::deserialize_fmu_state::<Pfc>(c.c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut st) };

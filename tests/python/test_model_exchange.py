@@ -102,6 +102,41 @@ def test_model_exchange_at_an_importers_tolerance(flexible):
         assert -1.01325e5 <= me[p].min() and me[p].max() <= 400e5, (p, me[p].min(), me[p].max())
 
 
+@pytest.mark.parametrize("u_ref, rtol", [(-0.1, 1e-4), (-0.3, 1e-3)])
+def test_trial_states_below_vacuum_do_not_stop_cvode(u_ref, rtol):
+    """Issue 49: HydraulicBoom alone, rigid, lowering from rest for 2 s under fmpy's own
+    simulate_fmu (CVode, whose right-hand-side callback takes an fmi2Discard for an
+    unrecoverable failure). CVode's trial states put p4 below absolute zero; when the plant
+    answered them with Discard these runs stopped (at 1.62 s and 0.90 s); the equations are now
+    continued there. Against the FMU's own Radau IIA at rtol 1e-9 (a second integrator): the run
+    completes, p3 is within 2 bar over the first 0.3 s (the issue's tolerance, 1 % of p3's
+    swing), and at rtol 1e-4 every pressure is within [-1.01325, 400] bar (absolute zero; no state
+    of this circuit reaches 400 bar: supply 200 bar, CBV setting 210 bar) and p3's peak-to-peak,
+    dominant frequency and the lowering over 1-2 s are within 2 % (the issue's). At 1e-3 CVode's
+    output points reach 2.8 kPa below vacuum and the cycle's phase drifts (docs/interfaces.md),
+    so only the completion and the first 0.3 s are checked there."""
+    kw = dict(stop_time=2.0, output_interval=1e-3, output=["p1", "p2", "p3", "p4", "cylinder.x"],
+              start_values={"boom.flexible": False, "valve.u_ref": u_ref})
+    me = simulate_fmu(fmu_path("HydraulicBoom"), fmi_type="ModelExchange", relative_tolerance=rtol, **kw)
+    ref = simulate_fmu(fmu_path("HydraulicBoom"), fmi_type="CoSimulation", relative_tolerance=1e-9, **kw)
+    assert me["time"][-1] == pytest.approx(2.0)
+    first = ref["time"] <= 0.3
+    error = np.abs(np.interp(ref["time"][first], me["time"], me["p3"]) - ref["p3"][first]).max() / 1e5
+    assert error < 2.0, f"p3 {error:.3g} bar off"
+    if rtol > 1e-4:
+        return
+    for p in ("p1", "p2", "p3", "p4"):
+        assert -1.01325e5 <= me[p].min() and me[p].max() <= 400e5, (p, me[p].min(), me[p].max())
+
+    def late(r):
+        k = r["time"] >= 1.0
+        return np.ptp(r["p3"][k]), metrics.dominant_frequency(r["time"][k], r["p3"][k])[0], \
+            r["cylinder.x"][-1] - np.interp(1.0, r["time"], r["cylinder.x"])
+
+    for name, m, c in zip(("p3 peak-to-peak", "f_dom", "lowering"), late(me), late(ref)):
+        assert abs(m / c - 1) < 0.02, f"{name}: {m:.4g} vs {c:.4g}"
+
+
 @pytest.mark.parametrize("scenario, boom", [("B", "rigid"), ("B", "flexible"), ("U", "flexible")])
 def test_compensated_lowering_at_an_importers_tolerance(scenario, boom, tolerances):
     """Plant and controller as one ME system under CVode at rtol 1e-4, the default tolerance of
@@ -109,8 +144,8 @@ def test_compensated_lowering_at_an_importers_tolerance(scenario, boom, toleranc
     tolerances of the CS run (the package's baselines/tolerances.toml; issue 27's row). The
     flexible arm passes under the modal damping law, the default (under the thesis' law B's
     u_comp_rms was 2.6 times the CS value). In U, CVode's trial states put p4 below absolute
-    zero; the plant discards them (FMI 2.0, 2.1.3) and run_me's CVode retries with a smaller
-    step (fmpy's own callback would lose the Discard). Not covered, as measured
+    zero; the plant's equations are continued there (issue 49) and the controller takes such a
+    fed-back pressure. Not covered, as measured
     (docs/interfaces.md): U rigid, which completes with v_mean 3.3 % slow (0.58 mm/s, tolerance
     0.23 mm/s): CVode's error at 1e-4 in the stick-slip cycle."""
     sc = load_scenario(scenario)

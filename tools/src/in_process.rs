@@ -90,10 +90,7 @@ impl<M: Model> InProcess<M> {
 
 impl<M: Model> Slave for InProcess<M> {
     fn set(&mut self, vr: u32, x: f64) -> Result<(), String> {
-        match self.0.set(&[vr], BaseType::Real, vec![Value::Real(x)])? {
-            Some(why) => Err(why),
-            None => Ok(()),
-        }
+        self.0.set(&[vr], BaseType::Real, vec![Value::Real(x)])
     }
     fn get(&mut self, vr: u32) -> Result<f64, String> {
         let mut x = [0.0];

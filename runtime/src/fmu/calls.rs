@@ -343,7 +343,8 @@ pub unsafe fn set<M: Model, T: Copy>(
             .iter()
             .map(|&x| convert(x))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(inst.set(vrs, wanted, values)?.map_or(Status::OK, |why| discard(inst, f, &why)))
+        inst.set(vrs, wanted, values)?;
+        Ok(Status::OK)
     })
 }
 
@@ -684,21 +685,12 @@ pub unsafe fn set_time<M: Model>(c: Handle, f: Call, time: f64) -> Status {
     })
 }
 
-/// Discard of states outside the model's domain ([`Model::outside_domain`]), logged: the states
-/// kept.
-fn discard<M: Model>(inst: &mut Instance<M>, f: Call, why: &str) -> Status {
-    let said = format!("{}: {why}; the states are kept (retry with a smaller step)", f.function);
-    inst.log.status(Status::Discard, &said);
-    Status::Discard
-}
-
-/// The continuous states; Discard, the states kept, where they are outside the model's domain
-/// ([`Model::outside_domain`]).
+/// The continuous states: any finite ones ([`Model::set_continuous_states`]).
 pub unsafe fn set_continuous_states<M: Model>(c: Handle, f: Call, x: *const f64, nx: usize) -> Status {
     call::<M>(c, f, |inst| {
         Instance::<M>::check_states(nx)?;
-        let x = slice(x, nx, states::<M>(), "x")?;
-        Ok(inst.set_continuous_states(x)?.map_or(Status::OK, |why| discard(inst, f, &why)))
+        inst.set_continuous_states(slice(x, nx, states::<M>(), "x")?)?;
+        Ok(Status::OK)
     })
 }
 

@@ -401,13 +401,10 @@ impl<M: Model> Instance<M> {
     }
 
     /// fmi2SetContinuousStates: all or nothing.
-    pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<Option<String>, String> {
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
         Self::check_states(x.len())?;
         if let Some(k) = x.iter().position(|x| !x.is_finite()) {
             return Err(format!("{} = {} is not a finite number", self.state_name(k), num(x[k])));
-        }
-        if let Some(why) = M::outside_domain(x) {
-            return Ok(Some(why));
         }
         let model = self.model()?;
         let before = model.clone();
@@ -417,7 +414,7 @@ impl<M: Model> Instance<M> {
         }
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
-        Ok(None)
+        Ok(())
     }
 
     /// The continuous states of the model built at initialisation.
@@ -710,9 +707,8 @@ impl<M: Model> Instance<M> {
     }
 
     /// Writes values, all or nothing: every value is checked (type, settability, range) before
-    /// any is stored. `Some(why)`: continuous states set by their value references are outside
-    /// the model's domain ([`Model::outside_domain`]), and nothing is stored (Discard).
-    pub fn set(&mut self, vrs: &[u32], wanted: BaseType, new: Vec<Value>) -> Result<Option<String>, String> {
+    /// any is stored.
+    pub fn set(&mut self, vrs: &[u32], wanted: BaseType, new: Vec<Value>) -> Result<(), String> {
         let mut checked = Vec::with_capacity(vrs.len());
         let mut states: Option<Vec<f64>> = None;
         for (&vr, value) in vrs.iter().zip(new) {
@@ -733,10 +729,8 @@ impl<M: Model> Instance<M> {
         if let Some(x) = states {
             // FMI 2.0, 3.2.3 rule 5: a continuous-time state set by its value reference is a new
             // state, as fmi2SetContinuousStates would set it (checked by the model the same way,
-            // and refused the same way outside the model's domain: nothing is set).
-            if let Some(why) = self.set_continuous_states(&x)? {
-                return Ok(Some(why));
-            }
+            // and refused the same way: nothing is set).
+            self.set_continuous_states(&x)?;
         }
         let tunes = matches!(self.core.mode, Mode::StepComplete | Mode::EventMode)
             && checked.iter().any(|&(i, _)| M::VARIABLES[i].causality == Causality::Parameter);
@@ -763,7 +757,7 @@ impl<M: Model> Instance<M> {
         }
         self.core.outputs_current = false;
         self.core.derivatives_current = false;
-        Ok(None)
+        Ok(())
     }
 
     /// FMI 3.0, 4.2.3: in Intermediate Update Mode the master sets the intermediate inputs it

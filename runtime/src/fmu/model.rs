@@ -153,20 +153,13 @@ pub trait Model: Clone + Send + Sized + 'static {
     fn continuous_states(&self, x: &mut [f64]);
 
     /// Takes new continuous states (fmi2SetContinuousStates, all finite); refuses states outside
-    /// the model's domain, naming the state, its value and its valid range.
+    /// the model's domain, naming the state, its value and its valid range. An integrator's
+    /// trial states are not outside it: the hydraulic plants' equations are defined for every
+    /// finite state (pressures below vacuum included, [`crate::hydraulics::line`]), so they take
+    /// any (FMI 2.0, 2.1.3 lists fmi2Discard for "a function outside of its domain", which then
+    /// does not arise; FMI 3.0, 3.2.1: fmi3Discard only "if the FMU rejects any of the state
+    /// values").
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
-
-    /// Why the equations do not hold at the continuous states `x` ([`Model::STATES`] order, all
-    /// finite), naming the state, its value and its bound, or None. fmi2SetContinuousStates and
-    /// fmi3SetContinuousStates then return Discard and keep the states they had: FMI 2.0, 2.1.3
-    /// (fmi2Discard in Model Exchange: "a function is outside of its domain", the integrator
-    /// retries with a smaller step), FMI 3.0, 3.2.1 (fmi3Discard "if the FMU rejects any of the
-    /// state values"). An integrator's trial states can leave the domain; it then retries with a
-    /// smaller step. fmi2SetReal / fmi3SetFloat64 of a state by its value reference is refused
-    /// the same way.
-    fn outside_domain(_x: &[f64]) -> Option<String> {
-        None
-    }
 
     /// Writes the states' time derivatives at the current states with the inputs of `values`.
     /// A non-finite value tells the importer to retry with a smaller step (fmi2Discard).

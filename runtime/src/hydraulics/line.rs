@@ -1,16 +1,23 @@
 //! Hydraulic volumes: pressure build-up `dp/dt = (sum Q - dV/dt) / C` (the continuity equation
 //! behind eq. 2.70-2.71 with `C = V / beta`), extended with the hose compliance of eq. 5.2 /
-//! Table 5.2 and an entrained-air model that keeps every pressure above absolute zero.
+//! Table 5.2 and an entrained-air model that keeps every pressure above absolute zero, and
+//! continued below it for the states an integrator tries ([`Fluid::pressure_rate`]).
 //!
 //! Pressures are gauge (Pa); absolute zero is `-P_ATM`.
 
-use crate::scalar::{max, Scalar};
+use crate::scalar::{Dual64, Scalar};
 use crate::units::P_ATM;
 
-/// Lowest absolute pressure used inside the bulk-modulus law (Pa). Only a solver overshoot below
-/// absolute zero can reach it; the floor keeps `dp/dt` finite and with the sign of the net
-/// inflow, so such a state returns towards the physical region.
-const P_ABS_FLOOR: f64 = 1e-3;
+/// Absolute pressure (Pa) below which the equations are continued ([`Fluid::bulk_modulus`],
+/// [`Fluid::pressure_rate`]): the physics never gets there (the air law holds every pressure
+/// above absolute zero; the lowest in the thesis' experiments and the lowering runs of
+/// scripts/me_trial_states.py is 2.5 kPa), only an integrator's trial state does. Above it every
+/// value is the law's, bit for bit.
+const P_ABS_MIN: f64 = 1e-3;
+
+/// Time constant (s) with which a pressure below [`P_ABS_MIN`] relaxes back to it
+/// ([`Fluid::pressure_rate`]).
+const TAU_VACUUM: f64 = 1e-3;
 
 /// Hydraulic fluid: oil with a small amount of entrained (undissolved) air.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,7 +35,7 @@ impl Fluid {
     /// plus isothermal ideal-gas air, `x0` = [`Fluid::air_fraction`]). The oil mass in a volume V
     /// is proportional to `V / phi(p)`.
     pub fn volume_ratio(&self, p: f64) -> f64 {
-        let p_abs = (p + P_ATM).max(P_ABS_FLOOR);
+        let p_abs = (p + P_ATM).max(P_ABS_MIN);
         (-p / self.beta).exp() + self.air_fraction * P_ATM / p_abs
     }
 
@@ -42,8 +49,24 @@ impl Fluid {
     /// expands without bound and `beta_e -> p_abs`, so `dp/dt -> 0` smoothly and a pressure
     /// never reaches absolute zero (vapour pressure of the oil is neglected against it). With
     /// `x0 = 0` it is exactly `beta`.
+    ///
+    /// Below [`P_ABS_MIN`] absolute (only an integrator's trial state gets there) the law is
+    /// continued by the exponential that meets it with value and slope there,
+    /// `beta_e(P_ABS_MIN) exp(k (p_abs - P_ABS_MIN))` with `k = beta_e' / beta_e` at
+    /// `P_ABS_MIN` (about `1 / P_ABS_MIN`): positive, continuously differentiable, and falling to
+    /// 0 within a few mPa below it, the limit the law itself tends to (free air that takes up any
+    /// volume change without a change of pressure). See [`Fluid::pressure_rate`].
     pub fn bulk_modulus<T: Scalar>(&self, p: T) -> T {
-        let p_abs = max(p + P_ATM, P_ABS_FLOOR);
+        if p.re() + P_ATM >= P_ABS_MIN {
+            return self.mixture(p);
+        }
+        let at = self.mixture(Dual64::new(P_ABS_MIN - P_ATM, 1.0));
+        ((p + (P_ATM - P_ABS_MIN)) * (at.eps / at.re)).exp() * at.re
+    }
+
+    /// The mixture law of [`Fluid::bulk_modulus`] at gauge pressure `p`, for `p_abs > 0`.
+    fn mixture<T: Scalar>(&self, p: T) -> T {
+        let p_abs = p + P_ATM;
         let e = exp_small(-p / self.beta);
         let a = self.air_fraction * P_ATM;
         p_abs * (e * p_abs + a) / (e * p_abs * p_abs / self.beta + a)
@@ -58,9 +81,31 @@ impl Fluid {
     /// at its pressure, `v0 + c_wall * p`, makes the law conserve oil mass exactly: the state
     /// equation `V(p, x) = m * phi(p)` differentiated in time gives this rate with `dm/dt`
     /// equal to `q_net / phi(p)`.
+    ///
+    /// Below [`P_ABS_MIN`] absolute, the states that an importer's integrator tries and the
+    /// physics never reaches, the rate is continued (issue 49): the flow term with the continued
+    /// `beta_e`, written `(q_net - dv_dt) beta_e / (V + c_wall beta_e)` (the same number, finite
+    /// as `beta_e -> 0`), plus a relaxation back to `P_ABS_MIN`, `d^2 / ((d + P_ABS_MIN) tau)`
+    /// with the depth `d = P_ABS_MIN - p_abs` and `tau` = [`TAU_VACUUM`]. Cavitation-consistent:
+    /// oil cannot hold a tension, so a pressure below vacuum is a cavity that opens at once (the
+    /// flows then change its size, not the pressure: the flow term vanishes with `beta_e`), and
+    /// the pressure returns to vacuum. The relaxation starts with zero value and slope (the rate
+    /// is continuously differentiable in `p`), grows as `d / tau` for `d >> P_ABS_MIN`, and
+    /// dominates the flow term, which is below `|q_net - dv_dt| P_ABS_MIN / V` there, for any
+    /// flow a trial state gives: every state has a finite rate, and one below vacuum is pulled
+    /// back. Nothing above `P_ABS_MIN` changes. tau = 1 ms is slower than the oil's own pressure
+    /// modes (time constants down to microseconds), so the continuation adds no stiffness, and
+    /// fast against the motion (periods of 0.3 s). The alternative, Model Exchange answering such
+    /// a state with Discard (FMI 2.0, 2.1.3), made fmpy's CVode stop: its right-hand-side
+    /// callback takes a Discard for an unrecoverable failure.
     pub fn pressure_rate<T: Scalar>(&self, p: T, q_net: T, v0: T, dv_dt: T, c_wall: f64) -> T {
         let v = v0 + p * c_wall;
-        (q_net - dv_dt) / (v / self.bulk_modulus(p) + c_wall)
+        if p.re() + P_ATM >= P_ABS_MIN {
+            return (q_net - dv_dt) / (v / self.bulk_modulus(p) + c_wall);
+        }
+        let beta_e = self.bulk_modulus(p);
+        let d = -(p + (P_ATM - P_ABS_MIN));
+        (q_net - dv_dt) * beta_e / (v + beta_e * c_wall) + d * d / ((d + P_ABS_MIN) * TAU_VACUUM)
     }
 }
 
@@ -177,6 +222,40 @@ mod tests {
         let simscape = Fluid { air_fraction: 5e-3, ..f };
         let reduction = 100.0 * (1.0 - simscape.bulk_modulus(AIR_PRESSURES[0]) / f.beta);
         assert_eq!(stated, format!("{reduction:.1}").parse::<f64>().unwrap(), "the law gives {reduction} %");
+    }
+
+    /// The continuation below [`P_ABS_MIN`] (issue 49). Continuously differentiable there: the
+    /// bulk modulus and the pressure rate 1e-10 Pa below and at the threshold, value and slope
+    /// (dual parts) within 1e-3 relative, the slopes also within the relaxation's own slope there,
+    /// below `2 delta / (P_ABS_MIN tau)` = 2e-4 /s at `delta` = 1e-10 Pa (the flow terms' are
+    /// 0.06 to 11 /s). Below vacuum, for suction, no flow and inflow
+    /// far beyond the circuit's (+-100 l/min, a piston at 1 m/s), the rate is positive (back
+    /// towards vacuum), finite and within `d / tau + |q| P_ABS_MIN / V`.
+    #[test]
+    fn continued_below_vacuum() {
+        let f = fluid();
+        let (v0, c_wall) = (300.0 * CM3, 0.00065e-5 * 150.0 * CM3);
+        let at = P_ABS_MIN - P_ATM;
+        let relaxation_slope = 2.0 * 1e-10 / (P_ABS_MIN * TAU_VACUUM);
+        let close = |a: Dual64, b: Dual64| {
+            (a.re - b.re).abs() <= 1e-3 * a.re.abs()
+                && (a.eps - b.eps).abs() <= 1e-3 * a.eps.abs() + relaxation_slope
+        };
+        let (k, below) = (f.bulk_modulus(Dual64::new(at, 1.0)), f.bulk_modulus(Dual64::new(at - 1e-10, 1.0)));
+        assert!(close(k, below), "{k:?} vs {below:?}");
+        for q in [-lpm(100.0), -lpm(1.0), 0.0, lpm(1.0), lpm(100.0), 3.3e-3] {
+            let rate = |p: Dual64| f.pressure_rate(p, Dual64::from(q), Dual64::from(v0), Dual64::from(0.0), c_wall);
+            let (k, below) = (rate(Dual64::new(at, 1.0)), rate(Dual64::new(at - 1e-10, 1.0)));
+            if q != 0.0 {
+                assert!(close(k, below), "q = {q}: {k:?} vs {below:?}");
+            }
+            for depth in [1e-3, 1.0, 1e3, 1e5, 1e7] {
+                let p = -P_ATM - depth;
+                let r = f.pressure_rate(p, q, v0, 0.0, c_wall);
+                let bound = (depth + P_ABS_MIN) / TAU_VACUUM + q.abs() * P_ABS_MIN / (v0 + c_wall * p);
+                assert!(r > 0.0 && r <= bound, "q = {q}, {depth} Pa below vacuum: {r} (bound {bound})");
+            }
+        }
     }
 
     /// Oil mass conservation and the vacuum bound: integrate a volume driven by a prescribed

@@ -254,10 +254,6 @@ impl Model for HydraulicBoom {
         Ok(())
     }
 
-    fn outside_domain(x: &[f64]) -> Option<String> {
-        super::circuit::below_absolute_zero(x)
-    }
-
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         super::circuit::event_indicators(&self.plant.circuit, self.state[circuit::X_V], values.real(vr::U_REF), z);
     }

@@ -280,10 +280,6 @@ impl Model for HydraulicCircuit {
         Ok(())
     }
 
-    fn outside_domain(x: &[f64]) -> Option<String> {
-        super::circuit::below_absolute_zero(x)
-    }
-
     fn event_indicators(&self, values: &Values, z: &mut [f64]) {
         super::circuit::event_indicators(&self.sys.circuit, self.state[circuit::X_V], values.real(vr::U_REF), z);
     }
