@@ -14,6 +14,7 @@ pub mod cosim;
 pub mod deflection_study;
 pub mod figures;
 pub mod in_process;
+pub mod jacobian_cost;
 pub mod pack;
 pub mod platform;
 pub mod reference;

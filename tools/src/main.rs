@@ -53,12 +53,17 @@ enum Cmd {
         /// (`solver.mode`), over `--repeats` runs of `--duration` s (in-process).
         #[arg(long)]
         realtime: bool,
+        /// Instead: the time of one Jacobian of the flexible plant at U's start in RHS
+        /// evaluations, finite differences against the exact one in dual numbers, under the
+        /// thesis' damping law and the default (in-process, a few seconds).
+        #[arg(long)]
+        jacobian: bool,
         /// Runs per case of `--realtime`, > 0.
         #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         repeats: u32,
         /// A parameter of the HydraulicBoom, NAME=VALUE (repeatable): every case runs with the
         /// defaults and then with these, and the table adds their ratios (same run, so load
-        /// cancels), e.g. --set boom.damping=1.
+        /// cancels), e.g. --set boom.damping=structural.
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
         set: Vec<String>,
     },
@@ -263,6 +268,25 @@ fn bench_changes(
     Ok(())
 }
 
+/// `boomsim bench --jacobian`: one Jacobian of the flexible plant in RHS evaluations.
+fn bench_jacobian() -> Result<(), String> {
+    println!("| boom.damping | states | RHS [us] | finite differences: RHS | time / RHS | dual numbers: time / RHS | difference |");
+    println!("| --- | --- | --- | --- | --- | --- | --- |");
+    for c in boomsim_tools::jacobian_cost::measure(&["thesis", "modal"])? {
+        println!(
+            "| {} | {} | {:.2} | {} | {:.1} | {:.1} | {:.1e} |",
+            c.law,
+            c.states,
+            c.rhs_s * 1e6,
+            c.fd_rhs,
+            c.fd_equivalents,
+            c.dual_equivalents,
+            c.difference
+        );
+    }
+    Ok(())
+}
+
 fn bench_realtime(repeats: usize, duration: f64) -> Result<(), String> {
     println!(
         "doStep distributions: {repeats} x {duration} s per row, 1 ms steps, rtol 1e-6, in-process; \
@@ -423,6 +447,7 @@ fn main() -> ExitCode {
              it does not go with --realtime"
             .into()),
         Cmd::Bench { realtime: true, duration, repeats, .. } => bench_realtime(repeats as usize, duration),
+        Cmd::Bench { jacobian: true, .. } => bench_jacobian(),
         Cmd::Bench { json, duration, model_exchange, set, .. } => {
             bench(json, duration, &set).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
         }
