@@ -25,7 +25,8 @@ from boomsim import regression
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VERSION = next(line.split('"')[1] for line in (ROOT / "python" / "pyproject.toml").read_text().splitlines()
                if line.startswith("version = "))
-WHEEL = ROOT / "dist" / f"boomsim-{VERSION}-py3-none-any.whl"
+#: The wheel of scripts/wheel, tagged for its binaries' platforms (scripts/wheel_tag.py).
+WHEEL = next((ROOT / "dist").glob(f"boomsim-{VERSION}-py3-none-*.whl"), ROOT / "dist" / f"boomsim-{VERSION}.whl")
 
 
 @pytest.fixture(scope="module")
@@ -142,6 +143,31 @@ def test_every_console_script_answers_help(installed):
             assert r.stdout.startswith("usage:"), (name, r.stdout[:200])
         else:
             assert r.returncode == 2 and len(lines) == 1 and 'pip install "boomsim[' in lines[0], (name, r.stderr)
+
+
+def test_the_wheel_installs_only_where_its_binaries_run(tmp_path):
+    """The wheel's tag names the three platforms of the FMUs' binaries (PEP 425 compressed tag
+    set: manylinux x86_64 and aarch64 with the glibc the .so files need, win_amd64), so pip
+    resolves it for those and refuses it for macOS ("is not a supported wheel on this platform"),
+    where no FMU could run. pip's --dry-run with --platform asks exactly that question; the
+    fixture `installed` installs it on this machine the ordinary way. The README
+    states the glibc the tag names."""
+    tags = WHEEL.name.removesuffix(".whl").split("-")[-1].split(".")
+    assert sorted("_".join(t.split("_")[3:]) if t.startswith("manylinux") else t for t in tags) == \
+        ["aarch64", "win_amd64", "x86_64"], tags
+
+    def resolves(platform: str):
+        return subprocess.run([sys.executable, "-m", "pip", "install", "--dry-run", "--no-deps", "-q",
+                               "--disable-pip-version-check", "--only-binary=:all:", "--target", str(tmp_path),
+                               "--platform", platform, str(WHEEL)], capture_output=True, text=True)
+
+    for platform in tags:  # (pip 23's --platform does not widen a manylinux tag to older glibc)
+        r = resolves(platform)
+        assert r.returncode == 0, (platform, r.stderr)
+    r = resolves("macosx_11_0_arm64")
+    assert r.returncode != 0 and "is not a supported wheel on this platform" in r.stderr, r.stderr
+    glibc = next(t for t in tags if t.startswith("manylinux")).split("_")[1:3]
+    assert f"glibc {'.'.join(glibc)} or later" in (ROOT / "README.md").read_text(), "README's requirement"
 
 
 def test_the_release_folder_has_every_fmu_and_checks_out():
