@@ -359,8 +359,8 @@ pub unsafe fn set_string<M: Model>(
     set::<M, fmi3String>(c, f, (vr, n, v, nv), BaseType::String, |p| calls::string_value(p))
 }
 
-/// The get and set functions of the types no variable has (Float32, Int8 ... UInt64, Binary,
-/// Clock): the first value reference is named with its variable's actual type; none is OK.
+/// The get and set functions of the types no variable has (Float32, Int8 ... UInt32, UInt64,
+/// Binary, Clock): the first value reference is named with its variable's actual type; none is OK.
 pub unsafe fn other_type<M: Model>(
     c: fmi3Instance,
     function: &'static str,
