@@ -36,7 +36,11 @@ fn start_values<M: Model>(values: &Map<String, Json>) -> Result<Vec<(u32, Value)
             }
             (BaseType::Boolean, Json::Bool(b)) => Value::Boolean(*b),
             (BaseType::Enumeration, Json::String(s)) => Value::Integer(v.item_value(s)?),
-            (BaseType::Enumeration, Json::Number(n)) => Value::Integer(v.item_value(&n.to_string())?),
+            // a whole number as Python's json writes it (0.0: "0" here) is an item's value
+            (BaseType::Enumeration, Json::Number(n)) => {
+                let whole = n.as_f64().filter(|x| x.fract() == 0.0).ok_or_else(bad)?;
+                Value::Integer(v.item_value(&whole.to_string())?)
+            }
             _ => return Err(bad()),
         };
         out.push((v.vr, x));

@@ -101,7 +101,7 @@ impl Fluid {
     pub fn pressure_rate<T: Scalar>(&self, p: T, q_net: T, v0: T, dv_dt: T, c_wall: f64) -> T {
         let v = v0 + p * c_wall;
         if p.re() + P_ATM >= P_ABS_MIN {
-            return (q_net - dv_dt) / (v / self.bulk_modulus(p) + c_wall);
+            return (q_net - dv_dt) / (v / self.mixture(p) + c_wall);
         }
         let beta_e = self.bulk_modulus(p);
         let d = -(p + (P_ATM - P_ABS_MIN));
