@@ -607,14 +607,20 @@ impl<M: Model> Instance<M> {
         Ok(c.values.take_non_finite())
     }
 
-    /// Writes the outputs of the state a step reached; `Err` names the first Real that is not a
-    /// finite number (the model left its valid range): such a step is not done.
+    /// Writes the outputs of the state a step reached; `Err` names what left the model's domain
+    /// ([`Model::in_domain`]) or the first Real that is not a finite number: such a step is not
+    /// done.
     fn outputs_at_step_end(&mut self) -> Result<(), String> {
-        let Some(i) = self.write_current_outputs()? else {
-            return Ok(());
-        };
+        let non_finite = self.write_current_outputs()?;
         let c = &mut self.core;
+        let outside = c.model.as_ref().map_or(Ok(()), |m| m.in_domain());
+        if non_finite.is_none() && outside.is_ok() {
+            return Ok(());
+        }
         c.outputs_current = false;
+        let Some(i) = non_finite else {
+            return Err(format!("{} at t = {}", outside.err().unwrap_or_default(), num(c.time)));
+        };
         let x = if let Value::Real(x) = c.values.at(i) { *x } else { f64::NAN };
         Err(format!("{} = {} at t = {}: the model left its valid range", M::VARIABLES[i].name, num(x), num(c.time)))
     }

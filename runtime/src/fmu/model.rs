@@ -149,6 +149,13 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Writes outputs and locals from the current state and inputs.
     fn outputs(&self, values: &mut Values);
 
+    /// Whether the state a Co-Simulation step reached is inside the model's domain (checked at
+    /// every step end with the outputs, so O(1)); `Err` names the variable, its value and its valid
+    /// range, and the step is not done. Default: every state is.
+    fn in_domain(&self) -> Result<(), String> {
+        Ok(())
+    }
+
     /// Writes the continuous states ([`Model::STATES`] order).
     fn continuous_states(&self, x: &mut [f64]);
 

@@ -65,6 +65,15 @@ impl Cylinder {
         (T::from(self.stroke) - x) * self.area_b() + self.v_dead_b
     }
 
+    /// The strokes at which a chamber's volume `V_CH + A x` is gone (m): the piston pressed past
+    /// an end stop through the dead volume, into the barrel's end or the rod's gland. Between them
+    /// the stops are contacts that yield (1e8 N/m: 15 mm at the piston side takes 1.5 MN, 16 times
+    /// the largest pressure force); outside them the cylinder is broken, and no model of it is
+    /// valid. The thesis has no such limit (its simulations never reach the stops).
+    pub fn stroke_domain(&self) -> (f64, f64) {
+        (-self.v_dead_a / self.area_a(), self.stroke + self.v_dead_b / self.area_b())
+    }
+
     /// End-stop force on the rod (N, positive extending): zero inside `[0, s_c]`, pushing
     /// outward at the bottom stop (`x < 0`) and inward at the top stop (`x > s_c`).
     ///

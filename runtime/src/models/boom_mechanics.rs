@@ -15,6 +15,7 @@ use super::exposed::{BOOM_DERIVATIVES, BOOM_STATES};
 use super::terminals;
 use super::table::{out, TableBuilder, FLEXIBLE_SWITCH, N_BOOM_ROWS, SOLVER_VARIABLES, START_STROKE, TIP_DEFLECTION};
 use crate::fmu::driver::Step;
+use crate::fmu::log::num;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::Circuit;
 use crate::hydraulics::cylinder::Cylinder;
@@ -258,6 +259,24 @@ impl Model for BoomMechanics {
 
     fn model_exchange_check(values: &Values) -> Result<(), String> {
         port::model_exchange_check(values)
+    }
+
+    /// The stroke within the cylinder's ([`Cylinder::stroke_domain`]): a force past the stops'
+    /// strength (above 1.5 MN at the defaults) drives the piston through the barrel's end, and
+    /// further on the rigid boom's triangle folds flat (dead centre), where the equations end.
+    fn in_domain(&self) -> Result<(), String> {
+        let b = self.sys.boom.mechanics();
+        let x = b.stroke(&self.state[..b.dof()]);
+        let (lo, hi) = self.sys.cylinder.stroke_domain();
+        if (lo..=hi).contains(&x) {
+            return Ok(());
+        }
+        Err(format!(
+            "cylinder.x = {} m is past an end stop by more than the chamber's dead volume: the piston is through the cylinder's end (valid: [{}, {}] m, the strokes at which a chamber's volume is gone)",
+            num(x),
+            num(lo),
+            num(hi)
+        ))
     }
 
     fn continuous_states(&self, x: &mut [f64]) {
