@@ -194,3 +194,43 @@ def test_the_damping_tables_model_exchange_counts_are_the_interface_tables():
         thesis, modal, ratio = int(cells[2].replace(" ", "")), int(cells[4].replace(" ", "")), cells[5]
         assert modal == me[case], f"{case} flexible ME: {modal} RHS on performance.md, {me[case]} on interfaces.md"
         assert rounds_to(ratio, thesis / modal), f"{case}: {ratio} against {thesis / modal:.4g}"
+
+
+def test_the_test_commands_duration_is_the_changelogs_range():
+    """README.md and docs/development.md give `scripts/test`'s duration as the range of the quiet
+    fresh-clone runs that CHANGELOG.md tables, rounded to whole minutes."""
+    quiet = []
+    for line in (ROOT / "CHANGELOG.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 7 and cells[3] == "quiet":
+            quiet.append(float(cells[4]))
+    assert len(quiet) >= 2, "CHANGELOG.md's table of test command durations has no quiet runs"
+    stated = f"`scripts/test` {round(min(quiet))} to {round(max(quiet))} minutes from a fresh clone"
+    for page in (ROOT / "README.md", DOCS / "development.md"):
+        assert stated in " ".join(page.read_text().split()), f"{page.name} should say: {stated}"
+
+
+def test_the_cylinders_domain_is_its_dead_volumes():
+    """docs/models.md's end-stop paragraph: BoomMechanics' stroke domain ends where a chamber's
+    dead volume is gone, V_dead / area past a stop (areas of the bore and the annulus from the
+    diameters), computed here from HydraulicBoom's parameters (the same cylinder), to the digits
+    stated, and the force the stops take there, k_stop times the piston side's distance."""
+    import math
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(ROOT / "modelDescription" / "HydraulicBoom.xml").getroot()
+    p = {v.get("name"): float(v[0].get("start")) for v in root.iter("ScalarVariable")
+         if v.get("name", "").startswith("cylinder.") and v.get("causality") == "parameter"}
+    a = math.pi / 4 * p["cylinder.d_piston"] ** 2
+    a_rod_side = math.pi / 4 * (p["cylinder.d_piston"] ** 2 - p["cylinder.d_rod"] ** 2)
+    below, above = p["cylinder.v_dead_a"] / a * 1e3, p["cylinder.v_dead_b"] / a_rod_side * 1e3
+    text = page("models.md")
+    stated = re.search(r"\(([\d.]+) mm at the piston side, ([\d.]+) mm at the rod side\)", text)
+    domain = re.search(r"the stroke from -([\d.]+) to ([\d.]+) mm", text)
+    force = re.search(r"the stops take up to ([\d.]+) MN", text)
+    assert stated and domain and force, "models.md's end-stop paragraph changed its wording"
+    check(stated[1], below, "piston side")
+    check(stated[2], above, "rod side")
+    check(domain[1], below, "domain's lower end")
+    check(domain[2], p["cylinder.stroke"] * 1e3 + above, "domain's upper end")
+    check(force[1], p["cylinder.k_stop"] * below * 1e-3 / 1e6, "the stops' force there")
