@@ -2,13 +2,12 @@
 //! (the parts FMI 3.0 writes alike are in [`crate::xml`]).
 
 use crate::xml::{
-    default_experiment, document, element, enumeration_attrs, enumeration_items, flag, initial_unknowns,
-    log_categories, real_attrs, root_attrs, unit_definitions, variable_attrs, Attrs, Xml,
+    default_experiment, document, element, enumeration_attrs, enumeration_items, flag, log_categories,
+    model_structure, real_attrs, root_attrs, unit_definitions, variable_attrs, Attrs, Unknowns, Xml,
 };
 use boomsim::fmu::guid::guid;
 use boomsim::fmu::model::Model;
-use boomsim::fmu::structure::probe;
-use boomsim::fmu::variables::{enumerations, Causality, Kind, Variable};
+use boomsim::fmu::variables::{enumerations, Kind, Variable};
 use std::io;
 
 pub use crate::xml::{dependencies, initial_dependencies};
@@ -115,45 +114,6 @@ fn write<M: Model>() -> io::Result<String> {
             }
             Ok(())
         })?;
-        model_structure::<M>(w)
+        model_structure::<M>(w, Unknowns::Fmi2, indices::<M>)
     })
-}
-
-fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
-    let structure = probe::<M>();
-    let deps = dependencies::<M>(&structure);
-    w.create_element("ModelStructure").write_inner_content(|w| {
-        let unknown = |w: &mut Xml, vr: u32, deps: &[u32]| {
-            element(w, "Unknown", &vec![("index", indices::<M>(&[vr])), ("dependencies", indices::<M>(deps))])
-        };
-        let outputs: Vec<&Variable> = M::VARIABLES.iter().filter(|v| v.causality == Causality::Output).collect();
-        if !outputs.is_empty() {
-            w.create_element("Outputs").write_inner_content(|w| {
-                for v in &outputs {
-                    unknown(w, v.vr, &deps[&v.vr])?;
-                }
-                Ok(())
-            })?;
-        }
-        if !M::STATES.is_empty() {
-            // The order of the state vector (fmi2GetContinuousStates).
-            w.create_element("Derivatives").write_inner_content(|w| {
-                for s in M::STATES {
-                    unknown(w, s.derivative, &deps[&s.derivative])?;
-                }
-                Ok(())
-            })?;
-        }
-        let initial = initial_unknowns::<M>(&structure);
-        if !initial.is_empty() {
-            w.create_element("InitialUnknowns").write_inner_content(|w| {
-                for (vr, deps) in &initial {
-                    unknown(w, *vr, deps)?;
-                }
-                Ok(())
-            })?;
-        }
-        Ok(())
-    })?;
-    Ok(())
 }

@@ -12,15 +12,14 @@
 //! the unused sections beyond `boom.n2 + boom.n3` need no structural parameter for an array size.
 
 use crate::xml::{
-    default_experiment, dependencies, document, element, enumeration_attrs, enumeration_items, flag, initial_unknowns,
-    log_categories, range_attrs, root_attrs, unit_attrs, unit_definitions, variable_attrs, Attrs, Xml,
+    default_experiment, document, element, enumeration_attrs, enumeration_items, flag, log_categories,
+    model_structure, range_attrs, root_attrs, unit_attrs, unit_definitions, variable_attrs, Attrs, Unknowns, Xml,
 };
 use boomsim::fmu::guid::token;
 use boomsim::fmu::instance::INDEPENDENT_VR;
 use boomsim::fmu::log::num;
 use boomsim::fmu::model::{clock_row, has_event_mode, Model};
-use boomsim::fmu::structure::probe;
-use boomsim::fmu::variables::{enumerations, Causality, Kind, Variable};
+use boomsim::fmu::variables::{enumerations, Kind, Variable};
 use std::io;
 
 /// The complete FMI 3.0 modelDescription.xml of model `M`.
@@ -188,36 +187,6 @@ fn write<M: Model>() -> io::Result<String> {
             }
             Ok(())
         })?;
-        model_structure::<M>(w)
+        model_structure::<M>(w, Unknowns::Fmi3, references)
     })
-}
-
-/// FMI 3.0, 2.4.8: Output, ContinuousStateDerivative (in the order of the state vector),
-/// ClockedState (without `dependencies`: on every known), InitialUnknown and EventIndicator (in
-/// the order of fmi3GetEventIndicators), each with its dependencies by value reference.
-fn model_structure<M: Model>(w: &mut Xml) -> io::Result<()> {
-    let structure = probe::<M>();
-    let deps = dependencies::<M>(&structure);
-    w.create_element("ModelStructure").write_inner_content(|w| {
-        let unknown = |w: &mut Xml, name: &str, vr: u32, deps: &[u32]| {
-            element(w, name, &vec![("valueReference", vr.to_string()), ("dependencies", references(deps))])
-        };
-        for v in M::VARIABLES.iter().filter(|v| v.causality == Causality::Output) {
-            unknown(w, "Output", v.vr, &deps[&v.vr])?;
-        }
-        for s in M::STATES {
-            unknown(w, "ContinuousStateDerivative", s.derivative, &deps[&s.derivative])?;
-        }
-        for v in M::VARIABLES.iter().filter(|v| v.previous.is_some()) {
-            element(w, "ClockedState", &vec![("valueReference", v.vr.to_string())])?;
-        }
-        for (vr, deps) in &initial_unknowns::<M>(&structure) {
-            unknown(w, "InitialUnknown", *vr, deps)?;
-        }
-        for &vr in M::EVENT_INDICATORS {
-            unknown(w, "EventIndicator", vr, &deps[&vr])?;
-        }
-        Ok(())
-    })?;
-    Ok(())
 }

@@ -1,7 +1,7 @@
 //! modelDescription.xml, generated with quick-xml from a model's variable table: [`fmi2`] and
 //! [`fmi3`] write each version's schema; this module what they share: the document frame,
-//! units, log categories, default experiment, and which unknowns of ModelStructure depend on
-//! which knowns (by value reference; FMI 2.0 writes them as indices, FMI 3.0 as value
+//! units, log categories, default experiment, and ModelStructure ([`model_structure`]: which
+//! unknowns depend on which knowns; FMI 2.0 writes them as indices in groups, FMI 3.0 as value
 //! references).
 
 pub mod fmi2;
@@ -10,7 +10,7 @@ pub mod terminals;
 
 use boomsim::fmu::log::{num, GENERIC_CATEGORIES};
 use boomsim::fmu::model::{initial_unknown, Model};
-use boomsim::fmu::structure::Structure;
+use boomsim::fmu::structure::{probe, Structure};
 use boomsim::fmu::variables::{fmi_name, Causality, Initial, Kind, Variability, Variable};
 use boomsim::params::Enumeration;
 use boomsim::units::{self, BASE_NAMES};
@@ -239,4 +239,56 @@ pub fn initial_unknowns<M: Model>(structure: &Structure) -> Vec<(u32, Vec<u32>)>
             Some((v.vr, deps))
         })
         .collect()
+}
+
+/// How a version writes ModelStructure's unknowns: FMI 2.0 groups `<Unknown index=...>` under
+/// `<Outputs>`, `<Derivatives>`, `<InitialUnknowns>` and has no clocked states or event
+/// indicators there; FMI 3.0 writes one element per unknown, named by its kind, with
+/// `valueReference`.
+pub enum Unknowns {
+    Fmi2,
+    Fmi3,
+}
+
+/// ModelStructure of model `M` (FMI 2.0, 2.2.8; FMI 3.0, 2.4.8), the one writer of both
+/// versions: outputs, derivatives (in the order of the state vector), clocked states (on every
+/// known: no `dependencies`), initial unknowns, event indicators (in the order of
+/// fmi3GetEventIndicators), each with its knowns, written by `refs` (indices or value references).
+pub fn model_structure<M: Model>(w: &mut Xml, version: Unknowns, refs: impl Fn(&[u32]) -> String) -> io::Result<()> {
+    let structure = probe::<M>();
+    let deps = dependencies::<M>(&structure);
+    let with = |vr: u32| (vr, Some(deps[&vr].clone()));
+    let outputs = M::VARIABLES.iter().filter(|v| v.causality == Causality::Output).map(|v| with(v.vr)).collect();
+    let derivatives = M::STATES.iter().map(|s| with(s.derivative)).collect();
+    let clocked = M::VARIABLES.iter().filter(|v| v.previous.is_some()).map(|v| (v.vr, None)).collect();
+    let initial = initial_unknowns::<M>(&structure).into_iter().map(|(vr, d)| (vr, Some(d))).collect();
+    let indicators = M::EVENT_INDICATORS.iter().map(|&vr| with(vr)).collect();
+    // (FMI 2.0 group, FMI 3.0 element, its unknowns)
+    let lists: [(&str, &str, Vec<(u32, Option<Vec<u32>>)>); 5] = [
+        ("Outputs", "Output", outputs),
+        ("Derivatives", "ContinuousStateDerivative", derivatives),
+        ("", "ClockedState", clocked),
+        ("InitialUnknowns", "InitialUnknown", initial),
+        ("", "EventIndicator", indicators),
+    ];
+    w.create_element("ModelStructure").write_inner_content(|w| {
+        for (group, name, unknowns) in &lists {
+            let write = |w: &mut Xml, name: &str, reference: &'static str| {
+                unknowns.iter().try_for_each(|(vr, deps)| {
+                    let mut attrs = vec![(reference, refs(&[*vr]))];
+                    attrs.extend(deps.as_deref().map(|d| ("dependencies", refs(d))));
+                    element(w, name, &attrs)
+                })
+            };
+            match version {
+                Unknowns::Fmi3 => write(w, name, "valueReference")?,
+                Unknowns::Fmi2 if group.is_empty() || unknowns.is_empty() => {}
+                Unknowns::Fmi2 => {
+                    w.create_element(*group).write_inner_content(|w| write(w, "Unknown", "index"))?;
+                }
+            }
+        }
+        Ok(())
+    })?;
+    Ok(())
 }
