@@ -1,13 +1,11 @@
-//! `export_fmu!`: emits the 44 FMI 2.0 symbols (Model Exchange and Co-Simulation) for one model,
-//! and the FMI 3.0 ones ([`crate::export_fmi3`]). A cdylib crate under `fmu/<ModelIdentifier>/`
-//! consists of this one invocation.
+//! `export_fmi2!`: emits the 44 FMI 2.0 symbols (Model Exchange and Co-Simulation) for one model;
+//! [`crate::export_fmu`] invokes it beside [`crate::export_fmi3`].
 
-/// Exports the FMI 2.0 C ABI (25 common + 9 Co-Simulation + 10 Model Exchange functions) and the
-/// FMI 3.0 C ABI for a [`Model`](crate::fmu::Model).
+/// Exports the FMI 2.0 C ABI (25 common + 9 Co-Simulation + 10 Model Exchange functions) for a
+/// [`Model`](crate::fmu::Model).
 #[macro_export]
-macro_rules! export_fmu {
+macro_rules! export_fmi2 {
     ($model:ty) => {
-        $crate::export_fmi3!($model);
         mod fmi2_exports {
             use super::*;
             use std::os::raw::{c_char, c_int};

@@ -1,7 +1,6 @@
 //! `export_fmi3!`: emits the FMI 3.0 symbols for one model: every function of
 //! fmi3FunctionTypes.h (common, Model Exchange, Co-Simulation, and Scheduled Execution and
-//! clocks, which are refused). [`crate::export_fmu`] invokes it beside the FMI 2.0 symbols, so
-//! one cdylib serves both versions' .fmu files (the names differ: fmi2* and fmi3*).
+//! clocks, which are refused); [`crate::export_fmu`] invokes it beside [`crate::export_fmi2`].
 
 /// Exports the FMI 3.0 C ABI for a [`Model`](crate::fmu::Model).
 #[macro_export]

@@ -6,6 +6,7 @@
 
 pub mod calls;
 pub mod driver;
+mod export;
 mod forward;
 pub mod snapshot;
 pub mod guid;
