@@ -234,3 +234,7 @@ def test_the_cylinders_domain_is_its_dead_volumes():
     check(domain[1], below, "domain's lower end")
     check(domain[2], p["cylinder.stroke"] * 1e3 + above, "domain's upper end")
     check(force[1], p["cylinder.k_stop"] * below * 1e-3 / 1e6, "the stops' force there")
+    conformance = re.search(r"the stroke outside \[-([\d.]+), ([\d.]+)\] mm", page("conformance.md"))
+    assert conformance, "conformance.md's domain sentence changed its wording"
+    check(conformance[1], below, "conformance.md's lower end")
+    check(conformance[2], p["cylinder.stroke"] * 1e3 + above, "conformance.md's upper end")
