@@ -238,3 +238,23 @@ def test_the_cylinders_domain_is_its_dead_volumes():
     assert conformance, "conformance.md's domain sentence changed its wording"
     check(conformance[1], below, "conformance.md's lower end")
     check(conformance[2], p["cylinder.stroke"] * 1e3 + above, "conformance.md's upper end")
+
+
+def test_python_md_names_pyprojects_lower_bounds():
+    """docs/python.md lists the oldest versions the package's tests pass on: each is the lower
+    bound pyproject.toml declares (scripts/oldest-deps installs those), and every bound is listed."""
+    import tomllib
+
+    project = tomllib.loads((ROOT / "python" / "pyproject.toml").read_text())["project"]
+    declared = [*project["dependencies"], *(d for extra in ("sweeps", "pandas") for d in project["optional-dependencies"][extra])]
+    bounds = {m[1].lower(): m[2] for d in declared if (m := re.match(r"([A-Za-z_-]+)>=([\d.]+)", d))}
+    text = page("python.md")
+    listed = re.search(r"pass \((.*?)\), which `bash scripts/oldest-deps`", text)
+    assert listed, "docs/python.md's sentence on the lower bounds changed its wording"
+    stated = {}
+    for names, version in re.findall(r"([a-z][a-z, ]*?) ([\d.]+\d)", listed[1].replace(" and ", ", ")):
+        for name in names.split(","):
+            name = name.strip().split()[-1] if name.strip() else ""
+            if name:
+                stated[name] = version
+    assert stated == bounds, f"docs/python.md: {stated}; pyproject.toml: {bounds}"
