@@ -506,12 +506,12 @@ pub const PARAMS: &[Param] = &[
     param!(
         "friction.sigma_1",
         friction.sigma_1,
-        8.22e5,
+        14142.0,
         "N.s/m",
         "",
         [0.0, 1e9],
         "LuGre bristle damping (friction.regularisation = lugre)",
-        "not in the thesis: 2 sqrt(sigma_0 m), critical on the rigid boom's 16.9 t at the stroke (Canudas de Wit et al. 1995)"
+        "not in the thesis: 2 sqrt(sigma_0 m), critical on the piston and rod, cylinder.m_rod = 5 kg (Canudas de Wit et al. 1995)"
     ),
 ];
 
