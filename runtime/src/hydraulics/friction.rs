@@ -5,7 +5,7 @@
 //! pressure force (eq. 2.68: `F1 - F2 - F_L - F_fr - G_rod = m a`). The thesis' laws are
 //! magnitudes with the sign of the velocity, discontinuous at `v = 0`; two regularisations, chosen
 //! by `friction.regularisation` ([`FrictionRegularisation`]), make them an ODE:
-//! - `tanh` (default; the results before issue 49): the law times `tanh(v / v_s)`, smooth (C1)
+//! - `tanh` (default; the law before issue 49): the law times `tanh(v / v_s)`, smooth (C1)
 //!   through `v = 0` and zero at rest, so a rod under a force below the static level creeps;
 //! - `lugre`: the bristle model of Canudas de Wit, Olsson, Astrom & Lischinsky, "A new model for
 //!   control of systems with friction", IEEE TAC 40(3), 1995 (eq. 2-4 there), with a sixth circuit
@@ -48,8 +48,9 @@ impl Choice for FrictionModel {
 /// How [`Friction::force`] makes the law's `sign(v)` continuous (not in the thesis, issue 49).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrictionRegularisation {
-    /// `sign(v)` replaced by `tanh(v / v_s)` (fitted: `tanh(C_tan v)`, eq. 5.4's own): the
-    /// results before issue 49, bit for bit. Creeps under a force below the static level.
+    /// `sign(v)` replaced by `tanh(v / v_s)` (fitted: `tanh(C_tan v)`, eq. 5.4's own): the law
+    /// before issue 49 (the same force for the same arguments, bit for bit). Creeps under a force
+    /// below the static level.
     Tanh,
     /// LuGre (Canudas de Wit et al. 1995): a bristle deflection `z` whose spring `sigma_0 z`
     /// holds the rod below the static level and gives the thesis' law in steady sliding.
