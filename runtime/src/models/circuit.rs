@@ -28,8 +28,8 @@ pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
             _ => format!("friction.f_s = {}, friction.f_c = {}", fr.f_s, fr.f_c),
         };
         return Err(format!(
-            "friction.regularisation = lugre needs a static friction level above 0 (the bristle's deflection is \
-             divided by it): {level}; use friction.regularisation = tanh for no friction"
+            "friction.regularisation = lugre needs a static friction level above 0 (LuGre's bristle rate \
+             divides by it): {level}; use friction.regularisation = tanh for no friction"
         ));
     }
     Ok(circuit)
