@@ -111,7 +111,7 @@ pub struct Friction {
     /// pin (and, flexible, the arm's compliance). Critical for the rigid boom's 16.9 t at the
     /// stroke instead (8.22e5 N s/m) is a dashpot of that size on the sliding rod at every
     /// frequency above `sigma_0 |v| / g`, which costs the flexible arm 3.7 times the RHS of tanh
-    /// (docs/models.md, "LuGre against tanh"). The paper's example takes `sqrt(sigma_0 m)` for
+    /// (docs/friction.md). The paper's example takes `sqrt(sigma_0 m)` for
     /// its 1 kg (damping ratio 0.5).
     pub sigma_1: f64,
 }
@@ -169,10 +169,9 @@ impl Friction {
         }
     }
 
-    /// The smallest static level `g(0)` the law can have (N): Bak's `A p_static` (the pressure
-    /// term only adds), the Stribeck laws' `F_s` (the pressure and stroke terms only add, for
-    /// strokes within the cylinder). LuGre divides by `g(v)`, which stays above
-    /// `min(F_s, F_c)` for the Stribeck laws.
+    /// A lower bound of the level `g(v)` over every speed (N), which LuGre divides by: Bak's
+    /// `A p_static` (its pressure term only adds), `min(F_s, F_c)` for the Stribeck laws (their
+    /// pressure and stroke terms only add, for strokes within the cylinder).
     pub fn static_floor(&self, cyl: &Cylinder) -> f64 {
         match self.model {
             FrictionModel::Bak => cyl.area_a() * self.p_static,
