@@ -104,7 +104,8 @@ pub fn study(changes: &[(&str, Value)], stroke: f64, u_refs: &[f64]) -> Result<S
         return Err(format!("--stroke {} mm is outside the cylinder's stroke [0, {}] mm", stroke / MM, s_c / MM));
     }
     let rest = plant.boom.mechanics().equilibrium(stroke).map_err(|e| format!("no rest at {stroke} m: {e}"))?;
-    let rigid = Plant::from_values(&plant_values(changes.iter().cloned().chain([("boom.flexible", Value::Boolean(false))]))?)?;
+    let rigid =
+        Plant::from_values(&plant_values(changes.iter().cloned().chain([("boom.flexible", Value::Boolean(false))]))?)?;
     let Boom::Rigid(boom) = &rigid.boom else { unreachable!("built rigid") };
     let g = HydraulicBoom::VARIABLES.iter().find(|v| v.name == "env.g").map(|v| values.real(v.vr)).expect("env.g");
     let (c, load) = (plant.circuit, rest.f_cyl);
@@ -128,10 +129,11 @@ fn lowering(c: &Circuit, stroke: f64, load: f64, masses: [f64; 2], u: f64) -> Re
         return Err(format!("u = {u}: the A->T edge cannot pass {q3} m^3/s below the CBV's set pressure"));
     }
     let p2 = bisect(q2, p_t, c.cbv.p_set, 1e-13 * c.cbv.p_set);
-    let point = |betas, hoses| OperatingPoint { p2, ..OperatingPoint::of_volumes(c, stroke, masses[0], load, betas, hoses) };
-    let steady = point([beta; 2], false)
-        .with_flow(q3)
-        .ok_or_else(|| format!("u = {u}: the CBV cannot pass the lowering flow {q3} m^3/s at this load, even fully open"))?;
+    let point =
+        |betas, hoses| OperatingPoint { p2, ..OperatingPoint::of_volumes(c, stroke, masses[0], load, betas, hoses) };
+    let steady = point([beta; 2], false).with_flow(q3).ok_or_else(|| {
+        format!("u = {u}: the CBV cannot pass the lowering flow {q3} m^3/s at this load, even fully open")
+    })?;
     let p4 = steady.p4;
     let p3 = steady.linearise().map_err(|e| format!("u = {u}: {e}"))?.p3;
     let at = |betas, hoses| -> Result<(OperatingPoint, Linearised), String> {
