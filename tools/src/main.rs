@@ -111,6 +111,12 @@ enum Cmd {
     /// Linear stability analysis and pressure-feedback tuning (thesis sections 2.3, 6.1).
     #[command(allow_negative_numbers = true)]
     Analyze(Box<boomsim_tools::analysis::cli::AnalyzeArgs>),
+    /// The critical stroke of section 2.3's instability criterion for the HydraulicBoom's
+    /// parameters (eq. 2.87; 2.86 with line and dead volumes; 2.84 with the oil-air law, the A->T
+    /// edge's back pressure, rigid lines and hoses), at steady lowerings without pressure
+    /// feedback, and the linear frequencies (eq. 2.81) at a stroke.
+    #[command(allow_negative_numbers = true)]
+    Criterion(boomsim_tools::analysis::criterion_cli::CriterionArgs),
     /// The HydraulicBoom's linear model dx = A x + B u, y = C x + D u at an operating point (a
     /// steady lowering, rest, or a time of a run), open or closed with the pressure feedback,
     /// from exact derivatives: eigenvalues, margins, Bode data, .json/.npz/.mat files.
@@ -463,6 +469,7 @@ fn main() -> ExitCode {
         Cmd::Deflection { json } => deflection(json),
         Cmd::Cosim => boomsim_tools::cosim::main(),
         Cmd::Analyze(args) => boomsim_tools::analysis::cli::run(&args, root()),
+        Cmd::Criterion(args) => boomsim_tools::analysis::criterion_cli::run(&args),
         Cmd::Linearize(args) => boomsim_tools::analysis::linearize_cli::run(&args),
     };
     match result {

@@ -94,7 +94,8 @@ impl AnalyzeArgs {
             p_set: self.p_set.map_or_else(|| p_set_for(mu_p), bar),
             mass,
             load,
-            beta: self.beta.map_or(d.beta, |b| b * 1e6),
+            beta1: self.beta.map_or(d.beta1, |b| b * 1e6),
+            beta2: self.beta.map_or(d.beta2, |b| b * 1e6),
             c1_extra: self.c1_extra * 1e-6 / BAR,
             c2_extra: self.c2_extra * 1e-6 / BAR,
             ..d

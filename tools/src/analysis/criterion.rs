@@ -14,9 +14,11 @@ pub fn required_ratio(op: &OperatingPoint, lin: &Linearised) -> f64 {
     op.mu_c * op.mu_p * lin.k_qu / (lin.k_qu + lin.k_qp * op.p_fo)
 }
 
-/// Required `C2 / C1` of eq. 2.84 (eq. 2.83 with eq. 2.79, 2.80 inserted; equal by algebra).
+/// Required `C2 / C1` of eq. 2.84 (eq. 2.83 with eq. 2.79, 2.80 inserted; equal by algebra), with
+/// the CBV's pressure drop `p3 - p2` for the thesis' `p3` (see [`OperatingPoint::p2`]).
 pub fn required_ratio_steady_state(op: &OperatingPoint, lin: &Linearised) -> f64 {
-    op.mu_c * op.mu_p * 2.0 * lin.p3 / (2.0 * lin.p3 + lin.u_cbv * op.p_fo)
+    let dp = lin.p3 - op.p2;
+    op.mu_c * op.mu_p * 2.0 * dp / (2.0 * dp + lin.u_cbv * op.p_fo)
 }
 
 /// Simplified required `C2 / C1 = mu_c mu_p` (eq. 2.86: `u_cbv p_fo << p3`).
@@ -32,11 +34,11 @@ pub fn is_stable_exact(op: &OperatingPoint, lin: &Linearised) -> bool {
 /// Critical stroke (m) for a required ratio `r`: `C2(x) / C1(x) = r` solved for `x`, stable
 /// below it. `p3` and `u_cbv` do not depend on the stroke (eq. 2.85), so `r` is constant and
 /// the equation is linear in `x`:
-/// `x = (mu_c A s_c / beta + C2_extra - r C1_extra) / ((r + mu_c) A / beta)`.
+/// `x = (mu_c A s_c / beta2 + C2_extra - r C1_extra) / (r A / beta1 + mu_c A / beta2)`.
 /// May lie outside `[0, s_c]` (stable or unstable along the whole stroke).
 pub fn critical_stroke(op: &OperatingPoint, r: f64) -> f64 {
-    let a = op.area / op.beta;
-    (op.mu_c * a * op.stroke + op.c2_extra - r * op.c1_extra) / ((r + op.mu_c) * a)
+    let (a1, a2) = (op.area / op.beta1, op.area / op.beta2);
+    (op.mu_c * a2 * op.stroke + op.c2_extra - r * op.c1_extra) / (r * a1 + op.mu_c * a2)
 }
 
 /// Exact critical stroke (m), eq. 2.84 solved for `x_c`.
@@ -44,15 +46,16 @@ pub fn xc_crit_exact(op: &OperatingPoint, lin: &Linearised) -> f64 {
     critical_stroke(op, required_ratio(op, lin))
 }
 
-/// Where along the stroke `[0, s_c]` a critical stroke `x` (stable below it) leaves the system
-/// stable, as the report says it: "123.4 mm", or that no stroke in the range is critical.
-pub fn describe_critical_stroke(op: &OperatingPoint, x: f64) -> String {
-    let range = format!("[0, {:.1}] mm", op.stroke / boomsim::units::MM);
+/// Where along the stroke `[0, s_c]` of a cylinder with `stroke` a critical stroke `x` (stable
+/// below it) leaves the system stable, as the report says it: "123.4 mm", or that no stroke in
+/// the range is critical.
+pub fn describe_critical_stroke(stroke: f64, x: f64) -> String {
+    let range = format!("[0, {:.1}] mm", stroke / boomsim::units::MM);
     if x.is_nan() {
         "undefined".into()
     } else if x <= 0.0 {
         format!("none: unstable at every stroke in {range} (the root of eq. 2.84 is {:.1} mm)", x / boomsim::units::MM)
-    } else if x >= op.stroke {
+    } else if x >= stroke {
         format!("none: stable at every stroke in {range} (the root of eq. 2.84 is {:.1} mm)", x / boomsim::units::MM)
     } else {
         format!("{:.1} mm", x / boomsim::units::MM)
@@ -125,14 +128,14 @@ mod tests {
         let lin = base.linearise().unwrap();
         let x = xc_crit_exact(&base, &lin);
         assert!(x < 0.0, "{x}");
-        assert!(describe_critical_stroke(&base, x).starts_with("none: unstable at every stroke"));
+        assert!(describe_critical_stroke(base.stroke, x).starts_with("none: unstable at every stroke"));
         // Every stroke short of the full one (there C2 = 0: the piston side has no volume).
         for i in 0..20 {
             let op = OperatingPoint { x_c: base.stroke * i as f64 / 20.0, ..base };
             let lin = op.linearise().unwrap();
             assert!(!closed_loop(lin.c2, &HParams::new(&op, &lin).h()).is_stable(), "x = {}", op.x_c);
         }
-        assert!(describe_critical_stroke(&base, 2.0 * base.stroke).starts_with("none: stable at every stroke"));
-        assert_eq!(describe_critical_stroke(&base, 0.1234), "123.4 mm");
+        assert!(describe_critical_stroke(base.stroke, 2.0 * base.stroke).starts_with("none: stable at every stroke"));
+        assert_eq!(describe_critical_stroke(base.stroke, 0.1234), "123.4 mm");
     }
 }

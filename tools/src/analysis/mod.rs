@@ -5,6 +5,7 @@
 
 pub mod cli;
 pub mod criterion;
+pub mod criterion_cli;
 #[cfg(test)]
 mod dimensions;
 pub mod directional;

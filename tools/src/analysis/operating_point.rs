@@ -50,8 +50,12 @@ pub struct OperatingPoint {
     /// Load force on the rod (N); eq. 2.69 has `m g`. A separate value lets the rigid boom's
     /// static force and its effective mass differ (the nonlinear cross-check).
     pub load: f64,
-    /// Bulk modulus `beta` (Pa).
-    pub beta: f64,
+    /// Bulk modulus `beta` of the piston side, in `C1` (Pa).
+    pub beta1: f64,
+    /// Bulk modulus `beta` of the rod side, in `C2` (Pa). Section 2.3 has one constant `beta`;
+    /// two let the oil-air law's effective bulk modulus at each side's steady pressure in
+    /// (`boomsim criterion`).
+    pub beta2: f64,
     /// Capacitance added to `C1 = V3 / beta` (m^3/Pa): line 3, dead volume, hoses.
     pub c1_extra: f64,
     /// Capacitance added to `C2 = V4 / beta` (m^3/Pa): line 4, dead volume, hoses.
@@ -66,6 +70,10 @@ pub struct OperatingPoint {
     pub k2: f64,
     /// Pressure rise to fully open the load-holding valve `p_fo,cbv` (Pa).
     pub p_fo: f64,
+    /// Steady pressure downstream of the CBV, in line 2 (Pa). Section 2.3 takes the CBV's
+    /// pressure drop as `p3` (line 2 at tank pressure, 0); a positive `p2` (the back pressure of
+    /// the valve's A->T edge) makes it `p3 - p2` in eq. 2.72, 2.79, 2.80 and 2.84.
+    pub p2: f64,
 }
 
 /// The pilot ratio and equivalent mass behind Table 6.1, identified from its `K_f` and
@@ -102,22 +110,36 @@ impl OperatingPoint {
     /// static load (eq. 2.19), the line and dead volumes and hose compliance (eq. 5.2) as extra
     /// capacitance, the CBV's and cylinder's parameters.
     pub fn of_circuit(c: &Circuit, boom: &RigidBoom, x_c: f64, p4: f64) -> Self {
-        let (cyl, ln, beta) = (&c.cylinder, &c.lines, c.fluid.beta);
+        let beta = c.fluid.beta;
+        let op = Self::of_volumes(c, x_c, boom.m_eff(x_c), boom.static_force(x_c), [beta, beta], true);
+        OperatingPoint { p4, ..op }
+    }
+
+    /// The point of section 2.3 for boomsim's circuit `c` at stroke `x_c` with the mass `mass`
+    /// and load `load` at the cylinder, the rod side at tank pressure (0; see
+    /// [`OperatingPoint::with_flow`]): the line and dead volumes as extra capacitance at the bulk
+    /// moduli `[beta1, beta2]` of the piston and rod side, plus the hose compliance (eq. 5.2) if
+    /// `hoses`, the CBV's and cylinder's parameters.
+    pub fn of_volumes(c: &Circuit, x_c: f64, mass: f64, load: f64, [beta1, beta2]: [f64; 2], hoses: bool) -> Self {
+        let (cyl, ln) = (&c.cylinder, &c.lines);
+        let hose = |v: f64| if hoses { ln.hose_compliance(v) } else { 0.0 };
         OperatingPoint {
             x_c,
-            p4,
+            p4: 0.0,
             mu_p: c.cbv.mu_p,
             p_set: c.cbv.p_set,
-            mass: boom.m_eff(x_c),
-            load: boom.static_force(x_c),
-            beta,
-            c1_extra: (cyl.v_dead_a + ln.v_l3) / beta + ln.hose_compliance(ln.v_l3),
-            c2_extra: (cyl.v_dead_b + ln.v_l4) / beta + ln.hose_compliance(ln.v_l4),
+            mass,
+            load,
+            beta1,
+            beta2,
+            c1_extra: (cyl.v_dead_a + ln.v_l3) / beta1 + hose(ln.v_l3),
+            c2_extra: (cyl.v_dead_b + ln.v_l4) / beta2 + hose(ln.v_l4),
             area: cyl.area_a(),
             mu_c: cyl.mu_c(),
             stroke: cyl.stroke,
             k2: c.cbv.k2(),
             p_fo: c.cbv.p_fo_cbv,
+            p2: 0.0,
         }
     }
 }
@@ -136,7 +158,8 @@ impl Default for OperatingPoint {
             p_set: p_set_for(id.mu_p),
             mass: id.mass,
             load: id.mass * BoomParams::default().g,
-            beta: c.fluid.beta,
+            beta1: c.fluid.beta,
+            beta2: c.fluid.beta,
             c1_extra: 0.0,
             c2_extra: 0.0,
             area: c.cylinder.area_a(),
@@ -144,6 +167,7 @@ impl Default for OperatingPoint {
             stroke: c.cylinder.stroke,
             k2: c.cbv.k2(),
             p_fo: c.cbv.p_fo_cbv,
+            p2: 0.0,
         }
     }
 }
@@ -151,17 +175,17 @@ impl Default for OperatingPoint {
 /// The linearised coefficients at an operating point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Linearised {
-    /// `C1 = A_c x_c / beta + extra` (m^3/Pa), piston side (eq. 2.70).
+    /// `C1 = A_c x_c / beta1 + extra` (m^3/Pa), piston side (eq. 2.70).
     pub c1: f64,
-    /// `C2 = mu_c A_c (s_c - x_c) / beta + extra` (m^3/Pa), rod side (eq. 2.71).
+    /// `C2 = mu_c A_c (s_c - x_c) / beta2 + extra` (m^3/Pa), rod side (eq. 2.71).
     pub c2: f64,
     /// `p3^(ss) = mu_c p4 + F / A_c` (Pa), eq. 2.85.
     pub p3: f64,
     /// `u_cbv^(ss) = (mu_p p4 + p3 - p_set) / p_fo,cbv` (-), eq. 2.73.
     pub u_cbv: f64,
-    /// `K_qu = K2 sqrt(p3)` (m^3/s), eq. 2.79.
+    /// `K_qu = K2 sqrt(p3 - p2)` (m^3/s), eq. 2.79.
     pub k_qu: f64,
-    /// `K_qp = K2 u_cbv / (2 sqrt(p3))` (m^3/(s Pa)), eq. 2.80.
+    /// `K_qp = K2 u_cbv / (2 sqrt(p3 - p2))` (m^3/(s Pa)), eq. 2.80.
     pub k_qp: f64,
 }
 
@@ -192,12 +216,12 @@ impl std::error::Error for SteadyStateError {}
 impl OperatingPoint {
     /// `C1` at stroke `x` (m^3/Pa).
     pub fn c1_at(&self, x: f64) -> f64 {
-        self.area * x / self.beta + self.c1_extra
+        self.area * x / self.beta1 + self.c1_extra
     }
 
     /// `C2` at stroke `x` (m^3/Pa).
     pub fn c2_at(&self, x: f64) -> f64 {
-        self.mu_c * self.area * (self.stroke - x) / self.beta + self.c2_extra
+        self.mu_c * self.area * (self.stroke - x) / self.beta2 + self.c2_extra
     }
 
     /// Steady state and linearised coefficients (eq. 2.73, 2.79, 2.80, 2.85).
@@ -206,7 +230,7 @@ impl OperatingPoint {
         if !(0.0..=self.stroke).contains(&self.x_c) {
             return invalid(format!("x_c = {} mm is outside the stroke [0, {}] mm", self.x_c * 1e3, self.stroke * 1e3));
         }
-        for (name, x, unit, scale) in [("mass", self.mass, "kg", 1.0), ("beta", self.beta, "MPa", 1e-6)] {
+        for (name, x, unit, scale) in [("mass", self.mass, "kg", 1.0), ("beta1", self.beta1, "MPa", 1e-6), ("beta2", self.beta2, "MPa", 1e-6)] {
             if !(x > 0.0) {
                 return invalid(format!("{name} = {} {unit} must be > 0", x * scale));
             }
@@ -230,15 +254,19 @@ impl OperatingPoint {
         if u_cbv > 1.0 {
             return Err(SteadyStateError::CbvSaturated { u_cbv });
         }
-        let k_qu = self.k2 * p3.sqrt();
-        let k_qp = self.k2 * u_cbv / (2.0 * p3.sqrt());
+        let dp = p3 - self.p2;
+        if !(dp > 0.0) {
+            return invalid(format!("p3 = {} bar must exceed p2 = {} bar (the CBV's pressure drop)", p3 * 1e-5, self.p2 * 1e-5));
+        }
+        let k_qu = self.k2 * dp.sqrt();
+        let k_qp = self.k2 * u_cbv / (2.0 * dp.sqrt());
         Ok(Linearised { c1, c2, p3, u_cbv, k_qu, k_qp })
     }
 
-    /// Steady CBV flow `Q3 = K2 u_cbv sqrt(p3)` (m^3/s), eq. 2.72; the rod-side inflow is
+    /// Steady CBV flow `Q3 = K2 u_cbv sqrt(p3 - p2)` (m^3/s), eq. 2.72; the rod-side inflow is
     /// `mu_c Q3` (eq. 2.70, 2.71 at rest).
     pub fn flow(&self) -> Result<f64, SteadyStateError> {
-        self.linearise().map(|l| self.k2 * l.u_cbv * l.p3.sqrt())
+        self.linearise().map(|l| self.k2 * l.u_cbv * (l.p3 - self.p2).sqrt())
     }
 
     /// The operating point with the rod-side pressure that carries the steady CBV flow `q3`

@@ -77,7 +77,7 @@ impl Analysis {
         json!({
             "operating_point": {
                 "x_c_mm": op.x_c / MM, "p4_bar": op.p4 / BAR, "mu_p": op.mu_p, "p_set_bar": op.p_set / BAR,
-                "mass_kg": op.mass, "load_N": op.load, "beta_MPa": op.beta / 1e6,
+                "mass_kg": op.mass, "load_N": op.load, "beta1_MPa": op.beta1 / 1e6, "beta2_MPa": op.beta2 / 1e6,
                 "C1_extra": op.c1_extra, "C2_extra": op.c2_extra, "omega_v": self.omega_v,
             },
             "p3_bar": lin.p3 / BAR,
@@ -136,8 +136,8 @@ pub fn text(a: &Analysis) -> String {
         a.h.omega_n,
         a.h.zeta,
         if a.stable_uncompensated { "stable" } else { "unstable" },
-        super::criterion::describe_critical_stroke(&a.op, a.xc_crit_exact),
-        super::criterion::describe_critical_stroke(&a.op, a.xc_crit_simplified),
+        super::criterion::describe_critical_stroke(a.op.stroke, a.xc_crit_exact),
+        super::criterion::describe_critical_stroke(a.op.stroke, a.xc_crit_simplified),
         "n_K",
         "n_omega",
         "K_f",
