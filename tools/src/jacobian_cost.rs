@@ -1,8 +1,10 @@
 //! The cost of one Jacobian of the HydraulicBoom's flexible plant, in right-hand-side
 //! evaluations (issue 48, item 4; `boomsim bench --jacobian`): the integrator's finite
 //! differences (one RHS per state and one at the point, as Radau5 forms them) against the exact
-//! Jacobian in dual numbers (the plant's RHS once per state in `Dual64`, seeded with that state),
-//! each timed in the same process as the RHS itself, so that the machine's load cancels.
+//! Jacobian in dual numbers (the plant's RHS once per state in `Dual64`, seeded with that state)
+//! and the structured one the integrator uses (`OdeSystem::jacobian`: the circuit in dual numbers,
+//! the arm in closed form), each timed in the same process as the RHS itself, so that the
+//! machine's load cancels.
 
 use crate::analysis::modes::plant_values;
 use boomsim::fmu::Value;
@@ -10,6 +12,8 @@ use boomsim::mechanics::params::DampingLaw;
 use boomsim::params::Choice;
 use boomsim::models::hydraulic_boom::Plant;
 use boomsim::scalar::Dual64;
+use boomsim::solver::OdeSystem;
+use nalgebra::DMatrix;
 use std::time::Instant;
 
 /// One law's measurement.
@@ -28,6 +32,10 @@ pub struct JacobianCost {
     /// Largest difference of the two Jacobians over the largest entry of its row (the
     /// differences' truncation error: a check that both are the same matrix).
     pub difference: f64,
+    /// The structured Jacobian: its time over one RHS's, and its largest difference from the
+    /// dual numbers' over the largest entry of the row (round-off).
+    pub structured_equivalents: f64,
+    pub structured_difference: f64,
 }
 
 /// Seconds per call of `f`, the best of 5 rounds of `n` calls.
@@ -76,13 +84,23 @@ fn one(law: &'static str) -> Result<JacobianCost, String> {
             (0..n).for_each(|i| exact[i * n + k] = ds[i].eps);
         }
     });
-    let difference = (0..n)
-        .map(|i| {
-            let row = &exact[i * n..][..n];
-            let size = row.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
-            row.iter().zip(&fd[i * n..][..n]).fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / size))
-        })
-        .fold(0.0, f64::max);
+    let mut jac = DMatrix::zeros(n, n);
+    let structured_s = timed(5000, || {
+        plant.jacobian(0.0, &x, &mut jac);
+    });
+    if !plant.jacobian(0.0, &x, &mut jac) {
+        return Err("the flexible plant has no structured Jacobian".into());
+    }
+    let structured: Vec<f64> = (0..n * n).map(|e| jac[(e / n, e % n)]).collect();
+    let difference = |other: &[f64]| {
+        (0..n)
+            .map(|i| {
+                let row = &exact[i * n..][..n];
+                let size = row.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
+                row.iter().zip(&other[i * n..][..n]).fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / size))
+            })
+            .fold(0.0, f64::max)
+    };
     Ok(JacobianCost {
         law,
         states: n,
@@ -90,7 +108,9 @@ fn one(law: &'static str) -> Result<JacobianCost, String> {
         fd_rhs: n + 1,
         fd_equivalents: fd_s / rhs_s,
         dual_equivalents: dual_s / rhs_s,
-        difference,
+        difference: difference(&fd),
+        structured_equivalents: structured_s / rhs_s,
+        structured_difference: difference(&structured),
     })
 }
 

@@ -270,18 +270,23 @@ fn bench_changes(
 
 /// `boomsim bench --jacobian`: one Jacobian of the flexible plant in RHS evaluations.
 fn bench_jacobian() -> Result<(), String> {
-    println!("| boom.damping | states | RHS [us] | finite differences: RHS | time / RHS | dual numbers: time / RHS | difference |");
-    println!("| --- | --- | --- | --- | --- | --- | --- |");
+    println!(
+        "| boom.damping | states | RHS [us] | finite differences: RHS | time / RHS | dual numbers: time / RHS | difference \
+         | structured: time / RHS | difference |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for c in boomsim_tools::jacobian_cost::measure(&["thesis", "modal"])? {
         println!(
-            "| {} | {} | {:.2} | {} | {:.1} | {:.1} | {:.1e} |",
+            "| {} | {} | {:.2} | {} | {:.1} | {:.1} | {:.1e} | {:.2} | {:.1e} |",
             c.law,
             c.states,
             c.rhs_s * 1e6,
             c.fd_rhs,
             c.fd_equivalents,
             c.dual_equivalents,
-            c.difference
+            c.difference,
+            c.structured_equivalents,
+            c.structured_difference
         );
     }
     Ok(())

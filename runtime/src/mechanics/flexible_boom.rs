@@ -106,6 +106,7 @@ use super::params::{BeamParams, BoomParams, DampingLaw};
 use super::rigid_boom::RigidBoom;
 use super::{Energy, Equilibrium, Kinetics, Mechanics, MechanicsError};
 use crate::scalar::Scalar;
+use crate::solver::lu;
 
 /// The modal law's band of interest (rad/s): 50 Hz, numerics issue 27's "the boom's dynamics of
 /// interest are below 50 Hz" (the rig's mode is 2.85 Hz, thesis 5.1.3; the feedback's filter
@@ -123,7 +124,7 @@ pub const CONVERGED: f64 = 0.01;
 /// Most sections the chain may have: max(n2, 1) + n3.
 pub const MAX_SECTIONS: usize = 32;
 
-type Column = [f64; MAX_SECTIONS];
+pub type Column = [f64; MAX_SECTIONS];
 
 /// The lumped flexible boom; see the module documentation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -175,6 +176,18 @@ struct Sweep<T> {
     hx: T,
     hy: T,
     e: T,
+}
+
+/// The derivatives of the arm's accelerations ([`FlexibleBoom::acceleration_jacobian`]).
+#[derive(Debug, Clone)]
+pub struct ArmJacobian {
+    /// d q_ddot / d q, d q_ddot / d q_dot at a fixed cylinder force, then d q_ddot / d F_cyl:
+    /// n rows, 2n + 1 columns.
+    pub columns: DMatrix<f64>,
+    /// g = d x / d q = d v / d q_dot of the stroke x and its rate v (zero beyond part II).
+    pub gradient: Column,
+    /// d v / d q = H q_dot.
+    pub rate_gradient: Column,
 }
 
 /// Sine and cosine of the section angles (the first n, or the first n_ii for the pin alone).
@@ -460,11 +473,18 @@ impl FlexibleBoom {
     /// Torque of the damper of joint i (between sections i and i + 1): its own rate's under the
     /// per-section and structural laws (2.36-2.38), every joint's under the modal law.
     fn damper<T: Scalar>(&self, qd: &[T], i: usize) -> T {
+        let (first, row) = self.damper_row(i);
+        row.iter().zip(first..).fold(T::from(0.0), |tau, (&c, j)| tau + (qd[j + 1] - qd[j]) * c)
+    }
+
+    /// The coefficients of the damper of joint i on the joints' rates q_dot_(j+1) - q_dot_j,
+    /// j = first, first + 1, ...: (i, [c_i]) under the per-section and structural laws
+    /// (2.36-2.38), (0, row i of C) under the modal laws.
+    fn damper_row(&self, i: usize) -> (usize, &[f64]) {
         if matches!(self.damping, DampingLaw::Modal | DampingLaw::ConvergedModal) {
-            let row = &self.modal[i * MAX_SECTIONS..][..self.n - 1];
-            row.iter().enumerate().fold(T::from(0.0), |tau, (j, &c)| tau + (qd[j + 1] - qd[j]) * c)
+            (0, &self.modal[i * MAX_SECTIONS..][..self.n - 1])
         } else {
-            (qd[i + 1] - qd[i]) * self.c[i]
+            (i, std::slice::from_ref(&self.c[i]))
         }
     }
 
@@ -533,6 +553,109 @@ impl FlexibleBoom {
             out[i] += tau;
             out[i + 1] -= tau;
         }
+    }
+
+    /// The derivatives of the accelerations of [`Kinetics::accelerations`] (issue 48), in
+    /// closed form from the equations of motion of the module documentation,
+    /// M~(q) q_ddot = Phi(q, q_dot, F_cyl) with M~ = M + m_rod g g^T: at the accelerations
+    /// `qdd` (those of `f_cyl`), d q_ddot / dz = M~^-1 d(Phi - M~ q_ddot) / dz with q_ddot held,
+    /// one LU factorisation of M~ (the integrator's, [`lu`]) and 2n + 1 solves. The differentiated residual:
+    ///
+    /// - gravity (2.16's potential of each section): diagonal, g_acc (P_i sin q_i + S_i,y cos q_i),
+    ///   P_i = l_i m_out,i + S_i,x;
+    /// - springs (2.34, 2.35) and dampers (2.36-2.38 or the modal C): constant, tridiagonal in q
+    ///   and [`Self::damper_row`]'s pattern in q_dot;
+    /// - the chain's inertia, -h - M q_ddot: M_jk and h_j depend on q_j - q_k only, so
+    ///   d M / d q_k is zero outside row and column k; with W_jk = A_jk sin - B_jk cos
+    ///   (= -d M_jk / d(q_j - q_k)) the entry (j, k != j) is M_jk q_dot_k^2 - W_jk q_ddot_k and
+    ///   the diagonal the negated sum of its row (a rigid turn of every section changes neither);
+    ///   d(-h_j) / d q_dot_k = -2 W_jk q_dot_k;
+    /// - the rod, g phi with phi = F_cyl - m_rod (kappa + g_acc sin theta1 + g . q_ddot) the force
+    ///   it passes on and kappa = q_dot^T H q_dot, H = d g / d q the Hessian of l_cyl:
+    ///   H_jk = (r_j . r_k - g_j g_k) / l - delta_jk u . r_j over part II's levers r_j (2.1, 2.5),
+    ///   so d(g phi) / d q = H phi + g (d phi / d q)^T and d(g phi) / d q_dot = -2 m_rod g (H q_dot)^T.
+    ///
+    /// The stroke x and its rate v (which the circuit sees) have dx / dq = dv / dq_dot = g and
+    /// dv / dq = H q_dot. `None` if M~ is singular.
+    pub fn acceleration_jacobian(&self, q: &[f64], qd: &[f64], f_cyl: f64, qdd: &[f64]) -> Option<ArmJacobian> {
+        let (n, m) = (self.n, self.n_ii);
+        let (rel, t) = (self.relative_trig(q, n), self.trig(q));
+        let pin = self.pin_of(&t);
+        let (u, l) = (pin.u, pin.l);
+        let r: [Vector2<f64>; MAX_SECTIONS] =
+            std::array::from_fn(|j| if j < m { self.lever(&t, j) } else { Vector2::zeros() });
+        let g = self.cylinder_gradient(&t);
+        let hessian = |j: usize, k: usize| (r[j].dot(&r[k]) - g[j] * g[k]) / l - if j == k { u.dot(&r[j]) } else { 0.0 };
+        let (mut h_qd, mut h_qdd) = ([0.0; MAX_SECTIONS], [0.0; MAX_SECTIONS]);
+        for j in 0..m {
+            for k in 0..m {
+                let h = hessian(j, k);
+                h_qd[j] += h * qd[k];
+                h_qdd[j] += h * qdd[k];
+            }
+        }
+        // C_dot, l_dot, the levers' centripetal sum and kappa = q_dot^T H q_dot (module doc).
+        let c_dot = self.pin_velocity(&t, qd);
+        let v = u.dot(&c_dot);
+        let centripetal = (0..m).fold(Vector2::zeros(), |a, j| a - r[j] * (qd[j] * qd[j]));
+        let kappa = (0..m).map(|j| qd[j] * h_qd[j]).sum::<f64>();
+        let phi = f_cyl - self.m_rod * (kappa + self.g * u.y + (0..m).map(|j| g[j] * qdd[j]).sum::<f64>());
+        let mut mass = DMatrix::zeros(n, n);
+        let mut a = DMatrix::zeros(n, 2 * n + 1);
+        for j in 0..n {
+            mass[(j, j)] = self.len[j] * self.len[j] * self.m_out[j] + self.second[j] + self.m_rod * g[j] * g[j];
+            let s = self.first[j];
+            a[(j, j)] += self.g * ((self.m_out[j] * self.len[j] + s.x) * t.s[j] + s.y * t.c[j]);
+            a[(j, 2 * n)] = g[j];
+            for k in j + 1..n {
+                let (aa, bb) = self.coupling(j, k);
+                let (sin, cos) = (rel.s[j] * rel.c[k] - rel.c[j] * rel.s[k], rel.c[j] * rel.c[k] + rel.s[j] * rel.s[k]);
+                let (m_jk, w) = (aa * cos + bb * sin, aa * sin - bb * cos);
+                mass[(j, k)] = m_jk + self.m_rod * g[j] * g[k];
+                mass[(k, j)] = mass[(j, k)];
+                // W_kj = -W_jk.
+                let (jk, kj) = (m_jk * qd[k] * qd[k] - w * qdd[k], m_jk * qd[j] * qd[j] + w * qdd[j]);
+                a[(j, k)] += jk;
+                a[(j, j)] -= jk;
+                a[(k, j)] += kj;
+                a[(k, k)] -= kj;
+                a[(j, n + k)] -= 2.0 * w * qd[k];
+                a[(k, n + j)] += 2.0 * w * qd[j];
+            }
+        }
+        for i in 0..n - 1 {
+            let k = self.k[i];
+            a[(i, i)] -= k;
+            a[(i, i + 1)] += k;
+            a[(i + 1, i + 1)] -= k;
+            a[(i + 1, i)] += k;
+            let (first, row) = self.damper_row(i);
+            for (&c, j) in row.iter().zip(first..) {
+                a[(i, n + j + 1)] += c;
+                a[(i, n + j)] -= c;
+                a[(i + 1, n + j + 1)] -= c;
+                a[(i + 1, n + j)] += c;
+            }
+        }
+        for k in 0..m {
+            // d u / d q_k = (perp(r_k) - u g_k) / l; d kappa / d q_k from kappa =
+            // u . centripetal + (|C_dot|^2 - l_dot^2) / l.
+            let du = (perp(r[k]) - u * g[k]) / l;
+            let d_kappa = du.dot(&centripetal) - g[k] * qd[k] * qd[k]
+                - 2.0 * (qd[k] * c_dot.dot(&r[k]) + v * h_qd[k]) / l
+                - (c_dot.norm_squared() - v * v) * g[k] / (l * l);
+            let d_phi = -self.m_rod * (d_kappa + self.g * du.y + h_qdd[k]);
+            for j in 0..m {
+                a[(j, k)] += hessian(j, k) * phi + g[j] * d_phi;
+                a[(j, n + k)] -= 2.0 * self.m_rod * g[j] * h_qd[k];
+            }
+        }
+        let mut piv = [0; MAX_SECTIONS];
+        if !lu::factor(mass.as_mut_slice(), &mut piv[..n]) {
+            return None;
+        }
+        a.as_mut_slice().chunks_exact_mut(n).for_each(|column| lu::solve(mass.as_slice(), &piv[..n], column));
+        Some(ArmJacobian { columns: a, gradient: g, rate_gradient: h_qd })
     }
 
     /// Cylinder length |A C| for the section angles `q`.

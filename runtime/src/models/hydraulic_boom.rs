@@ -22,8 +22,11 @@ use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::mechanics::flexible_boom::MAX_SECTIONS;
+use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
+use crate::mechanics::Kinetics;
 use crate::scalar::{Dual64, Scalar};
+use nalgebra::{Const, DMatrix, U1};
+use num_dual::DualSVec64;
 use crate::solver::{OdeSystem, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
@@ -109,6 +112,15 @@ impl OdeSystem for Plant {
         self.rhs_with(self.u_ref.at(t), s, dx);
     }
 
+    /// The flexible boom's Jacobian from its structure ([`Plant::flexible_jacobian`]); the
+    /// rigid boom's by the integrator's finite differences.
+    fn jacobian(&self, t: f64, s: &[f64], jac: &mut DMatrix<f64>) -> bool {
+        match &self.boom {
+            Boom::Flexible(arm) => self.flexible_jacobian(arm, self.u_ref.at(t), s, jac),
+            Boom::Rigid(_) => false,
+        }
+    }
+
     /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
     fn second_order(&self) -> Option<SecondOrder> {
         let dof = self.boom.mechanics().dof();
@@ -132,6 +144,61 @@ impl Plant {
             e.force
         };
         self.boom.kinetics().accelerations(q, qd, &mut force, dqd);
+    }
+
+    /// The Jacobian of [`Self::rhs_with`] for the flexible boom `arm` (issue 48): the circuit
+    /// sees the arm only through the stroke x and its rate v, and the arm the circuit only through
+    /// the cylinder force F, so the chain rule joins the circuit's derivatives with respect to its
+    /// states, x and v (exact, dual numbers in all seven directions at once) and the arm's closed
+    /// form ([`FlexibleBoom::acceleration_jacobian`], eq. 2.34-2.39 with 2.1-2.5):
+    /// d/dq = d/dx g^T + d/dv (H q_dot)^T, d/dq_dot = d/dv g^T, and d q_ddot / d(circuit) =
+    /// d q_ddot / dF dF / d(circuit). The rows of q are dq/dt = q_dot. `false` (the integrator's
+    /// finite differences) if the arm's mass matrix does not factorise.
+    fn flexible_jacobian(&self, arm: &FlexibleBoom, u_ref: f64, s: &[f64], jac: &mut DMatrix<f64>) -> bool {
+        type Seeded = DualSVec64<{ N_CIRCUIT + 2 }>;
+        let n = arm.sections();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(n);
+        let (x, v) = (arm.stroke(q), arm.stroke_rate(q, qd));
+        let seeded = |value: f64, i: usize| Seeded::from_re(value).derivative(i);
+        let e = self.circuit.evaluate(
+            &std::array::from_fn(|i| seeded(c[i], i)),
+            Seeded::from(u_ref),
+            seeded(x, N_CIRCUIT),
+            seeded(v, N_CIRCUIT + 1),
+        );
+        let gradient = |y: Seeded| y.eps.unwrap_generic(Const, U1);
+        let mut qdd = [0.0; MAX_SECTIONS];
+        arm.accelerations(q, qd, &mut |_, _| e.force.re, &mut qdd[..n]);
+        let Some(a) = arm.acceleration_jacobian(q, qd, e.force.re, &qdd[..n]) else {
+            return false;
+        };
+        let (g, h_qd) = (&a.gradient, &a.rate_gradient);
+        let (pos, vel) = (N_CIRCUIT, N_CIRCUIT + n);
+        jac.fill(0.0);
+        for (i, &dx) in e.dx.iter().enumerate() {
+            let d = gradient(dx);
+            for m in 0..N_CIRCUIT {
+                jac[(i, m)] = d[m];
+            }
+            for k in 0..n {
+                jac[(i, pos + k)] = d[N_CIRCUIT] * g[k] + d[N_CIRCUIT + 1] * h_qd[k];
+                jac[(i, vel + k)] = d[N_CIRCUIT + 1] * g[k];
+            }
+        }
+        let f = gradient(e.force);
+        for j in 0..n {
+            jac[(pos + j, vel + j)] = 1.0;
+            let a_f = a.columns[(j, 2 * n)];
+            for m in 0..N_CIRCUIT {
+                jac[(vel + j, m)] = a_f * f[m];
+            }
+            for k in 0..n {
+                jac[(vel + j, pos + k)] = a.columns[(j, k)] + a_f * (f[N_CIRCUIT] * g[k] + f[N_CIRCUIT + 1] * h_qd[k]);
+                jac[(vel + j, vel + k)] = a.columns[(j, n + k)] + a_f * f[N_CIRCUIT + 1] * g[k];
+            }
+        }
+        true
     }
 
     /// The derivatives `dx` of the Model Exchange states at the plant state `s` (native

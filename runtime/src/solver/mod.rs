@@ -9,7 +9,7 @@ use nalgebra::DMatrix;
 use std::fmt;
 
 mod iteration;
-mod lu;
+pub(crate) mod lu;
 pub mod radau5;
 #[cfg(test)]
 mod tests;
