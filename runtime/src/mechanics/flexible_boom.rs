@@ -106,7 +106,7 @@ use super::params::{BeamParams, BoomParams, DampingLaw};
 use super::rigid_boom::RigidBoom;
 use super::{Energy, Equilibrium, Kinetics, Mechanics, MechanicsError};
 use crate::scalar::Scalar;
-use crate::solver::lu;
+use crate::solver::cholesky;
 
 /// The modal law's band of interest (rad/s): 50 Hz, numerics issue 27's "the boom's dynamics of
 /// interest are below 50 Hz" (the rig's mode is 2.85 Hz, thesis 5.1.3; the feedback's filter
@@ -178,12 +178,14 @@ struct Sweep<T> {
     e: T,
 }
 
-/// The derivatives of the arm's accelerations ([`FlexibleBoom::acceleration_jacobian`]).
+/// The arm's accelerations and their derivatives ([`FlexibleBoom::acceleration_jacobian`]).
 #[derive(Debug, Clone)]
 pub struct ArmJacobian {
+    /// The accelerations q_ddot (the first n).
+    pub qdd: Column,
     /// d q_ddot / d q, d q_ddot / d q_dot at a fixed cylinder force, then d q_ddot / d F_cyl:
-    /// n rows, 2n + 1 columns.
-    pub columns: DMatrix<f64>,
+    /// n rows of 2n + 1, one after the other.
+    pub rows: Vec<f64>,
     /// g = d x / d q = d v / d q_dot of the stroke x and its rate v (zero beyond part II).
     pub gradient: Column,
     /// d v / d q = H q_dot.
@@ -191,9 +193,22 @@ pub struct ArmJacobian {
 }
 
 /// Sine and cosine of the section angles (the first n, or the first n_ii for the pin alone).
+#[derive(Clone, Copy)]
 struct Trig<T> {
     s: [T; MAX_SECTIONS],
     c: [T; MAX_SECTIONS],
+}
+
+impl<T: Scalar> Trig<T> {
+    /// The first `m` angles turned by `q0`: relative to q_0 ([`FlexibleBoom::relative_trig`])
+    /// into absolute.
+    fn turned(mut self, q0: T, m: usize) -> Self {
+        let (s0, c0) = q0.sin_cos();
+        for (s, c) in self.s[..m].iter_mut().zip(&mut self.c[..m]) {
+            (*s, *c) = (s0 * *c + c0 * *s, c0 * *c - s0 * *s);
+        }
+        self
+    }
 }
 
 /// sin and cos of |d| <= [`SMALL_ANGLE`] by their Taylor series to d^9 and d^10 (Horner in
@@ -502,12 +517,7 @@ impl FlexibleBoom {
     /// d = q[i] - q[0] ([`sin_cos_small`]) give them to an ulp or two; a difference beyond
     /// [`SMALL_ANGLE`] takes the library call.
     fn trig_to<T: Scalar>(&self, q: &[T], m: usize) -> Trig<T> {
-        let mut t = self.relative_trig(q, m);
-        let (s0, c0) = q[0].sin_cos();
-        for (s, c) in t.s[..m].iter_mut().zip(&mut t.c[..m]) {
-            (*s, *c) = (s0 * *c + c0 * *s, c0 * *c - s0 * *s);
-        }
-        t
+        self.relative_trig(q, m).turned(q[0], m)
     }
 
     /// sin and cos of the first `m` angles relative to the first, q[i] - q[0].
@@ -555,11 +565,13 @@ impl FlexibleBoom {
         }
     }
 
-    /// The derivatives of the accelerations of [`Kinetics::accelerations`] (issue 48), in
+    /// The accelerations of [`Kinetics::accelerations`] and their derivatives (issue 48), in
     /// closed form from the equations of motion of the module documentation,
-    /// M~(q) q_ddot = Phi(q, q_dot, F_cyl) with M~ = M + m_rod g g^T: at the accelerations
-    /// `qdd` (those of `f_cyl`), d q_ddot / dz = M~^-1 d(Phi - M~ q_ddot) / dz with q_ddot held,
-    /// one LU factorisation of M~ (the integrator's, [`lu`]) and 2n + 1 solves. The differentiated residual:
+    /// M~(q) q_ddot = Phi(q, q_dot, F_cyl) with M~ = M + m_rod g g^T, assembled densely: one Cholesky
+    /// factorisation of M~ ([`cholesky`]) gives q_ddot, and with q_ddot held,
+    /// d q_ddot / dz = M~^-1 d(Phi - M~ q_ddot) / dz, 2n + 1 solves. `f_cyl` is the cylinder force
+    /// at the stroke and its rate, as for [`Kinetics::accelerations`]. The differentiated
+    /// residual:
     ///
     /// - gravity (2.16's potential of each section): diagonal, g_acc (P_i sin q_i + S_i,y cos q_i),
     ///   P_i = l_i m_out,i + S_i,x;
@@ -576,65 +588,87 @@ impl FlexibleBoom {
     ///   so d(g phi) / d q = H phi + g (d phi / d q)^T and d(g phi) / d q_dot = -2 m_rod g (H q_dot)^T.
     ///
     /// The stroke x and its rate v (which the circuit sees) have dx / dq = dv / dq_dot = g and
-    /// dv / dq = H q_dot. `None` if M~ is singular.
-    pub fn acceleration_jacobian(&self, q: &[f64], qd: &[f64], f_cyl: f64, qdd: &[f64]) -> Option<ArmJacobian> {
-        let (n, m) = (self.n, self.n_ii);
-        let (rel, t) = (self.relative_trig(q, n), self.trig(q));
+    /// dv / dq = H q_dot. `None` if M~ is not positive definite.
+    pub fn acceleration_jacobian(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64) -> Option<ArmJacobian> {
+        let (n, m, cols) = (self.n, self.n_ii, 2 * self.n + 1);
+        let rel = self.relative_trig(q, n);
+        let t = rel.turned(q[0], n);
         let pin = self.pin_of(&t);
         let (u, l) = (pin.u, pin.l);
         let r: [Vector2<f64>; MAX_SECTIONS] =
             std::array::from_fn(|j| if j < m { self.lever(&t, j) } else { Vector2::zeros() });
         let g = self.cylinder_gradient(&t);
-        let hessian = |j: usize, k: usize| (r[j].dot(&r[k]) - g[j] * g[k]) / l - if j == k { u.dot(&r[j]) } else { 0.0 };
-        let (mut h_qd, mut h_qdd) = ([0.0; MAX_SECTIONS], [0.0; MAX_SECTIONS]);
-        for j in 0..m {
-            for k in 0..m {
-                let h = hessian(j, k);
-                h_qd[j] += h * qd[k];
-                h_qdd[j] += h * qdd[k];
+        let mut hessian = vec![0.0; m * m];
+        for (j, row) in hessian.chunks_exact_mut(m).enumerate() {
+            for (k, h) in row.iter_mut().enumerate() {
+                *h = (r[j].dot(&r[k]) - g[j] * g[k]) / l;
             }
+            row[j] -= u.dot(&r[j]);
         }
+        let times_h = |x: &[f64]| -> Column {
+            std::array::from_fn(|j| if j < m { hessian[j * m..][..m].iter().zip(x).map(|(h, x)| h * x).sum() } else { 0.0 })
+        };
+        let h_qd = times_h(qd);
         // C_dot, l_dot, the levers' centripetal sum and kappa = q_dot^T H q_dot (module doc).
         let c_dot = self.pin_velocity(&t, qd);
         let v = u.dot(&c_dot);
         let centripetal = (0..m).fold(Vector2::zeros(), |a, j| a - r[j] * (qd[j] * qd[j]));
         let kappa = (0..m).map(|j| qd[j] * h_qd[j]).sum::<f64>();
-        let phi = f_cyl - self.m_rod * (kappa + self.g * u.y + (0..m).map(|j| g[j] * qdd[j]).sum::<f64>());
-        let mut mass = DMatrix::zeros(n, n);
-        let mut a = DMatrix::zeros(n, 2 * n + 1);
+        let force = f_cyl(l - self.l_retracted, v);
+        // M~ (its lower triangle, for [`cholesky`]); M_jk above the diagonal of `mw`, W_jk below.
+        let (mut mass, mut mw) = (vec![0.0; n * n], vec![0.0; n * n]);
+        // The right-hand side Phi: gravity, springs and dampers, -h, the rod.
+        let mut qdd = [0.0; MAX_SECTIONS];
+        self.forces(q, qd, &t, &mut qdd);
         for j in 0..n {
-            mass[(j, j)] = self.len[j] * self.len[j] * self.m_out[j] + self.second[j] + self.m_rod * g[j] * g[j];
-            let s = self.first[j];
-            a[(j, j)] += self.g * ((self.m_out[j] * self.len[j] + s.x) * t.s[j] + s.y * t.c[j]);
-            a[(j, 2 * n)] = g[j];
+            mass[j * n + j] = self.len[j] * self.len[j] * self.m_out[j] + self.second[j] + self.m_rod * g[j] * g[j];
+            qdd[j] += g[j] * (force - self.m_rod * (kappa + self.g * u.y));
             for k in j + 1..n {
                 let (aa, bb) = self.coupling(j, k);
                 let (sin, cos) = (rel.s[j] * rel.c[k] - rel.c[j] * rel.s[k], rel.c[j] * rel.c[k] + rel.s[j] * rel.s[k]);
-                let (m_jk, w) = (aa * cos + bb * sin, aa * sin - bb * cos);
-                mass[(j, k)] = m_jk + self.m_rod * g[j] * g[k];
-                mass[(k, j)] = mass[(j, k)];
-                // W_kj = -W_jk.
-                let (jk, kj) = (m_jk * qd[k] * qd[k] - w * qdd[k], m_jk * qd[j] * qd[j] + w * qdd[j]);
-                a[(j, k)] += jk;
-                a[(j, j)] -= jk;
-                a[(k, j)] += kj;
-                a[(k, k)] -= kj;
-                a[(j, n + k)] -= 2.0 * w * qd[k];
-                a[(k, n + j)] += 2.0 * w * qd[j];
+                let (m_jk, w_jk) = (aa * cos + bb * sin, aa * sin - bb * cos);
+                (mw[j * n + k], mw[k * n + j]) = (m_jk, w_jk);
+                mass[k * n + j] = m_jk + self.m_rod * g[j] * g[k];
+                // h_j = sum_k W_jk q_dot_k^2, W_kj = -W_jk.
+                qdd[j] -= w_jk * qd[k] * qd[k];
+                qdd[k] += w_jk * qd[j] * qd[j];
+            }
+        }
+        let mut inv_diag = [0.0; MAX_SECTIONS];
+        if !cholesky::factor(&mut mass, &mut inv_diag[..n]) {
+            return None;
+        }
+        cholesky::solve_rows(&mass, &inv_diag[..n], &mut qdd[..n]);
+        let h_qdd = times_h(&qdd);
+        let phi = force - self.m_rod * (kappa + self.g * u.y + (0..m).map(|j| g[j] * qdd[j]).sum::<f64>());
+        let mut a = vec![0.0; n * cols];
+        for j in 0..n {
+            let s = self.first[j];
+            a[j * cols + j] += self.g * ((self.m_out[j] * self.len[j] + s.x) * t.s[j] + s.y * t.c[j]);
+            a[j * cols + 2 * n] = g[j];
+            for k in j + 1..n {
+                let (m_jk, w_jk) = (mw[j * n + k], mw[k * n + j]);
+                let (jk, kj) = (m_jk * qd[k] * qd[k] - w_jk * qdd[k], m_jk * qd[j] * qd[j] + w_jk * qdd[j]);
+                a[j * cols + k] += jk;
+                a[j * cols + j] -= jk;
+                a[k * cols + j] += kj;
+                a[k * cols + k] -= kj;
+                a[j * cols + n + k] -= 2.0 * w_jk * qd[k];
+                a[k * cols + n + j] += 2.0 * w_jk * qd[j];
             }
         }
         for i in 0..n - 1 {
             let k = self.k[i];
-            a[(i, i)] -= k;
-            a[(i, i + 1)] += k;
-            a[(i + 1, i + 1)] -= k;
-            a[(i + 1, i)] += k;
+            a[i * cols + i] -= k;
+            a[i * cols + i + 1] += k;
+            a[(i + 1) * cols + i + 1] -= k;
+            a[(i + 1) * cols + i] += k;
             let (first, row) = self.damper_row(i);
             for (&c, j) in row.iter().zip(first..) {
-                a[(i, n + j + 1)] += c;
-                a[(i, n + j)] -= c;
-                a[(i + 1, n + j + 1)] -= c;
-                a[(i + 1, n + j)] += c;
+                a[i * cols + n + j + 1] += c;
+                a[i * cols + n + j] -= c;
+                a[(i + 1) * cols + n + j + 1] -= c;
+                a[(i + 1) * cols + n + j] += c;
             }
         }
         for k in 0..m {
@@ -646,16 +680,12 @@ impl FlexibleBoom {
                 - (c_dot.norm_squared() - v * v) * g[k] / (l * l);
             let d_phi = -self.m_rod * (d_kappa + self.g * du.y + h_qdd[k]);
             for j in 0..m {
-                a[(j, k)] += hessian(j, k) * phi + g[j] * d_phi;
-                a[(j, n + k)] -= 2.0 * self.m_rod * g[j] * h_qd[k];
+                a[j * cols + k] += hessian[j * m + k] * phi + g[j] * d_phi;
+                a[j * cols + n + k] -= 2.0 * self.m_rod * g[j] * h_qd[k];
             }
         }
-        let mut piv = [0; MAX_SECTIONS];
-        if !lu::factor(mass.as_mut_slice(), &mut piv[..n]) {
-            return None;
-        }
-        a.as_mut_slice().chunks_exact_mut(n).for_each(|column| lu::solve(mass.as_slice(), &piv[..n], column));
-        Some(ArmJacobian { columns: a, gradient: g, rate_gradient: h_qd })
+        cholesky::solve_rows(&mass, &inv_diag[..n], &mut a);
+        Some(ArmJacobian { qdd, rows: a, gradient: g, rate_gradient: h_qd })
     }
 
     /// Cylinder length |A C| for the section angles `q`.

@@ -23,7 +23,6 @@ use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepS
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
-use crate::mechanics::Kinetics;
 use crate::scalar::{Dual64, Scalar};
 use nalgebra::{Const, DMatrix, U1};
 use num_dual::DualSVec64;
@@ -153,51 +152,52 @@ impl Plant {
     /// form ([`FlexibleBoom::acceleration_jacobian`], eq. 2.34-2.39 with 2.1-2.5):
     /// d/dq = d/dx g^T + d/dv (H q_dot)^T, d/dq_dot = d/dv g^T, and d q_ddot / d(circuit) =
     /// d q_ddot / dF dF / d(circuit). The rows of q are dq/dt = q_dot. `false` (the integrator's
-    /// finite differences) if the arm's mass matrix does not factorise.
+    /// finite differences) if the arm's mass matrix is singular.
     fn flexible_jacobian(&self, arm: &FlexibleBoom, u_ref: f64, s: &[f64], jac: &mut DMatrix<f64>) -> bool {
         type Seeded = DualSVec64<{ N_CIRCUIT + 2 }>;
+        const X: usize = N_CIRCUIT;
+        const V: usize = N_CIRCUIT + 1;
         let n = arm.sections();
         let (c, boom) = s.split_at(N_CIRCUIT);
         let (q, qd) = boom.split_at(n);
-        let (x, v) = (arm.stroke(q), arm.stroke_rate(q, qd));
         let seeded = |value: f64, i: usize| Seeded::from_re(value).derivative(i);
-        let e = self.circuit.evaluate(
-            &std::array::from_fn(|i| seeded(c[i], i)),
-            Seeded::from(u_ref),
-            seeded(x, N_CIRCUIT),
-            seeded(v, N_CIRCUIT + 1),
-        );
-        let gradient = |y: Seeded| y.eps.unwrap_generic(Const, U1);
-        let mut qdd = [0.0; MAX_SECTIONS];
-        arm.accelerations(q, qd, &mut |_, _| e.force.re, &mut qdd[..n]);
-        let Some(a) = arm.acceleration_jacobian(q, qd, e.force.re, &qdd[..n]) else {
+        let mut circuit = None;
+        let mut force = |x, v| {
+            let e = self.circuit.evaluate(&std::array::from_fn(|i| seeded(c[i], i)), Seeded::from(u_ref), seeded(x, X), seeded(v, V));
+            let force = e.force.re;
+            circuit = Some(e);
+            force
+        };
+        let (Some(a), Some(e)) = (arm.acceleration_jacobian(q, qd, &mut force), circuit) else {
             return false;
         };
-        let (g, h_qd) = (&a.gradient, &a.rate_gradient);
-        let (pos, vel) = (N_CIRCUIT, N_CIRCUIT + n);
-        jac.fill(0.0);
-        for (i, &dx) in e.dx.iter().enumerate() {
-            let d = gradient(dx);
-            for m in 0..N_CIRCUIT {
-                jac[(i, m)] = d[m];
+        let gradient = |y: Seeded| -> [f64; N_CIRCUIT + 2] { y.eps.unwrap_generic(Const, U1).into() };
+        let (dx, f) = (e.dx.map(gradient), gradient(e.force));
+        let (g, h_qd, rows) = (&a.gradient, &a.rate_gradient, &a.rows);
+        let (dim, vel, cols) = (N_CIRCUIT + 2 * n, N_CIRCUIT + n, 2 * n + 1);
+        let jac = jac.as_mut_slice();
+        // Column z: a circuit state, or q_k (through x and v), or q_dot_k (through v), with
+        // the arm's own column `arm`; `circuit(d)` is the circuit's derivative d along it.
+        let mut column = |z: usize, circuit: &dyn Fn(&[f64; N_CIRCUIT + 2]) -> f64, arm: Option<usize>| {
+            let col = &mut jac[z * dim..(z + 1) * dim];
+            for (ci, d) in col.iter_mut().zip(&dx) {
+                *ci = circuit(d);
             }
-            for k in 0..n {
-                jac[(i, pos + k)] = d[N_CIRCUIT] * g[k] + d[N_CIRCUIT + 1] * h_qd[k];
-                jac[(i, vel + k)] = d[N_CIRCUIT + 1] * g[k];
+            col[N_CIRCUIT..vel].fill(0.0);
+            let d_force = circuit(&f);
+            for (ci, row) in col[vel..].iter_mut().zip(rows.chunks_exact(cols)) {
+                *ci = arm.map_or(0.0, |k| row[k]) + row[2 * n] * d_force;
             }
+        };
+        for z in 0..N_CIRCUIT {
+            column(z, &|d| d[z], None);
         }
-        let f = gradient(e.force);
-        for j in 0..n {
-            jac[(pos + j, vel + j)] = 1.0;
-            let a_f = a.columns[(j, 2 * n)];
-            for m in 0..N_CIRCUIT {
-                jac[(vel + j, m)] = a_f * f[m];
-            }
-            for k in 0..n {
-                jac[(vel + j, pos + k)] = a.columns[(j, k)] + a_f * (f[N_CIRCUIT] * g[k] + f[N_CIRCUIT + 1] * h_qd[k]);
-                jac[(vel + j, vel + k)] = a.columns[(j, n + k)] + a_f * f[N_CIRCUIT + 1] * g[k];
-            }
+        for k in 0..n {
+            column(N_CIRCUIT + k, &|d| d[X] * g[k] + d[V] * h_qd[k], Some(k));
+            column(vel + k, &|d| d[V] * g[k], Some(n + k));
         }
+        // dq/dt = q_dot.
+        (0..n).for_each(|k| jac[(vel + k) * dim + N_CIRCUIT + k] = 1.0);
         true
     }
 

@@ -8,8 +8,9 @@
 use nalgebra::DMatrix;
 use std::fmt;
 
+pub(crate) mod cholesky;
 mod iteration;
-pub(crate) mod lu;
+mod lu;
 pub mod radau5;
 #[cfg(test)]
 mod tests;
