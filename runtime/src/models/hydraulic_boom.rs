@@ -23,9 +23,8 @@ use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepS
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
 use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
-use crate::scalar::{Dual64, Scalar};
+use crate::scalar::{Dual64, DualSVec64, Scalar};
 use nalgebra::{Const, DMatrix, U1};
-use num_dual::DualSVec64;
 use crate::solver::{OdeSystem, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
@@ -176,28 +175,30 @@ impl Plant {
         let (g, h_qd, rows) = (&a.gradient, &a.rate_gradient, &a.rows);
         let (dim, vel, cols) = (N_CIRCUIT + 2 * n, N_CIRCUIT + n, 2 * n + 1);
         let jac = jac.as_mut_slice();
-        // Column z: a circuit state, or q_k (through x and v), or q_dot_k (through v), with
-        // the arm's own column `arm`; `circuit(d)` is the circuit's derivative d along it.
-        let mut column = |z: usize, circuit: &dyn Fn(&[f64; N_CIRCUIT + 2]) -> f64, arm: Option<usize>| {
-            let col = &mut jac[z * dim..(z + 1) * dim];
+        // Each column z as a direction of the circuit's inputs (a circuit state; q_k through
+        // x and v; q_dot_k through v): its derivatives along it, then the accelerations' from the
+        // arm's own column `arm` and the force's.
+        for (z, col) in jac.chunks_exact_mut(dim).enumerate() {
+            // The arm's column is z - N_CIRCUIT: q_k, then q_dot_k.
+            let arm = z.checked_sub(N_CIRCUIT);
+            let along = |d: &[f64; N_CIRCUIT + 2]| match arm {
+                None => d[z],
+                Some(k) if k < n => d[X] * g[k] + d[V] * h_qd[k],
+                Some(k) => d[V] * g[k - n],
+            };
             for (ci, d) in col.iter_mut().zip(&dx) {
-                *ci = circuit(d);
+                *ci = along(d);
             }
             col[N_CIRCUIT..vel].fill(0.0);
-            let d_force = circuit(&f);
-            for (ci, row) in col[vel..].iter_mut().zip(rows.chunks_exact(cols)) {
-                *ci = arm.map_or(0.0, |k| row[k]) + row[2 * n] * d_force;
+            if let Some(k) = arm.filter(|&k| k >= n) {
+                // dq/dt = q_dot.
+                col[N_CIRCUIT + k - n] = 1.0;
             }
-        };
-        for z in 0..N_CIRCUIT {
-            column(z, &|d| d[z], None);
+            let d_force = along(&f);
+            for (ci, row) in col[vel..].iter_mut().zip(rows.chunks_exact(cols)) {
+                *ci = arm.map_or(0.0, |a| row[a]) + row[2 * n] * d_force;
+            }
         }
-        for k in 0..n {
-            column(N_CIRCUIT + k, &|d| d[X] * g[k] + d[V] * h_qd[k], Some(k));
-            column(vel + k, &|d| d[V] * g[k], Some(n + k));
-        }
-        // dq/dt = q_dot.
-        (0..n).for_each(|k| jac[(vel + k) * dim + N_CIRCUIT + k] = 1.0);
         true
     }
 
