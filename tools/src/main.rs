@@ -54,8 +54,9 @@ enum Cmd {
         #[arg(long)]
         realtime: bool,
         /// Instead: the time of one Jacobian of the flexible plant at U's start in RHS
-        /// evaluations, finite differences against the exact one in dual numbers, under the
-        /// thesis' damping law and the default (in-process, a few seconds).
+        /// evaluations, finite differences against the exact one in dual numbers and the
+        /// structured one the integrator uses, under the thesis' damping law and the default
+        /// (in-process, a few seconds).
         #[arg(long)]
         jacobian: bool,
         /// Runs per case of `--realtime`, > 0.
