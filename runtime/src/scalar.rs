@@ -3,7 +3,7 @@
 //! The `f64` instances compute exactly what the code computed before it was generic: constants
 //! on the left of an operator become `T::from(c)`, and no operation is regrouped.
 
-pub use num_dual::Dual64;
+pub use num_dual::{Dual64, DualSVec64};
 
 /// A real number of the right-hand sides.
 pub trait Scalar: num_dual::DualNum<Primitive = f64> + Copy {}

@@ -54,8 +54,9 @@ enum Cmd {
         #[arg(long)]
         realtime: bool,
         /// Instead: the time of one Jacobian of the flexible plant at U's start in RHS
-        /// evaluations, finite differences against the exact one in dual numbers, under the
-        /// thesis' damping law and the default (in-process, a few seconds).
+        /// evaluations, finite differences against the exact one in dual numbers and the
+        /// structured one the integrator uses, under the thesis' damping law and the default
+        /// (in-process, a few seconds).
         #[arg(long)]
         jacobian: bool,
         /// Runs per case of `--realtime`, > 0.
@@ -283,18 +284,23 @@ fn bench_changes(
 
 /// `boomsim bench --jacobian`: one Jacobian of the flexible plant in RHS evaluations.
 fn bench_jacobian() -> Result<(), String> {
-    println!("| boom.damping | states | RHS [us] | finite differences: RHS | time / RHS | dual numbers: time / RHS | difference |");
-    println!("| --- | --- | --- | --- | --- | --- | --- |");
+    println!(
+        "| boom.damping | states | RHS [us] | finite differences: RHS | time / RHS | dual numbers: time / RHS | difference \
+         | structured: time / RHS | difference |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for c in boomsim_tools::jacobian_cost::measure(&["thesis", "modal"])? {
         println!(
-            "| {} | {} | {:.2} | {} | {:.1} | {:.1} | {:.1e} |",
+            "| {} | {} | {:.2} | {} | {:.1} | {:.1} | {:.1e} | {:.2} | {:.1e} |",
             c.law,
             c.states,
             c.rhs_s * 1e6,
             c.fd_rhs,
             c.fd_equivalents,
             c.dual_equivalents,
-            c.difference
+            c.difference,
+            c.structured_equivalents,
+            c.structured_difference
         );
     }
     Ok(())

@@ -98,6 +98,13 @@
 //! gravity and B turn with q_0 (one library sin_cos). Some 100 flops and four divisions per
 //! section, no matrix, nothing allocated; the test `equations_of_motion_hold` checks the sweeps against
 //! M q_ddot = Q assembled from the formulas above.
+//!
+//! The integrator's Jacobian ([`FlexibleBoom::acceleration_jacobian`], issue 48) differentiates
+//! that Lagrange form instead of the sweeps: M_jk and h_j depend on q_j - q_k only, so each
+//! derivative of M q_ddot + h is one entry per pair of sections; M~ is assembled densely,
+//! factorised once (Cholesky) and solved for the accelerations and the 2n + 1 columns
+//! (q, q_dot, F_cyl) at once, O(n^2) work plus the solves' n^2 (2n + 1), against n sweeps
+//! per column for differences or dual numbers.
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -106,6 +113,7 @@ use super::params::{BeamParams, BoomParams, DampingLaw};
 use super::rigid_boom::RigidBoom;
 use super::{Energy, Equilibrium, Kinetics, Mechanics, MechanicsError};
 use crate::scalar::Scalar;
+use crate::solver::cholesky;
 
 /// The modal law's band of interest (rad/s): 50 Hz, numerics issue 27's "the boom's dynamics of
 /// interest are below 50 Hz" (the rig's mode is 2.85 Hz, thesis 5.1.3; the feedback's filter
@@ -123,7 +131,7 @@ pub const CONVERGED: f64 = 0.01;
 /// Most sections the chain may have: max(n2, 1) + n3.
 pub const MAX_SECTIONS: usize = 32;
 
-type Column = [f64; MAX_SECTIONS];
+pub type Column = [f64; MAX_SECTIONS];
 
 /// The lumped flexible boom; see the module documentation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -177,10 +185,37 @@ struct Sweep<T> {
     e: T,
 }
 
+/// The arm's accelerations and their derivatives ([`FlexibleBoom::acceleration_jacobian`]).
+#[derive(Debug, Clone)]
+pub struct ArmJacobian {
+    /// The accelerations q_ddot (the first n).
+    pub qdd: Column,
+    /// d q_ddot / d q, d q_ddot / d q_dot at a fixed cylinder force, then d q_ddot / d F_cyl:
+    /// n rows of 2n + 1, one after the other.
+    pub rows: Vec<f64>,
+    /// g = d x / d q = d v / d q_dot of the stroke x and its rate v (zero beyond part II).
+    pub gradient: Column,
+    /// d v / d q = H q_dot.
+    pub rate_gradient: Column,
+}
+
 /// Sine and cosine of the section angles (the first n, or the first n_ii for the pin alone).
+#[derive(Clone, Copy)]
 struct Trig<T> {
     s: [T; MAX_SECTIONS],
     c: [T; MAX_SECTIONS],
+}
+
+impl<T: Scalar> Trig<T> {
+    /// The first `m` angles turned by `q0`: relative to q_0 ([`FlexibleBoom::relative_trig`])
+    /// into absolute.
+    fn turned(mut self, q0: T, m: usize) -> Self {
+        let (s0, c0) = q0.sin_cos();
+        for (s, c) in self.s[..m].iter_mut().zip(&mut self.c[..m]) {
+            (*s, *c) = (s0 * *c + c0 * *s, c0 * *c - s0 * *s);
+        }
+        self
+    }
 }
 
 /// sin and cos of |d| <= [`SMALL_ANGLE`] by their Taylor series to d^9 and d^10 (Horner in
@@ -460,11 +495,18 @@ impl FlexibleBoom {
     /// Torque of the damper of joint i (between sections i and i + 1): its own rate's under the
     /// per-section and structural laws (2.36-2.38), every joint's under the modal law.
     fn damper<T: Scalar>(&self, qd: &[T], i: usize) -> T {
+        let (first, row) = self.damper_row(i);
+        row.iter().zip(first..).fold(T::from(0.0), |tau, (&c, j)| tau + (qd[j + 1] - qd[j]) * c)
+    }
+
+    /// The coefficients of the damper of joint i on the joints' rates q_dot_(j+1) - q_dot_j,
+    /// j = first, first + 1, ...: (i, [c_i]) under the per-section and structural laws
+    /// (2.36-2.38), (0, row i of C) under the modal laws.
+    fn damper_row(&self, i: usize) -> (usize, &[f64]) {
         if matches!(self.damping, DampingLaw::Modal | DampingLaw::ConvergedModal) {
-            let row = &self.modal[i * MAX_SECTIONS..][..self.n - 1];
-            row.iter().enumerate().fold(T::from(0.0), |tau, (j, &c)| tau + (qd[j + 1] - qd[j]) * c)
+            (0, &self.modal[i * MAX_SECTIONS..][..self.n - 1])
         } else {
-            (qd[i + 1] - qd[i]) * self.c[i]
+            (i, std::slice::from_ref(&self.c[i]))
         }
     }
 
@@ -482,12 +524,7 @@ impl FlexibleBoom {
     /// d = q[i] - q[0] ([`sin_cos_small`]) give them to an ulp or two; a difference beyond
     /// [`SMALL_ANGLE`] takes the library call.
     fn trig_to<T: Scalar>(&self, q: &[T], m: usize) -> Trig<T> {
-        let mut t = self.relative_trig(q, m);
-        let (s0, c0) = q[0].sin_cos();
-        for (s, c) in t.s[..m].iter_mut().zip(&mut t.c[..m]) {
-            (*s, *c) = (s0 * *c + c0 * *s, c0 * *c - s0 * *s);
-        }
-        t
+        self.relative_trig(q, m).turned(q[0], m)
     }
 
     /// sin and cos of the first `m` angles relative to the first, q[i] - q[0].
@@ -533,6 +570,129 @@ impl FlexibleBoom {
             out[i] += tau;
             out[i + 1] -= tau;
         }
+    }
+
+    /// The accelerations of [`Kinetics::accelerations`] and their derivatives (issue 48), in
+    /// closed form from the equations of motion of the module documentation,
+    /// M~(q) q_ddot = Phi(q, q_dot, F_cyl) with M~ = M + m_rod g g^T, assembled densely: one Cholesky
+    /// factorisation of M~ ([`cholesky`]) gives q_ddot, and with q_ddot held,
+    /// d q_ddot / dz = M~^-1 d(Phi - M~ q_ddot) / dz, 2n + 1 solves. `f_cyl` is the cylinder force
+    /// at the stroke and its rate, as for [`Kinetics::accelerations`]. The differentiated
+    /// residual:
+    ///
+    /// - gravity (2.16's potential of each section): diagonal, g_acc (P_i sin q_i + S_i,y cos q_i),
+    ///   P_i = l_i m_out,i + S_i,x;
+    /// - springs (2.34, 2.35) and dampers (2.36-2.38 or the modal C): constant, tridiagonal in q
+    ///   and [`Self::damper_row`]'s pattern in q_dot;
+    /// - the chain's inertia, -h - M q_ddot: M_jk and h_j depend on q_j - q_k only, so
+    ///   d M / d q_k is zero outside row and column k; with W_jk = A_jk sin - B_jk cos
+    ///   (= -d M_jk / d(q_j - q_k)) the entry (j, k != j) is M_jk q_dot_k^2 - W_jk q_ddot_k and
+    ///   the diagonal the negated sum of its row (a rigid turn of every section changes neither);
+    ///   d(-h_j) / d q_dot_k = -2 W_jk q_dot_k;
+    /// - the rod, g phi with phi = F_cyl - m_rod (kappa + g_acc sin theta1 + g . q_ddot) the force
+    ///   it passes on and kappa = q_dot^T H q_dot, H = d g / d q the Hessian of l_cyl:
+    ///   H_jk = (r_j . r_k - g_j g_k) / l - delta_jk u . r_j over part II's levers r_j (2.1, 2.5),
+    ///   so d(g phi) / d q = H phi + g (d phi / d q)^T and d(g phi) / d q_dot = -2 m_rod g (H q_dot)^T.
+    ///
+    /// The stroke x and its rate v (which the circuit sees) have dx / dq = dv / dq_dot = g and
+    /// dv / dq = H q_dot. `None` if M~ is not positive definite.
+    pub fn acceleration_jacobian(&self, q: &[f64], qd: &[f64], f_cyl: &mut dyn FnMut(f64, f64) -> f64) -> Option<ArmJacobian> {
+        let (n, m, cols) = (self.n, self.n_ii, 2 * self.n + 1);
+        let rel = self.relative_trig(q, n);
+        let t = rel.turned(q[0], n);
+        let pin = self.pin_of(&t);
+        let (u, l) = (pin.u, pin.l);
+        let r: [Vector2<f64>; MAX_SECTIONS] =
+            std::array::from_fn(|j| if j < m { self.lever(&t, j) } else { Vector2::zeros() });
+        let g = self.cylinder_gradient(&t);
+        let mut hessian = vec![0.0; m * m];
+        for (j, row) in hessian.chunks_exact_mut(m).enumerate() {
+            for (k, h) in row.iter_mut().enumerate() {
+                *h = (r[j].dot(&r[k]) - g[j] * g[k]) / l;
+            }
+            row[j] -= u.dot(&r[j]);
+        }
+        let times_h = |x: &[f64]| -> Column {
+            std::array::from_fn(|j| if j < m { hessian[j * m..][..m].iter().zip(x).map(|(h, x)| h * x).sum() } else { 0.0 })
+        };
+        let h_qd = times_h(qd);
+        // C_dot, l_dot, the levers' centripetal sum and kappa = q_dot^T H q_dot (module doc).
+        let c_dot = self.pin_velocity(&t, qd);
+        let v = u.dot(&c_dot);
+        let centripetal = (0..m).fold(Vector2::zeros(), |a, j| a - r[j] * (qd[j] * qd[j]));
+        let kappa = (0..m).map(|j| qd[j] * h_qd[j]).sum::<f64>();
+        let force = f_cyl(l - self.l_retracted, v);
+        // M~ (its lower triangle, for [`cholesky`]); M_jk above the diagonal of `mw`, W_jk below.
+        let (mut mass, mut mw) = (vec![0.0; n * n], vec![0.0; n * n]);
+        // The right-hand side Phi: gravity, springs and dampers, -h, the rod.
+        let mut qdd = [0.0; MAX_SECTIONS];
+        self.forces(q, qd, &t, &mut qdd);
+        for j in 0..n {
+            mass[j * n + j] = self.len[j] * self.len[j] * self.m_out[j] + self.second[j] + self.m_rod * g[j] * g[j];
+            qdd[j] += g[j] * (force - self.m_rod * (kappa + self.g * u.y));
+            for k in j + 1..n {
+                let (aa, bb) = self.coupling(j, k);
+                let (sin, cos) = (rel.s[j] * rel.c[k] - rel.c[j] * rel.s[k], rel.c[j] * rel.c[k] + rel.s[j] * rel.s[k]);
+                let (m_jk, w_jk) = (aa * cos + bb * sin, aa * sin - bb * cos);
+                (mw[j * n + k], mw[k * n + j]) = (m_jk, w_jk);
+                mass[k * n + j] = m_jk + self.m_rod * g[j] * g[k];
+                // h_j = sum_k W_jk q_dot_k^2, W_kj = -W_jk.
+                qdd[j] -= w_jk * qd[k] * qd[k];
+                qdd[k] += w_jk * qd[j] * qd[j];
+            }
+        }
+        let mut inv_diag = [0.0; MAX_SECTIONS];
+        if !cholesky::factor(&mut mass, &mut inv_diag[..n]) {
+            return None;
+        }
+        cholesky::solve_rows(&mass, &inv_diag[..n], &mut qdd[..n]);
+        let h_qdd = times_h(&qdd);
+        let phi = force - self.m_rod * (kappa + self.g * u.y + (0..m).map(|j| g[j] * qdd[j]).sum::<f64>());
+        let mut a = vec![0.0; n * cols];
+        for j in 0..n {
+            let s = self.first[j];
+            a[j * cols + j] += self.g * ((self.m_out[j] * self.len[j] + s.x) * t.s[j] + s.y * t.c[j]);
+            a[j * cols + 2 * n] = g[j];
+            for k in j + 1..n {
+                let (m_jk, w_jk) = (mw[j * n + k], mw[k * n + j]);
+                let (jk, kj) = (m_jk * qd[k] * qd[k] - w_jk * qdd[k], m_jk * qd[j] * qd[j] + w_jk * qdd[j]);
+                a[j * cols + k] += jk;
+                a[j * cols + j] -= jk;
+                a[k * cols + j] += kj;
+                a[k * cols + k] -= kj;
+                a[j * cols + n + k] -= 2.0 * w_jk * qd[k];
+                a[k * cols + n + j] += 2.0 * w_jk * qd[j];
+            }
+        }
+        for i in 0..n - 1 {
+            let k = self.k[i];
+            a[i * cols + i] -= k;
+            a[i * cols + i + 1] += k;
+            a[(i + 1) * cols + i + 1] -= k;
+            a[(i + 1) * cols + i] += k;
+            let (first, row) = self.damper_row(i);
+            for (&c, j) in row.iter().zip(first..) {
+                a[i * cols + n + j + 1] += c;
+                a[i * cols + n + j] -= c;
+                a[(i + 1) * cols + n + j + 1] -= c;
+                a[(i + 1) * cols + n + j] += c;
+            }
+        }
+        for k in 0..m {
+            // d u / d q_k = (perp(r_k) - u g_k) / l; d kappa / d q_k from kappa =
+            // u . centripetal + (|C_dot|^2 - l_dot^2) / l.
+            let du = (perp(r[k]) - u * g[k]) / l;
+            let d_kappa = du.dot(&centripetal) - g[k] * qd[k] * qd[k]
+                - 2.0 * (qd[k] * c_dot.dot(&r[k]) + v * h_qd[k]) / l
+                - (c_dot.norm_squared() - v * v) * g[k] / (l * l);
+            let d_phi = -self.m_rod * (d_kappa + self.g * du.y + h_qdd[k]);
+            for j in 0..m {
+                a[j * cols + k] += hessian[j * m + k] * phi + g[j] * d_phi;
+                a[j * cols + n + k] -= 2.0 * self.m_rod * g[j] * h_qd[k];
+            }
+        }
+        cholesky::solve_rows(&mass, &inv_diag[..n], &mut a);
+        Some(ArmJacobian { qdd, rows: a, gradient: g, rate_gradient: h_qd })
     }
 
     /// Cylinder length |A C| for the section angles `q`.
@@ -994,6 +1154,16 @@ mod tests {
         (m + boom.m_rod * &g * g.transpose(), rhs)
     }
 
+    /// Pseudo-random numbers uniform in [-1, 1) (xorshift64 from `seed`).
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
     /// The sweeps of `accelerations` satisfy (M + m_rod g g^T) q_ddot = rhs (module doc) on
     /// random states of several layouts: section angles spread by 1e-4 rad (the stiff springs
     /// dominate), 1e-2 rad and 0.3 rad (beyond the polynomial sin and cos), speeds up to 20 rad/s.
@@ -1003,13 +1173,7 @@ mod tests {
     /// for 16 + 16 sections; these sweeps by 1.2e-13).
     #[test]
     fn equations_of_motion_hold() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rand = uniform(0x2545_f491_4f6c_dd1d);
         let p = BoomParams::default();
         let mut worst = 0.0f64;
         for (n2, n3) in [(4, 5), (0, 1), (0, 5), (1, 1), (3, 1), (8, 2), (16, 16)] {
@@ -1034,6 +1198,70 @@ mod tests {
             }
         }
         println!("largest residual / row terms: {worst:.2e}");
+    }
+
+    /// [`FlexibleBoom::acceleration_jacobian`] against a second implementation: the
+    /// articulated-body sweeps of `accelerations` in dual numbers, seeded with one coordinate,
+    /// rate or the cylinder force at a time, on the random states of `equations_of_motion_hold`
+    /// (angles spread by up to 0.3 rad, rates up to 20 rad/s), every damping law, several layouts.
+    /// The accelerations, the stroke's gradient g and d l_dot / dq come along. Both are exact;
+    /// they differ by rounding, which each solve with M~ amplifies by up to its condition number
+    /// kappa (4e2 at 0 + 3 sections, 8e4 at 4 + 5, 2.4e6 at 16 + 16): the bound is
+    /// 10 eps kappa(M~) of the largest entry of a row (the accelerations: of max |q_ddot|), the
+    /// 10 for the few roundings of each entry before the solve. g and H q_dot involve no solve:
+    /// 1e-12 m/rad and 1e-10 m/s/rad (entries up to 0.6 and 10) are rounding bounds.
+    #[test]
+    fn acceleration_jacobian_matches_dual_numbers() {
+        use crate::scalar::Dual64;
+        let mut rand = uniform(0x9e37_79b9_7f4a_7c15);
+        let p = BoomParams::default();
+        let mut worst = 0.0f64;
+        let laws = [DampingLaw::Thesis, DampingLaw::Structural, DampingLaw::Modal];
+        for (n2, n3, damping) in [(4, 5, 0), (4, 5, 1), (4, 5, 2), (0, 3, 0), (1, 2, 2), (8, 8, 0), (16, 16, 2)] {
+            let boom = build(&p, &BeamParams { n2, n3, damping: laws[damping], ..BeamParams::default() });
+            let n = boom.sections();
+            for x in [0.0, 0.45] {
+                let q0 = boom.equilibrium(x).unwrap().q;
+                for trial in 0..12 {
+                    let q: Vec<f64> = q0.iter().map(|a| a + [1e-4, 1e-2, 0.3][trial % 3] * rand()).collect();
+                    let qd: Vec<f64> = (0..n).map(|_| [0.1, 2.0, 20.0][trial % 3] * rand()).collect();
+                    let f = 24e3 * (1.0 + 0.5 * rand());
+                    let a = boom.acceleration_jacobian(&q, &qd, &mut |_, _| f).unwrap();
+                    let g = DVector::from_column_slice(&boom.cylinder_gradient(&boom.trig(&q))[..n]);
+                    let singular = (boom.mass_matrix(&q) + boom.m_rod * &g * g.transpose()).singular_values();
+                    let bound = 10.0 * f64::EPSILON * singular.max() / singular.min();
+                    let mut qdd = vec![0.0; n];
+                    boom.accelerations(&q, &qd, &mut |_, _| f, &mut qdd);
+                    let size = qdd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    let error = qdd.iter().zip(&a.qdd).fold(0.0f64, |m, (e, c)| m.max((e - c).abs()));
+                    worst = worst.max(error / size / bound);
+                    assert!(error < bound * size, "{n2} + {n3}: q_ddot {error} of {size}");
+                    // Column c of the closed form: q (c < n), q_dot (c < 2n), F_cyl.
+                    let mut exact = vec![0.0; n * (2 * n + 1)];
+                    for c in 0..=2 * n {
+                        let seeded = |x: &[f64], k: usize| -> Vec<Dual64> {
+                            x.iter().enumerate().map(|(i, &v)| Dual64::new(v, (i == k) as u8 as f64)).collect()
+                        };
+                        let (q_s, qd_s) = (seeded(&q, c), seeded(&qd, c.wrapping_sub(n)));
+                        let force = Dual64::new(f, (c == 2 * n) as u8 as f64);
+                        let mut out = vec![Dual64::from(0.0); n];
+                        boom.accelerations(&q_s, &qd_s, &mut |_, _| force, &mut out);
+                        (0..n).for_each(|j| exact[j * (2 * n + 1) + c] = out[j].eps);
+                        if c < n {
+                            let (dx, dv) = (boom.stroke(&q_s).eps, boom.stroke_rate(&q_s, &seeded(&qd, n)).eps);
+                            assert!((dx - a.gradient[c]).abs() < 1e-12 && (dv - a.rate_gradient[c]).abs() < 1e-10, "g, H q_dot");
+                        }
+                    }
+                    for (row, closed) in exact.chunks_exact(2 * n + 1).zip(a.rows.chunks_exact(2 * n + 1)) {
+                        let size = row.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                        let error = row.iter().zip(closed).fold(0.0f64, |m, (e, c)| m.max((e - c).abs()));
+                        worst = worst.max(error / size / bound);
+                        assert!(error < bound * size, "{n2} + {n3}, {:?}: {error} of {size}", laws[damping]);
+                    }
+                }
+            }
+        }
+        println!("largest difference / row's largest entry, over 10 eps cond(M~): {worst:.2e}");
     }
 
     /// The polynomial sin and cos agree with the library's to an ulp on [-0.1, 0.1].

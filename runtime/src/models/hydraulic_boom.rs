@@ -22,8 +22,9 @@ use crate::fmu::driver::Step;
 use crate::fmu::{ContinuousState, Log, Model, ModelInfo, Seeds, StepError, StepStart, Value, Values, Variable};
 use crate::hydraulics::circuit::{self, Circuit, N_STATES as N_CIRCUIT};
 use crate::hydraulics::params::PARAMS;
-use crate::mechanics::flexible_boom::MAX_SECTIONS;
-use crate::scalar::{Dual64, Scalar};
+use crate::mechanics::flexible_boom::{FlexibleBoom, MAX_SECTIONS};
+use crate::scalar::{Dual64, DualSVec64, Scalar};
+use nalgebra::{Const, DMatrix, U1};
 use crate::solver::{OdeSystem, SecondOrder};
 
 /// Value references (stable across releases: append, never renumber).
@@ -109,6 +110,15 @@ impl OdeSystem for Plant {
         self.rhs_with(self.u_ref.at(t), s, dx);
     }
 
+    /// The flexible boom's Jacobian from its structure ([`Plant::flexible_jacobian`]); the
+    /// rigid boom's by the integrator's finite differences.
+    fn jacobian(&self, t: f64, s: &[f64], jac: &mut DMatrix<f64>) -> bool {
+        match &self.boom {
+            Boom::Flexible(arm) => self.flexible_jacobian(arm, self.u_ref.at(t), s, jac),
+            Boom::Rigid(_) => false,
+        }
+    }
+
     /// dq/dt = q_dot: the integrator eliminates the coordinates from its linear systems.
     fn second_order(&self) -> Option<SecondOrder> {
         let dof = self.boom.mechanics().dof();
@@ -132,6 +142,64 @@ impl Plant {
             e.force
         };
         self.boom.kinetics().accelerations(q, qd, &mut force, dqd);
+    }
+
+    /// The Jacobian of [`Self::rhs_with`] for the flexible boom `arm` (issue 48): the circuit
+    /// sees the arm only through the stroke x and its rate v, and the arm the circuit only through
+    /// the cylinder force F, so the chain rule joins the circuit's derivatives with respect to its
+    /// states, x and v (exact, dual numbers in all seven directions at once) and the arm's closed
+    /// form ([`FlexibleBoom::acceleration_jacobian`], eq. 2.34-2.39 with 2.1-2.5):
+    /// d/dq = d/dx g^T + d/dv (H q_dot)^T, d/dq_dot = d/dv g^T, and d q_ddot / d(circuit) =
+    /// d q_ddot / dF dF / d(circuit). The rows of q are dq/dt = q_dot. `false` (the integrator's
+    /// finite differences) if the arm's mass matrix is singular.
+    fn flexible_jacobian(&self, arm: &FlexibleBoom, u_ref: f64, s: &[f64], jac: &mut DMatrix<f64>) -> bool {
+        type Seeded = DualSVec64<{ N_CIRCUIT + 2 }>;
+        const X: usize = N_CIRCUIT;
+        const V: usize = N_CIRCUIT + 1;
+        let n = arm.sections();
+        let (c, boom) = s.split_at(N_CIRCUIT);
+        let (q, qd) = boom.split_at(n);
+        let seeded = |value: f64, i: usize| Seeded::from_re(value).derivative(i);
+        let mut circuit = None;
+        let mut force = |x, v| {
+            let e = self.circuit.evaluate(&std::array::from_fn(|i| seeded(c[i], i)), Seeded::from(u_ref), seeded(x, X), seeded(v, V));
+            let force = e.force.re;
+            circuit = Some(e);
+            force
+        };
+        let (Some(a), Some(e)) = (arm.acceleration_jacobian(q, qd, &mut force), circuit) else {
+            return false;
+        };
+        let gradient = |y: Seeded| -> [f64; N_CIRCUIT + 2] { y.eps.unwrap_generic(Const, U1).into() };
+        let (dx, f) = (e.dx.map(gradient), gradient(e.force));
+        let (g, h_qd, rows) = (&a.gradient, &a.rate_gradient, &a.rows);
+        let (dim, vel, cols) = (N_CIRCUIT + 2 * n, N_CIRCUIT + n, 2 * n + 1);
+        let jac = jac.as_mut_slice();
+        // Each column z as a direction of the circuit's inputs (a circuit state; q_k through
+        // x and v; q_dot_k through v): its derivatives along it, then the accelerations' from the
+        // arm's own column `arm` and the force's.
+        for (z, col) in jac.chunks_exact_mut(dim).enumerate() {
+            // The arm's column is z - N_CIRCUIT: q_k, then q_dot_k.
+            let arm = z.checked_sub(N_CIRCUIT);
+            let along = |d: &[f64; N_CIRCUIT + 2]| match arm {
+                None => d[z],
+                Some(k) if k < n => d[X] * g[k] + d[V] * h_qd[k],
+                Some(k) => d[V] * g[k - n],
+            };
+            for (ci, d) in col.iter_mut().zip(&dx) {
+                *ci = along(d);
+            }
+            col[N_CIRCUIT..vel].fill(0.0);
+            if let Some(k) = arm.filter(|&k| k >= n) {
+                // dq/dt = q_dot.
+                col[N_CIRCUIT + k - n] = 1.0;
+            }
+            let d_force = along(&f);
+            for (ci, row) in col[vel..].iter_mut().zip(rows.chunks_exact(cols)) {
+                *ci = arm.map_or(0.0, |a| row[a]) + row[2 * n] * d_force;
+            }
+        }
+        true
     }
 
     /// The derivatives `dx` of the Model Exchange states at the plant state `s` (native

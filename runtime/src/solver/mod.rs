@@ -8,6 +8,7 @@
 use nalgebra::DMatrix;
 use std::fmt;
 
+pub(crate) mod cholesky;
 mod iteration;
 mod lu;
 pub mod radau5;
