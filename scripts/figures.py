@@ -65,13 +65,16 @@ def u_against_b() -> None:
 
 
 def notebook() -> None:
-    """Runs the notebook from top to bottom in the checkout (its files go to out/) and saves its
-    outputs in place."""
+    """Runs the notebook from top to bottom in a temporary folder (its files go to out/ there)
+    and saves its outputs in place."""
+    import tempfile
+
     import nbclient
     import nbformat
 
     nb = nbformat.read(ROOT / NOTEBOOK, as_version=4)
-    nbclient.NotebookClient(nb, timeout=600, resources={"metadata": {"path": str(ROOT)}}).execute()
+    with tempfile.TemporaryDirectory() as folder:
+        nbclient.NotebookClient(nb, timeout=600, resources={"metadata": {"path": folder}}).execute()
     nbformat.write(nb, ROOT / NOTEBOOK)
 
 
