@@ -133,6 +133,9 @@ pub const MAX_SECTIONS: usize = 32;
 
 pub type Column = [f64; MAX_SECTIONS];
 
+/// The most numbers of [`ArmJacobian::rows`]: n rows of 2n + 1 at n = [`MAX_SECTIONS`].
+const JACOBIAN_ROWS: usize = MAX_SECTIONS * (2 * MAX_SECTIONS + 1);
+
 /// The lumped flexible boom; see the module documentation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlexibleBoom {
@@ -191,8 +194,8 @@ pub struct ArmJacobian {
     /// The accelerations q_ddot (the first n).
     pub qdd: Column,
     /// d q_ddot / d q, d q_ddot / d q_dot at a fixed cylinder force, then d q_ddot / d F_cyl:
-    /// n rows of 2n + 1, one after the other.
-    pub rows: Vec<f64>,
+    /// n rows of 2n + 1, one after the other (the rest zero).
+    pub rows: [f64; JACOBIAN_ROWS],
     /// g = d x / d q = d v / d q_dot of the stroke x and its rate v (zero beyond part II).
     pub gradient: Column,
     /// d v / d q = H q_dot.
@@ -605,8 +608,10 @@ impl FlexibleBoom {
         let r: [Vector2<f64>; MAX_SECTIONS] =
             std::array::from_fn(|j| if j < m { self.lever(&t, j) } else { Vector2::zeros() });
         let g = self.cylinder_gradient(&t);
-        let mut hessian = vec![0.0; m * m];
-        for (j, row) in hessian.chunks_exact_mut(m).enumerate() {
+        // Every matrix on the stack, at the chain's largest size: a real-time doStep never
+        // allocates (tests/leaks).
+        let mut hessian = [0.0; MAX_SECTIONS * MAX_SECTIONS];
+        for (j, row) in hessian[..m * m].chunks_exact_mut(m).enumerate() {
             for (k, h) in row.iter_mut().enumerate() {
                 *h = (r[j].dot(&r[k]) - g[j] * g[k]) / l;
             }
@@ -623,7 +628,7 @@ impl FlexibleBoom {
         let kappa = (0..m).map(|j| qd[j] * h_qd[j]).sum::<f64>();
         let force = f_cyl(l - self.l_retracted, v);
         // M~ (its lower triangle, for [`cholesky`]); M_jk above the diagonal of `mw`, W_jk below.
-        let (mut mass, mut mw) = (vec![0.0; n * n], vec![0.0; n * n]);
+        let (mut mass, mut mw) = ([0.0; MAX_SECTIONS * MAX_SECTIONS], [0.0; MAX_SECTIONS * MAX_SECTIONS]);
         // The right-hand side Phi: gravity, springs and dampers, -h, the rod.
         let mut qdd = [0.0; MAX_SECTIONS];
         self.forces(q, qd, &t, &mut qdd);
@@ -642,13 +647,14 @@ impl FlexibleBoom {
             }
         }
         let mut inv_diag = [0.0; MAX_SECTIONS];
-        if !cholesky::factor(&mut mass, &mut inv_diag[..n]) {
+        let mass = &mut mass[..n * n];
+        if !cholesky::factor(mass, &mut inv_diag[..n]) {
             return None;
         }
-        cholesky::solve_rows(&mass, &inv_diag[..n], &mut qdd[..n]);
+        cholesky::solve_rows(mass, &inv_diag[..n], &mut qdd[..n]);
         let h_qdd = times_h(&qdd);
         let phi = force - self.m_rod * (kappa + self.g * u.y + (0..m).map(|j| g[j] * qdd[j]).sum::<f64>());
-        let mut a = vec![0.0; n * cols];
+        let mut a = [0.0; JACOBIAN_ROWS];
         for j in 0..n {
             let s = self.first[j];
             a[j * cols + j] += self.g * ((self.m_out[j] * self.len[j] + s.x) * t.s[j] + s.y * t.c[j]);
@@ -691,7 +697,7 @@ impl FlexibleBoom {
                 a[j * cols + n + k] -= 2.0 * self.m_rod * g[j] * h_qd[k];
             }
         }
-        cholesky::solve_rows(&mass, &inv_diag[..n], &mut a);
+        cholesky::solve_rows(mass, &inv_diag[..n], &mut a[..n * cols]);
         Some(ArmJacobian { qdd, rows: a, gradient: g, rate_gradient: h_qd })
     }
 
