@@ -9,7 +9,6 @@ over the whole cycles of p3 there, as boomsim.metrics' v_steady: a window with a
 period left over would be biased by the oscillation's phase).
 
     PYTHONPATH=python .venv/bin/python scripts/me_trial_states.py [--rtol 1e-4 1e-3] [--u -0.3]
-        [--param friction.regularisation=lugre]  (FMU parameters of every run, the reference's too)
 """
 
 import argparse
@@ -20,7 +19,6 @@ from pathlib import Path
 import numpy as np
 from fmpy import simulate_fmu
 
-from boomsim.errors import parse_params
 from boomsim.metrics import OSCILLATING, dominant_frequency, whole_cycles
 
 FMU = str(Path(__file__).resolve().parent.parent / "target" / "fmu" / "HydraulicBoom.fmu")
@@ -28,15 +26,15 @@ COMMANDS = [-1.0, -0.7, -0.5, -0.3, -0.2, -0.1, -0.05]
 OUTPUTS = ["p1", "p2", "p3", "p4", "cylinder.x"]
 
 
-def run(interface, u, flexible, rtol, params, reached=None):
-    """One run with the FMU parameters `params`; `reached[0]`: the last output time."""
+def run(interface, u, flexible, rtol, reached=None):
+    """One run; `reached[0]`: the last output time."""
     def step_finished(t, _recorder):
         if reached is not None:
             reached[0] = t
         return True
 
     return simulate_fmu(FMU, fmi_type=interface, relative_tolerance=rtol, stop_time=2.0, output_interval=1e-3,
-                        output=OUTPUTS, start_values={**params, "boom.flexible": flexible, "valve.u_ref": u},
+                        output=OUTPUTS, start_values={"boom.flexible": flexible, "valve.u_ref": u},
                         step_finished=step_finished)
 
 
@@ -51,10 +49,10 @@ def late(r):
     return np.ptp(p3) / 1e5, f, amp / 1e5, (np.interp(t_b, t, x) - np.interp(t_a, t, x)) / (t_b - t_a)
 
 
-def row(u, flexible, rtol, params, ref):
+def row(u, flexible, rtol, ref):
     t0, reached = time.time(), [0.0]
     try:
-        me = run("ModelExchange", u, flexible, rtol, params, reached)
+        me = run("ModelExchange", u, flexible, rtol, reached)
     except Exception:  # fmpy raises on CVode's failure
         return [u, "flexible" if flexible else "rigid", rtol, f"no (t = {reached[0]:.3f} s)"] + ["-"] * 6, \
             time.time() - t0
@@ -72,22 +70,19 @@ def main():
     ap.add_argument("--rtol", type=float, nargs="+", default=[1e-4, 1e-3])
     ap.add_argument("--u", type=float, nargs="+", default=COMMANDS)
     ap.add_argument("--boom", nargs="+", choices=["rigid", "flexible"], default=["rigid", "flexible"])
-    ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                    help="an FMU parameter for every run (repeatable), e.g. friction.regularisation=lugre")
     a = ap.parse_args()
-    params = parse_params(ap, a.param)
     head = ["u_ref", "boom", "rtol", "completed", "min p [bar]", "max p [bar]", "p3 err 0-0.3 s [bar]",
             "p3 ptp 1-2 s [%]", "f_dom [%]", "speed [%]"]
     rows = []
     for boom in a.boom:
         for u in a.u:
             t0 = time.time()
-            ref = run("CoSimulation", u, boom == "flexible", 1e-9, params)
+            ref = run("CoSimulation", u, boom == "flexible", 1e-9)
             low = min(ref[n].min() for n in ("p2", "p3", "p4")) + 1.01325e5
             print(f"reference {boom} u_ref {u}: {time.time() - t0:.1f} s, lowest absolute pressure {low:.0f} Pa",
                   file=sys.stderr, flush=True)
             for rtol in a.rtol:
-                r, dt = row(u, boom == "flexible", rtol, params, ref)
+                r, dt = row(u, boom == "flexible", rtol, ref)
                 print(f"  rtol {rtol:g}: {r[3]} ({dt:.1f} s)", file=sys.stderr, flush=True)
                 rows.append(r)
     print("| " + " | ".join(head) + " |")

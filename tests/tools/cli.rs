@@ -13,7 +13,7 @@ fn boomsim(args: &[&str]) -> (bool, String) {
 
 #[test]
 fn wrong_arguments_get_one_clear_line() {
-    let cases: [(&[&str], &[&str]); 23] = [
+    let cases: [(&[&str], &[&str]); 21] = [
         (&["analyze", "--xc", "-10"], &["x_c = -10 mm is outside the stroke [0, 500] mm"]),
         (&["analyze", "--p4", "-5"], &["p4 = -5 bar must be >= 0"]),
         (&["bench", "--duration", "0"], &["0 is not a positive number of seconds"]),
@@ -29,12 +29,6 @@ fn wrong_arguments_get_one_clear_line() {
         (&["eigen", "--set", "boom.damping=viscous"], &["boom.damping = viscous is no item of DampingLaw", "3 (converged_modal)"]),
         (&["bench", "--set", "boom.damping=1", "--json"], &["does not go with --json"]),
         (&["bench", "--realtime", "--set", "boom.damping=1"], &["does not go with --realtime"]),
-        (&["bench", "--base", "boom.damping=thesis"], &["--set"]),
-        // eigen leaves friction out (friction.p_static = 0): LuGre divides by the static level.
-        (
-            &["eigen", "--set", "friction.regularisation=lugre"],
-            &["friction.regularisation = lugre needs a static friction level above 0", "friction.p_static = 0"],
-        ),
         (&["linearize", "--u-ref", "-2"], &["--u-ref -2 is outside [-1, 1]"]),
         (&["linearize", "--u-ref", "0"], &["valve.u_ref = 0: a steady lowering needs a reference below 0", "--rest"]),
         (&["linearize", "--stroke", "600"], &["start.x = 0.6 is outside the stroke [0, 0.5] m"]),

@@ -67,11 +67,6 @@ enum Cmd {
         /// cancels), e.g. --set boom.damping=structural.
         #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
         set: Vec<String>,
-        /// With --set: a parameter of the HydraulicBoom that both runs take, NAME=VALUE
-        /// (repeatable), so that --set is compared against it rather than the defaults, e.g.
-        /// --base boom.damping=thesis --set friction.regularisation=lugre.
-        #[arg(long = "base", value_name = "NAME=VALUE", allow_hyphen_values = true, requires = "set")]
-        base: Vec<String>,
     },
     /// Modes of the HydraulicBoom linearised at rest with the boom horizontal (full payload,
     /// spool closed): the flexible boom (default n2 = 4, n3 = 5) and, for comparison, the rigid one.
@@ -186,19 +181,19 @@ fn bench_interfaces() -> Result<(), String> {
     status.success().then_some(()).ok_or_else(|| format!("scripts/bench_interfaces.py: {status}"))
 }
 
-fn bench(json: bool, duration: f64, set: &[String], base: &[String]) -> Result<(), String> {
+fn bench(json: bool, duration: f64, set: &[String]) -> Result<(), String> {
     use boomsim_tools::analysis::modes::parameter_change;
-    let parse = |args: &[String]| {
-        args.iter().map(|arg| parameter_change(arg).map(|(v, value)| (v.vr, value))).collect::<Result<Vec<_>, String>>()
-    };
-    let (changes, base_changes) = (parse(set)?, parse(base)?);
+    let changes = set
+        .iter()
+        .map(|arg| parameter_change(arg).map(|(v, value)| (v.vr, value)))
+        .collect::<Result<Vec<_>, String>>()?;
     if json && !changes.is_empty() {
         return Err("--set prints a comparison table; it does not go with --json".into());
     }
     build_fmus(&boomsim_tools::platform::PLATFORMS[0])?;
     let libs = target_dir().join("release");
     if !changes.is_empty() {
-        return bench_changes(&libs, duration, (&base_changes, base), (&changes, set));
+        return bench_changes(&libs, duration, &changes, set);
     }
     let results = boomsim_tools::bench::run_all(&libs, duration, &[])?;
     let cycle_in = boomsim_tools::bench::controller_cycle(
@@ -246,19 +241,17 @@ fn bench(json: bool, duration: f64, set: &[String], base: &[String]) -> Result<(
     Ok(())
 }
 
-/// `boomsim bench --set`: every case with the default parameters (and `--base`'s), then with
-/// `changes` too, and the ratios (reference over changed: above 1, the change is faster or needs
-/// fewer evaluations).
+/// `boomsim bench --set`: every case with the default parameters, then with `changes`, and the
+/// ratios (default over changed: above 1, the change is faster or needs fewer evaluations).
 fn bench_changes(
     libs: &Path,
     duration: f64,
-    (base, base_args): (&[(u32, boomsim::fmu::Value)], &[String]),
-    (changes, set): (&[(u32, boomsim::fmu::Value)], &[String]),
+    changes: &[(u32, boomsim::fmu::Value)],
+    set: &[String],
 ) -> Result<(), String> {
-    let reference = boomsim_tools::bench::run_all(libs, duration, base)?;
-    let changed = boomsim_tools::bench::run_all(libs, duration, &[base, changes].concat())?;
-    let with = if base_args.is_empty() { String::new() } else { format!(" with {}", base_args.join(", ")) };
-    println!("{duration} s per case, 1 ms steps, rtol 1e-6; default{with} against {}", set.join(", "));
+    let reference = boomsim_tools::bench::run_all(libs, duration, &[])?;
+    let changed = boomsim_tools::bench::run_all(libs, duration, changes)?;
+    println!("{duration} s per case, 1 ms steps, rtol 1e-6; default against {}", set.join(", "));
     println!(
         "{:<5} {:<8} {:<11} {:>8} {:>8} {:>10} {:>10} {:>8} {:>8} {:>9} {:>9}",
         "case", "boom", "via", "rtf", "rtf set", "rhs", "rhs set", "jac", "jac set", "speed-up", "rhs ratio"
@@ -467,8 +460,8 @@ fn main() -> ExitCode {
             .into()),
         Cmd::Bench { realtime: true, duration, repeats, .. } => bench_realtime(repeats as usize, duration),
         Cmd::Bench { jacobian: true, .. } => bench_jacobian(),
-        Cmd::Bench { json, duration, model_exchange, set, base, .. } => {
-            bench(json, duration, &set, &base).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
+        Cmd::Bench { json, duration, model_exchange, set, .. } => {
+            bench(json, duration, &set).and_then(|()| if model_exchange { bench_interfaces() } else { Ok(()) })
         }
         Cmd::Eigen { json, count, p4, set } => eigen(json, count, p4, &set),
         Cmd::Xml { check } => xml(check),

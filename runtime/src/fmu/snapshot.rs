@@ -23,7 +23,7 @@ use super::version::Version;
 
 const MAGIC: &[u8; 8] = b"BOOMSIM\0";
 /// Version of the byte format; bump it when the layout changes.
-pub const FORMAT_VERSION: u32 = 7;
+pub const FORMAT_VERSION: u32 = 6;
 
 /// Who took a state: the FMI version and interface of the instance.
 pub type Origin = (Version, Interface);

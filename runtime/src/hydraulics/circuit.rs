@@ -4,9 +4,8 @@
 //! line 3 + piston-side chamber (p3); rod-side chamber + line 4 (p4) -> B->T (Q4) for `u > 0`,
 //! mirrored for `u < 0`. The CBV pilot is p4; the compensator senses p2 or p4.
 //!
-//! States (see [`STATE_NAMES`]): the pressures p2..p4, the main spool position, the
-//! load-holding valve opening and the friction's bristle deflection (LuGre; constant under the
-//! `tanh` regularisation, [`super::friction::FrictionRegularisation`]). Line 1 (p1, between compensator and spool) is quasi-static
+//! States (see [`STATE_NAMES`]): the pressures p2..p4, the main spool position and the
+//! load-holding valve opening. Line 1 (p1, between compensator and spool) is quasi-static
 //! ([`Circuit::line1_pressure`]). Line 3 and the piston-side chamber form one volume, as do the
 //! rod-side chamber and line 4: nothing restricts flow between them, and the thesis uses one
 //! pressure for each (p3, p4 in eq. 2.69-2.71, the Fig. 3.16 model and the logged rig data). The
@@ -26,7 +25,7 @@ use super::supply::Supply;
 use crate::scalar::{max, Dual64, Scalar};
 
 /// Number of continuous states.
-pub const N_STATES: usize = 6;
+pub const N_STATES: usize = 5;
 /// Index of p2, line 2 between DCV port A and CBV (Pa).
 pub const P2: usize = 0;
 /// Index of p3, line 3 and piston-side chamber (Pa).
@@ -37,10 +36,8 @@ pub const P4: usize = 2;
 pub const X_V: usize = 3;
 /// Index of the load-holding valve opening `u_cbv` (-).
 pub const U_CBV: usize = 4;
-/// Index of the friction's bristle deflection `z` (m), LuGre ([`Friction::force`]).
-pub const Z: usize = 5;
 /// Structured names of the states, in state order.
-pub const STATE_NAMES: [&str; N_STATES] = ["p2", "p3", "p4", "valve.x_v", "cbv.u_cbv", "friction.z"];
+pub const STATE_NAMES: [&str; N_STATES] = ["p2", "p3", "p4", "valve.x_v", "cbv.u_cbv"];
 
 /// Circuit state vector, laid out as [`STATE_NAMES`].
 pub type State = [f64; N_STATES];
@@ -135,13 +132,12 @@ impl Circuit {
     /// - line 1: quasi-static, `Q1 - Q_P - Q_LP = 0` ([`Circuit::line1_pressure`]);
     /// - line 2 (`V_L2`): `Q2 - Q3 - Q_LA`;
     /// - line 3 + chamber A (`V_L3 + V_CH1 + A x`): `Q3 - A v` (eq. 2.70);
-    /// - chamber B + line 4 (`V_L4 + V_CH2 + mu_c A (s_c - x)`): `mu_c A v - Q4 - Q_LB` (2.71);
-    /// - bristle deflection: [`Friction::force`]'s rate (LuGre; zero under `tanh`).
+    /// - chamber B + line 4 (`V_L4 + V_CH2 + mu_c A (s_c - x)`): `mu_c A v - Q4 - Q_LB` (2.71).
     ///
     /// The geometric chamber volumes are kept above 10 % of the dead volume, a guard that only
     /// matters for strokes far outside the end stops.
     pub fn evaluate<T: Scalar>(&self, s: &[T; N_STATES], u_ref: T, x: T, v: T) -> Eval<T> {
-        let [p2, p3, p4, x_v, u_cbv, z] = *s;
+        let [p2, p3, p4, x_v, u_cbv] = *s;
         let (p_t, p_tr) = (self.supply.p_t, self.p_tr);
         let (cyl, fl, ln) = (&self.cylinder, &self.fluid, &self.lines);
 
@@ -166,8 +162,7 @@ impl Circuit {
         dx[U_CBV] = self.cbv.holding_rate(u_cbv, u_cbv_static);
 
         let f_pressure = cyl.pressure_force(p3, p4);
-        let (f_friction, dz) = self.friction.force(cyl, v, x, p3, p4, z);
-        dx[Z] = dz;
+        let f_friction = self.friction.force(cyl, v, x, p3, p4);
         let f_stop = cyl.end_stop_force(x, v);
         Eval {
             dx,
@@ -493,7 +488,7 @@ mod tests {
         for p in [-1e7, -P_ATM, 0.0, 1e9] {
             for xv in [-1.0, 0.0, 1.0] {
                 for (x, v) in [(-1.0, -10.0), (0.25, 0.0), (2.0, 10.0)] {
-                    let s = [p, p, p, xv, 2.0, 0.0];
+                    let s = [p, p, p, xv, 2.0];
                     for u_ref in [-5.0, 0.0, 5.0] {
                         let e = c.evaluate(&s, u_ref, x, v);
                         assert!(e.dx.iter().all(|d| d.is_finite()), "{s:?} {x} {v}");
@@ -514,7 +509,7 @@ mod tests {
             for (p2, p3, p4) in
                 [(0.0, 70.0, 0.0), (1.0, 100.0, 40.0), (80.0, 75.0, 2.0), (3.0, 230.0, 180.0), (0.6, 0.6, 201.3)]
             {
-                cases.push([bar(p2), bar(p3), bar(p4), x_v, 0.3, 0.0]);
+                cases.push([bar(p2), bar(p3), bar(p4), x_v, 0.3]);
             }
         }
         cases.push(c.equilibrium(30e3, None).unwrap());
@@ -578,7 +573,7 @@ mod tests {
                 assert!(t < 1e-7, "{s:?}: {t} s");
             }
         }
-        let closed = [0.0, bar(70.0), 0.0, 0.0, 0.0, 0.0];
+        let closed = [0.0, bar(70.0), 0.0, 0.0, 0.0];
         let (t, u_pcv) = tau(&closed, bar(180.0));
         assert_eq!(u_pcv, 0.0);
         assert!((t - V_L1 / (c.fluid.bulk_modulus(bar(180.0)) * c.dcv.dq_leak)).abs() < 1e-9 * t);

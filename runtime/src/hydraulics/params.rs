@@ -6,7 +6,7 @@ use super::cbv::Cbv;
 use super::circuit::Circuit;
 use super::cylinder::Cylinder;
 use super::dcv::Dcv;
-use super::friction::{Friction, FrictionModel, FrictionRegularisation};
+use super::friction::{Friction, FrictionModel};
 use super::line::{Fluid, Lines};
 use super::pcv::Pcv;
 use super::supply::Supply;
@@ -490,29 +490,6 @@ pub const PARAMS: &[Param] = &[
         "Largest spool speed toward neutral, with valve.omega_loop > 0",
         "Table 4.2: 7 mm in the rated reaction time max -> neutral, 0.090 s"
     ),
-    param!(choice "friction.regularisation", friction.regularisation, FrictionRegularisation::Tanh,
-        "How the friction law's sign(v) is made continuous: tanh (tanh(v / v_s)) or lugre (bristle state friction.z)",
-        "not in the thesis: issue 49, docs/models.md (Friction); tanh gives the results before it"),
-    param!(
-        "friction.sigma_0",
-        friction.sigma_0,
-        1e7,
-        "N/m",
-        "",
-        [1e3, 1e10],
-        "LuGre bristle stiffness (friction.regularisation = lugre)",
-        "not in the thesis: pre-sliding 33-115 um at the laws' static levels (Canudas de Wit et al. 1995)"
-    ),
-    param!(
-        "friction.sigma_1",
-        friction.sigma_1,
-        14142.0,
-        "N.s/m",
-        "",
-        [0.0, 1e9],
-        "LuGre bristle damping (friction.regularisation = lugre)",
-        "not in the thesis: 2 sqrt(sigma_0 m), critical on the piston and rod, cylinder.m_rod = 5 kg (Canudas de Wit et al. 1995)"
-    ),
 ];
 
 impl Default for Circuit {
@@ -553,7 +530,6 @@ impl Default for Circuit {
             },
             friction: Friction {
                 model: FrictionModel::Bak,
-                regularisation: FrictionRegularisation::Tanh,
                 c_p_bak: 0.0,
                 p_static: 0.0,
                 v_s: 0.0,
@@ -564,8 +540,6 @@ impl Default for Circuit {
                 c_p: 0.0,
                 c_tan: 0.0,
                 c_l: 0.0,
-                sigma_0: 0.0,
-                sigma_1: 0.0,
             },
             fluid: Fluid { beta: 0.0, air_fraction: 0.0 },
             lines: Lines { v_l2: 0.0, v_l3: 0.0, v_l4: 0.0, c_hose: 0.0 },

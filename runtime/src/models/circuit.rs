@@ -5,7 +5,6 @@ use super::table::param_value;
 use super::vr;
 use crate::fmu::Values;
 use crate::hydraulics::circuit::{self, Circuit, Eval, N_STATES as N_CIRCUIT};
-use crate::hydraulics::friction::{FrictionModel, FrictionRegularisation};
 use crate::scalar::Scalar;
 
 /// The circuit from the parameter values at [`vr::hydraulic`]; refuses inconsistent combinations.
@@ -21,17 +20,6 @@ pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
     if circuit.dcv.x_db >= circuit.dcv.x_max {
         return Err(format!("valve.x_db = {} must be less than valve.x_max = {}", circuit.dcv.x_db, circuit.dcv.x_max));
     }
-    let fr = &circuit.friction;
-    if fr.regularisation == FrictionRegularisation::Lugre && fr.static_floor(cyl) <= 0.0 {
-        let level = match fr.model {
-            FrictionModel::Bak => format!("friction.p_static = {}", fr.p_static),
-            _ => format!("friction.f_s = {}, friction.f_c = {}", fr.f_s, fr.f_c),
-        };
-        return Err(format!(
-            "friction.regularisation = lugre needs a static friction level above 0 (LuGre's bristle rate \
-             divides by it): {level}; use friction.regularisation = tanh for no friction"
-        ));
-    }
     Ok(circuit)
 }
 
@@ -44,10 +32,8 @@ pub(crate) fn circuit_from_values(values: &Values) -> Result<Circuit, String> {
 pub(crate) const ME_TOLERANCE: f64 = 1e-6;
 
 /// Scales of the circuit states for the absolute tolerance `atol_i = rtol * scale_i`: 1 bar,
-/// 1 mm of spool travel, full valve opening, 10 um of bristle deflection (LuGre; its force
-/// `sigma_0 z` at the default 1e7 N/m is 100 N, of the order of 1 bar on the piston, 332 N;
-/// the pre-sliding range is 33-115 um).
-pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e-3, 1.0, 1e-5];
+/// 1 mm of spool travel, full valve opening.
+pub(crate) const CIRCUIT_SCALE: [f64; N_CIRCUIT] = [1e5, 1e5, 1e5, 1e-3, 1.0];
 
 /// The outputs and locals that are circuit states: (value reference, index in the state).
 const STATE_ROWS: [(u32, usize); N_CIRCUIT] = [
@@ -56,14 +42,12 @@ const STATE_ROWS: [(u32, usize); N_CIRCUIT] = [
     (vr::P4, circuit::P4),
     (vr::X_V, circuit::X_V),
     (vr::U_CBV, circuit::U_CBV),
-    (vr::FRICTION_Z, circuit::Z),
 ];
 
 /// The circuit's outputs and locals (p1..Q4, cylinder.F, cylinder.F_fr, spool, compensator,
-/// load-sensing pressure, bristle deflection) for state `c` and its evaluation `e`, as (value
-/// reference, value).
-pub(crate) fn circuit_rows<T: Scalar>(c: &[T; N_CIRCUIT], e: &Eval<T>) -> [(u32, T); 17] {
-    let [s0, s1, s2, s3, s4, s5] = STATE_ROWS.map(|(r, i)| (r, c[i]));
+/// load-sensing pressure) for state `c` and its evaluation `e`, as (value reference, value).
+pub(crate) fn circuit_rows<T: Scalar>(c: &[T; N_CIRCUIT], e: &Eval<T>) -> [(u32, T); 16] {
+    let [s0, s1, s2, s3, s4] = STATE_ROWS.map(|(r, i)| (r, c[i]));
     [
         (vr::P1, e.p1),
         s0,
@@ -81,7 +65,6 @@ pub(crate) fn circuit_rows<T: Scalar>(c: &[T; N_CIRCUIT], e: &Eval<T>) -> [(u32,
         s3,
         (vr::U_PCV, e.u_pcv),
         (vr::P_X, e.p_x),
-        s5,
     ]
 }
 

@@ -18,26 +18,21 @@ const PHI_NOMINAL: f64 = 2e-3;
 const OMEGA_NOMINAL: f64 = 0.1;
 
 /// The value reference of `der()` of slot `k` of HydraulicBoom's layout as it was with line 1
-/// integrated (p1, the circuit's other five, then the boom's 64; slot 70 is `friction.z`'s, added
-/// later); the same in every model that has the state. Slot 0, der(p1), is retired: line 1 is quasi-static
+/// integrated (p1, the circuit's other five, then the boom's 64); the same in every model that
+/// has the state. Slot 0, der(p1), is retired: line 1 is quasi-static
 /// ([`crate::hydraulics::Circuit::line1_pressure`]).
 const fn der_vr(k: usize) -> u32 {
     vr::DERIVATIVES + k as u32
 }
 
-/// The `der()` slot of the bristle deflection `friction.z` (added with LuGre, issue 49): the
-/// first after the boom's, so that no existing reference moves.
-const FRICTION_Z_SLOT: usize = 6 + 2 * MAX_SECTIONS;
-
-/// The circuit's states p2..p4, spool position, load-holding opening, bristle deflection, with
-/// their nominals ([`super::circuit::CIRCUIT_SCALE`]).
+/// The circuit's states p2..p4, spool position, load-holding opening, with their nominals
+/// ([`super::circuit::CIRCUIT_SCALE`]).
 pub(crate) const CIRCUIT_STATES: [ContinuousState; N_CIRCUIT] = {
-    let r = [vr::P2, vr::P3, vr::P4, vr::X_V, vr::U_CBV, vr::FRICTION_Z];
-    let slot = [1, 2, 3, 4, 5, FRICTION_Z_SLOT];
+    let r = [vr::P2, vr::P3, vr::P4, vr::X_V, vr::U_CBV];
     let mut s = [ContinuousState { state: 0, derivative: 0, nominal: 0.0 }; N_CIRCUIT];
     let mut k = 0;
     while k < N_CIRCUIT {
-        s[k] = ContinuousState { state: r[k], derivative: der_vr(slot[k]), nominal: super::circuit::CIRCUIT_SCALE[k] };
+        s[k] = ContinuousState { state: r[k], derivative: der_vr(1 + k), nominal: super::circuit::CIRCUIT_SCALE[k] };
         k += 1;
     }
     s
@@ -77,7 +72,6 @@ pub(crate) const CIRCUIT_DERIVATIVES: [Variable; N_CIRCUIT] = [
     der("der(p4)", 3, "Pa/s", "bar/s"),
     der("der(valve.x_v)", 4, "m/s", "mm/s"),
     der("der(cbv.u_cbv)", 5, "1/s", ""),
-    der("der(friction.z)", FRICTION_Z_SLOT, "m/s", "mm/s"),
 ];
 
 /// The `der()` variables of the boom's states.

@@ -33,7 +33,7 @@ pub mod vr {
 }
 
 #[rustfmt::skip]
-const OWN: [Variable; 39] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 38] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         out("cylinder.x", vr::X, "m", "mm", "Cylinder stroke"),

@@ -64,7 +64,7 @@ const START_FORCE: ParamSpec = ParamSpec {
 };
 
 #[rustfmt::skip]
-const OWN: [Variable; 43] = TableBuilder::new(&[U_REF_INPUT])
+const OWN: [Variable; 42] = TableBuilder::new(&[U_REF_INPUT])
     .vars(&CIRCUIT_OUTPUTS)
     .vars(&[
         Variable::real_input("cylinder.x", vr::X, 0.480, "m", "mm", (-1.0, 10.0),

@@ -47,14 +47,12 @@ pub(crate) const CIRCUIT_OUTPUTS: [Variable; 11] = [
     out("Q4", vr::Q4, "m3/s", "l/min", "DCV flow out of line 4, B->T / P->B (eq. 2.41, 2.43)"),
 ];
 
-/// The circuit's locals: spool position, bristle deflection, compensator opening, load-sensing pressure, and the
+/// The circuit's locals: spool position, compensator opening, load-sensing pressure, and the
 /// event indicators ([`super::circuit::event_indicators`]; FMI 3.0 lists them as
 /// ModelStructure `<EventIndicator>`).
 #[rustfmt::skip]
-pub(crate) const CIRCUIT_LOCALS: [Variable; 7] = [
+pub(crate) const CIRCUIT_LOCALS: [Variable; 6] = [
     Variable::real_local("valve.x_v", vr::X_V, "m", "mm", "Main spool position (state of eq. 2.45)"),
-    Variable::real_local("friction.z", vr::FRICTION_Z, "m", "mm",
-        "Friction bristle deflection (LuGre, Canudas de Wit et al. 1995); 0 with friction.regularisation = tanh"),
     Variable::real_local("pcv.u", vr::U_PCV, "1", "%", "Pressure compensator opening (eq. 2.49)"),
     Variable::real_local("valve.p_x", vr::P_X, "Pa", "bar", "Load-sensing pressure p_x, gauge"),
     Variable::real_local("event.spool_reference", vr::EVENT_U_REF, "1", "%",

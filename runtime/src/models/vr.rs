@@ -33,16 +33,13 @@ pub const EVENT_DEAD_BAND_LOWER: u32 = 29;
 pub const X0: u32 = 30;
 pub const FLEXIBLE: u32 = 31;
 pub const START_P4: u32 = 32;
-/// The friction's bristle deflection (LuGre), a circuit state ([`crate::hydraulics::circuit::Z`]).
-pub const FRICTION_Z: u32 = 37;
 pub const TIP_DEFLECTION: u32 = 40;
 /// Section angles: `SECTIONS + i` is `boom.section[i + 1].phi`.
 pub const SECTIONS: u32 = 41;
 /// Section rates: `SECTION_RATES + i` is `boom.section[i + 1].omega`.
 pub const SECTION_RATES: u32 = 300;
 /// Derivatives of the continuous states: `DERIVATIVES + k` is der() of state k of
-/// HydraulicBoom's layout with line 1 integrated, then `friction.z`'s at + 70
-/// ([`crate::models::exposed`]).
+/// HydraulicBoom's layout ([`crate::models::states`]).
 pub const DERIVATIVES: u32 = 400;
 /// Hydraulic parameters: [`hydraulic`] of their index in [`crate::hydraulics::params::PARAMS`].
 pub const HYDRAULICS: u32 = 100;

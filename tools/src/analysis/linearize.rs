@@ -4,10 +4,8 @@
 //! derivatives of its right-hand side (forward-mode dual numbers through the same equations the
 //! FMUs integrate), and the same closed with the high-pass pressure feedback (eq. 6.2).
 //!
-//! States are the plant's native coordinates, those Co-Simulation integrates: the circuit's six
-//! (p2, p3, p4, spool position, load-holding opening, the friction's bristle deflection: under
-//! `friction.regularisation` = tanh a constant, an eigenvalue 0 that neither the input nor an
-//! output reaches), then the boom's coordinates and rates
+//! States are the plant's native coordinates, those Co-Simulation integrates: the circuit's five
+//! (p2, p3, p4, spool position, load-holding opening), then the boom's coordinates and rates
 //! (rigid: the stroke and its rate; flexible: each section's absolute angle and rate). Model
 //! Exchange's layout pads the flexible arm to 32 sections and gives the rigid boom its angle in
 //! every slot; a linear model of it would carry those copies as uncontrollable modes.
@@ -26,8 +24,7 @@ use super::sine_test::run_to;
 use boomsim::control::HighPassFeedback;
 use boomsim::fmu::variables::Kind;
 use boomsim::fmu::{Causality, Model, Value};
-use boomsim::hydraulics::circuit::{N_STATES as N_CIRCUIT, P2, P3, P4, STATE_NAMES, Z};
-use boomsim::hydraulics::friction::FrictionRegularisation;
+use boomsim::hydraulics::circuit::{N_STATES as N_CIRCUIT, P2, P3, P4, STATE_NAMES};
 use boomsim::models::hydraulic_boom::{Boom, Plant};
 use boomsim::models::port::Ramp;
 use boomsim::models::HydraulicBoom;
@@ -330,9 +327,8 @@ pub fn linearize(plant: &Plant, x0: &[f64], u_ref: f64, outputs: &[&str]) -> Res
 /// The steady lowering at `u_ref` through `stroke`: the plant state where every derivative is
 /// zero except the coordinates', which move together at one rate (rigid: the stroke at the
 /// lowering speed; flexible: every section angle at the boom's angular rate, the arm turning
-/// with its shape held). Unknowns: the circuit's six states, the coordinates and that rate;
-/// equations: the circuit's six derivatives (under the tanh regularisation the bristle
-/// deflection has none: it stays at rest, 0), the accelerations, and the stroke. Newton's method
+/// with its shape held). Unknowns: the circuit's five states, the coordinates and that rate;
+/// equations: the circuit's five derivatives, the accelerations, and the stroke. Newton's method
 /// with exact Jacobians and a step halved until the scaled residual falls, from the load held at
 /// rest with the spool at its steady opening, the CBV at its static opening and the rate of the
 /// flow the spool passes.
@@ -359,9 +355,6 @@ pub fn steady_lowering(plant: &Plant, u_ref: f64, stroke: f64) -> Result<Vec<f64
         let mut ds = vec![Dual64::from(0.0); s.len()];
         plant.rhs_with(Dual64::from(u_ref), &s, &mut ds);
         let mut r: Vec<Dual64> = ds[..N_CIRCUIT].to_vec();
-        if plant.circuit.friction.regularisation == FrictionRegularisation::Tanh {
-            r[Z] = s[Z];
-        }
         r.extend_from_slice(&ds[N_CIRCUIT + dof..]);
         r.push(plant.boom.kinetics().stroke(&s[N_CIRCUIT..N_CIRCUIT + dof]) - stroke);
         r.iter_mut().zip(z_scale).for_each(|(r, s)| *r = *r / *s);
@@ -450,8 +443,7 @@ fn no_steady_state(u_ref: f64, stroke: f64, residual: f64) -> String {
 /// fills with `K1 |u| sqrt(p_pcv)` (eq. 2.43), the cylinder retracting at that flow over the
 /// annulus, the piston side's flow leaving line 2 through the spool's A-T edge (eq. 2.41: p2
 /// above tank by `(A_a v / (K1 u))^2`), and p3, p4 where the CBV is a fifth open (eq. 2.56) with
-/// the load balanced (eq. 2.69); the bristle at rest, 0 (LuGre: Newton finds its deflection with the
-/// rest).
+/// the load balanced (eq. 2.69).
 fn initial_guess(plant: &Plant, u_ref: f64, stroke: f64) -> Result<Vec<f64>, String> {
     let rest = plant.equilibrium(stroke, None)?;
     let dof = plant.boom.mechanics().dof();
@@ -467,7 +459,7 @@ fn initial_guess(plant: &Plant, u_ref: f64, stroke: f64) -> Result<Vec<f64>, Str
     let p4 = ((open - f_load / cyl.area_a()) / (cbv.mu_p + cyl.mu_c())).max(p_t);
     let p3 = (f_load + p4 * cyl.area_b()) / cyl.area_a();
     let p2 = p_t + (cyl.area_a() * v / (c.dcv.k1() * u)).powi(2);
-    let mut z = vec![p2, p3, p4, x_v, cbv.holding_opening(p3, p4, p_t), 0.0];
+    let mut z = vec![p2, p3, p4, x_v, cbv.holding_opening(p3, p4, p_t)];
     let q = &rest[N_CIRCUIT..N_CIRCUIT + dof];
     z.extend_from_slice(q);
     let ones = vec![1.0; dof];

@@ -5,8 +5,6 @@ use crate::analysis::poly::eigenvalues;
 use boomsim::fmu::instance::in_range;
 use boomsim::fmu::variables::BaseType;
 use boomsim::fmu::{Causality, Model, Value, Values, Variable};
-use boomsim::hydraulics::circuit::Z;
-use boomsim::hydraulics::friction::FrictionRegularisation;
 use boomsim::models::hydraulic_boom::{vr, Plant};
 use boomsim::models::HydraulicBoom;
 use boomsim::solver::OdeSystem;
@@ -89,12 +87,7 @@ pub fn hydraulic_boom_modes(
     changes: &[(&str, Value)],
 ) -> Result<(f64, Vec<Mode>), String> {
     let rest = rest(flexible, p4, changes)?;
-    let j = jacobian(&rest.plant, 0.0, &rest.state, &rest.plant.state_scale());
-    // Under the tanh regularisation the bristle deflection is a constant (its row and column are
-    // zero): no degree of freedom, and with another eigenvalue near 0 the pair can come out as a
-    // spurious slow "mode".
-    let tanh = rest.plant.circuit.friction.regularisation == FrictionRegularisation::Tanh;
-    Ok((rest.stroke, modes(if tanh { j.remove_row(Z).remove_column(Z) } else { j })))
+    Ok((rest.stroke, modes(jacobian(&rest.plant, 0.0, &rest.state, &rest.plant.state_scale()))))
 }
 
 /// The plant at rest with the boom horizontal ([`hydraulic_boom_modes`]).
